@@ -1,0 +1,1 @@
+//! The `drape` command line: argument parsing and subcommands; nothing numerical lives here.

@@ -1,0 +1,1 @@
+//! Writers for draped nets: the JSON contract, VTU (ParaView) and CSV.

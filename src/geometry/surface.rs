@@ -1,0 +1,318 @@
+//! [`ToolSurface`]: a checked triangle mesh with a BVH (parry3d), edge adjacency and per-triangle
+//! frames, answering the geometric queries the drape engine needs.
+use super::check::{mend, MendedMesh, NO_NEIGHBOUR};
+use super::obj::{read_obj, MeshReport, ObjError, RawMesh};
+use super::{Point, Vector};
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::TriMesh;
+use std::path::Path;
+
+/// Vertices closer than this fraction of the mesh's bounding-box diagonal are welded.
+pub const WELD_TOLERANCE_REL: f64 = 1e-9;
+/// Barycentric slack when deciding whether a point lies in a triangle: points this close
+/// (relative) outside an edge still count, so roots on shared edges are never lost.
+pub const INSIDE_TOLERANCE: f64 = 1e-10;
+
+/// Precomputed per-triangle data for fast plane and barycentric tests.
+#[derive(Debug, Clone, Copy)]
+struct TriangleFrame {
+    v0: Point,
+    e1: Vector,
+    e2: Vector,
+    normal: Vector,
+    d11: f64,
+    d12: f64,
+    d22: f64,
+    inv_den: f64,
+}
+
+/// A point on the tool: where it is, in which triangle, and the triangle's unit normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub point: Point,
+    pub triangle: u32,
+    pub normal: Vector,
+    /// Distance from the query point (zero for points built on the surface).
+    pub distance: f64,
+}
+
+/// A circle in space: `center + radius (cos t e1 + sin t e2)`.
+#[derive(Debug, Clone, Copy)]
+pub struct Circle {
+    pub center: Point,
+    pub e1: Vector,
+    pub e2: Vector,
+    pub radius: f64,
+}
+
+/// A point where a circle crosses the tool surface.
+#[derive(Debug, Clone, Copy)]
+pub struct CircleRoot {
+    pub point: Point,
+    pub triangle: u32,
+    /// cos of the circle parameter: 1 at `center + radius e1`, decreasing away from it.
+    pub cos_t: f64,
+}
+
+/// The tool surface: a checked, consistently oriented triangle mesh with a BVH.
+pub struct ToolSurface {
+    vertices: Vec<Point>,
+    triangles: Vec<[u32; 3]>,
+    neighbours: Vec<[u32; 3]>,
+    frames: Vec<TriangleFrame>,
+    /// Bounding sphere of each triangle (centre, radius), for cheap ball tests.
+    spheres: Vec<(Point, f64)>,
+    mesh: TriMesh,
+    report: MeshReport,
+    diagonal: f64,
+}
+
+impl std::fmt::Debug for ToolSurface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ToolSurface").field("report", &self.report).finish()
+    }
+}
+
+impl ToolSurface {
+    /// Load, check and mend an OBJ file.
+    pub fn from_obj(path: &Path) -> Result<Self, ObjError> {
+        let (raw, report) = read_obj(path)?;
+        Self::from_raw(raw, report, path)
+    }
+
+    /// Build from in-memory triangles (analytic shapes, tests); goes through the same checks.
+    pub fn from_triangles(vertices: Vec<Point>, triangles: Vec<[u32; 3]>) -> Result<Self, ObjError> {
+        let report = MeshReport {
+            vertices_read: vertices.len(),
+            faces_read: triangles.len(),
+            ..Default::default()
+        };
+        let path = Path::new("<memory>");
+        if triangles.is_empty() {
+            return Err(ObjError::Empty { path: path.into() });
+        }
+        for (f, tri) in triangles.iter().enumerate() {
+            for &i in tri {
+                if i as usize >= vertices.len() {
+                    return Err(ObjError::BadIndex {
+                        path: path.into(),
+                        face: f,
+                        index: i as usize,
+                        count: vertices.len(),
+                    });
+                }
+            }
+        }
+        for (i, v) in vertices.iter().enumerate() {
+            if let Some(&value) = v.coords.iter().find(|c| !c.is_finite()) {
+                return Err(ObjError::NonFinite { path: path.into(), index: i, value });
+            }
+        }
+        Self::from_raw(RawMesh { vertices, triangles }, report, path)
+    }
+
+    fn from_raw(raw: RawMesh, mut report: MeshReport, path: &Path) -> Result<Self, ObjError> {
+        let diagonal = bounding_diagonal(&raw.vertices);
+        let MendedMesh { vertices, triangles, neighbours } =
+            mend(raw, WELD_TOLERANCE_REL * diagonal, path, &mut report)?;
+        if triangles.is_empty() {
+            return Err(ObjError::AllDegenerate { path: path.into() });
+        }
+        let frames = triangles
+            .iter()
+            .map(|t| {
+                let v0 = vertices[t[0] as usize];
+                let e1 = vertices[t[1] as usize] - v0;
+                let e2 = vertices[t[2] as usize] - v0;
+                let normal = e1.cross(&e2).normalize();
+                let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+                let inv_den = 1.0 / (d11 * d22 - d12 * d12);
+                TriangleFrame { v0, e1, e2, normal, d11, d12, d22, inv_den }
+            })
+            .collect();
+        let spheres = triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|i| vertices[i as usize]);
+                let c = Point::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+                let r = p.iter().map(|q| (q - c).norm()).fold(0.0, f64::max);
+                (c, r)
+            })
+            .collect();
+        let mesh = TriMesh::new(vertices.clone(), triangles.clone()).map_err(|e| ObjError::Parse {
+            path: path.into(),
+            reason: format!("mesh rejected by the geometry kernel: {e}"),
+        })?;
+        report.triangles = triangles.len();
+        report.vertices = vertices.len();
+        Ok(ToolSurface { vertices, triangles, neighbours, frames, spheres, mesh, report, diagonal })
+    }
+
+    /// What the checks found and mended.
+    pub fn report(&self) -> &MeshReport {
+        &self.report
+    }
+    /// Number of triangles.
+    pub fn num_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+    /// Welded vertex positions.
+    pub fn vertices(&self) -> &[Point] {
+        &self.vertices
+    }
+    /// Triangles (consistently wound within each connected piece).
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+    /// Length of the bounding-box diagonal: the mesh's length scale.
+    pub fn diagonal(&self) -> f64 {
+        self.diagonal
+    }
+    /// Corner positions of triangle `t`.
+    pub fn corners(&self, t: u32) -> [Point; 3] {
+        self.triangles[t as usize].map(|i| self.vertices[i as usize])
+    }
+    /// Vertex indices of triangle `t`.
+    pub fn triangle(&self, t: u32) -> [u32; 3] {
+        self.triangles[t as usize]
+    }
+    /// Unit normal of triangle `t`.
+    pub fn normal(&self, t: u32) -> Vector {
+        self.frames[t as usize].normal
+    }
+    /// Triangle across the edge of `t` opposite corner `k`, if there is exactly one.
+    pub fn neighbour(&self, t: u32, k: usize) -> Option<u32> {
+        let n = self.neighbours[t as usize][k];
+        (n != NO_NEIGHBOUR).then_some(n)
+    }
+    /// All three neighbours of `t` ([`NO_NEIGHBOUR`] where there is none).
+    pub fn neighbours(&self, t: u32) -> [u32; 3] {
+        self.neighbours[t as usize]
+    }
+
+    /// The closest point of the tool to `p`.
+    pub fn closest_point(&self, p: &Point) -> SurfacePoint {
+        let (proj, (triangle, _)) = self.mesh.project_local_point_and_get_location(p, false);
+        let _ = proj;
+        // Project onto our own frame so the point and the triangle agree exactly.
+        let point = self.project_to_triangle(triangle, p);
+        SurfacePoint { point, triangle, normal: self.normal(triangle), distance: (point - p).norm() }
+    }
+
+    /// Closest point of triangle `t` to `p`.
+    pub fn project_to_triangle(&self, t: u32, p: &Point) -> Point {
+        let c = self.corners(t);
+        closest_point_on_triangle(p, &c[0], &c[1], &c[2])
+    }
+
+    /// Barycentric coordinates of `p` (assumed in the plane of `t`) with respect to `t`.
+    pub fn barycentric(&self, t: u32, p: &Point) -> [f64; 3] {
+        let f = &self.frames[t as usize];
+        let w = p - f.v0;
+        let (a, b) = (w.dot(&f.e1), w.dot(&f.e2));
+        let l1 = (f.d22 * a - f.d12 * b) * f.inv_den;
+        let l2 = (f.d11 * b - f.d12 * a) * f.inv_den;
+        [1.0 - l1 - l2, l1, l2]
+    }
+
+    /// Triangles whose bounding box meets the ball (`center`, `radius`), from the BVH.
+    pub fn triangles_near(&self, center: &Point, radius: f64) -> Vec<u32> {
+        let r = Vector::repeat(radius);
+        let aabb = Aabb::new(center - r, center + r);
+        self.mesh.bvh().intersect_aabb(&aabb).collect()
+    }
+
+    /// Whether triangle `t` may come within `radius` of `center` (bounding-sphere test).
+    #[inline]
+    pub fn triangle_may_meet_ball(&self, t: u32, center: &Point, radius: f64) -> bool {
+        let (c, r) = self.spheres[t as usize];
+        (c - center).norm_squared() <= (r + radius) * (r + radius)
+    }
+
+    /// Points where `circle` crosses triangle `t` (zero, one or two), exactly up to rounding.
+    #[inline]
+    pub fn circle_roots(&self, t: u32, circle: &Circle, out: &mut Vec<CircleRoot>) {
+        let f = &self.frames[t as usize];
+        // Plane: n.(x - v0) = 0 with x = c + r (cos e1 + sin e2):  p cos + q sin = -h / r.
+        let p = f.normal.dot(&circle.e1);
+        let q = f.normal.dot(&circle.e2);
+        let h = f.normal.dot(&(circle.center - f.v0));
+        let rho = (p * p + q * q).sqrt();
+        if rho * circle.radius <= f64::EPSILON * (h.abs() + circle.radius) {
+            return; // the circle's plane is parallel to the triangle's: no isolated crossing
+        }
+        let cos_d = -h / (rho * circle.radius);
+        if !(-1.0..=1.0).contains(&cos_d) {
+            return;
+        }
+        let sin_d = (1.0 - cos_d * cos_d).sqrt();
+        let (ux, uy) = (p / rho, q / rho);
+        for s in [1.0, -1.0] {
+            // Unit vector (cos t, sin t) = cos_d u + s sin_d u_perp, u_perp = (-uy, ux).
+            let ct = cos_d * ux - s * sin_d * uy;
+            let st = cos_d * uy + s * sin_d * ux;
+            let x = circle.center + circle.radius * (ct * circle.e1 + st * circle.e2);
+            let l = self.barycentric(t, &x);
+            if l.iter().all(|&li| li >= -INSIDE_TOLERANCE) {
+                out.push(CircleRoot { point: x, triangle: t, cos_t: ct });
+            }
+            if sin_d == 0.0 {
+                break;
+            }
+        }
+    }
+}
+
+/// Length of the bounding-box diagonal of a point set (0 for fewer than two points).
+pub fn bounding_diagonal(points: &[Point]) -> f64 {
+    let mut lo = Vector::repeat(f64::INFINITY);
+    let mut hi = Vector::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(&p.coords);
+        hi = hi.sup(&p.coords);
+    }
+    if points.is_empty() {
+        0.0
+    } else {
+        (hi - lo).norm()
+    }
+}
+
+/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5).
+pub fn closest_point_on_triangle(p: &Point, a: &Point, b: &Point, c: &Point) -> Point {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return *a;
+    }
+    let bp = p - b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return *b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return *c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}

@@ -1,0 +1,1 @@
+//! Generators: the two fibre paths through the origin node that seed the fishnet.

@@ -1,0 +1,69 @@
+//! The kinematic (pin-jointed net, "fishnet") drape: generators through a seed point, then every
+//! other node as the intersection of the tool with a circle of points at distance d from two
+//! placed neighbours.
+pub mod fishnet;
+pub mod generators;
+pub mod net;
+
+pub use fishnet::{drape, DrapeError};
+pub use net::{DrapeNet, Method, NodeStatus};
+
+use crate::geometry::{Point, Vector};
+
+/// How the two fibre generators through the origin are laid.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GeneratorKind {
+    /// Straightest geodesics along the warp direction and its (pre-sheared) perpendicular.
+    Geodesic,
+    /// Each generator segment turned to minimise the shear of the cells beside it.
+    MinShear,
+    /// The warp generator follows this curve (projected onto the tool, resampled at d); the weft
+    /// generator is a geodesic.
+    Steer(Vec<Point>),
+}
+
+/// How far the net extends.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Extent {
+    /// A grid of `nu x nv` nodes with the origin at node `origin_node` (default: the centre).
+    Grid { nu: usize, nv: usize, origin_node: Option<(usize, usize)> },
+    /// A closed polyline on the tool: the grid is sized to cover it and nodes outside are dropped.
+    Outline(Vec<Point>),
+}
+
+/// Everything the kinematic drape of one ply needs (SI units, radians).
+#[derive(Debug, Clone)]
+pub struct KinematicSettings {
+    pub name: String,
+    /// Seed point; projected onto the tool.
+    pub origin: Point,
+    /// Warp direction; projected onto the tangent plane at the origin.
+    pub warp: Vector,
+    /// Fibre segment length d.
+    pub spacing: f64,
+    pub extent: Extent,
+    /// Pre-shear: the generators meet at pi/2 - pre_shear.
+    pub pre_shear: f64,
+    pub generators: GeneratorKind,
+    /// Nodes whose corner shear would reach this are not placed (radians, < pi/2).
+    pub max_shear: f64,
+}
+
+/// Default shear at which a node is refused as a collapsing cell (degrees).
+pub const DEFAULT_MAX_SHEAR_DEG: f64 = 75.0;
+
+impl KinematicSettings {
+    /// Settings for a geodesic-generator grid with the origin at the centre.
+    pub fn grid(name: &str, origin: Point, warp: Vector, spacing: f64, nu: usize, nv: usize) -> Self {
+        KinematicSettings {
+            name: name.to_string(),
+            origin,
+            warp,
+            spacing,
+            extent: Extent::Grid { nu, nv, origin_node: None },
+            pre_shear: 0.0,
+            generators: GeneratorKind::Geodesic,
+            max_shear: DEFAULT_MAX_SHEAR_DEG.to_radians(),
+        }
+    }
+}

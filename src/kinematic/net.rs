@@ -1,0 +1,220 @@
+//! [`DrapeNet`]: the warp/weft grid of nodes that travels through the whole pipeline.
+use crate::geometry::{Point, Vector};
+use serde::{Deserialize, Serialize};
+
+/// How a net was computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    Kinematic,
+    Mechanical,
+}
+
+/// What happened to one node of the net.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
+#[serde(rename_all = "snake_case")]
+#[repr(u8)]
+pub enum NodeStatus {
+    /// Placed on the tool.
+    Placed = 0,
+    /// Not computed yet (never left in a finished net).
+    Pending = 1,
+    /// A generator ran off the tool (open boundary, non-manifold edge or boundary vertex).
+    OffTool = 2,
+    /// The circle of points at distance d from both parents misses the tool.
+    NoRoot = 3,
+    /// The cell would shear past the limit (or its parents are farther apart than 2 d).
+    ShearLimit = 4,
+    /// The only root folds the fabric back over itself (cell turned over).
+    Fold = 5,
+    /// The only root lies on another sheet of the tool (e.g. the far side of a thin wall).
+    SheetJump = 6,
+    /// A node it depends on was not placed.
+    ParentMissing = 7,
+    /// Outside the ply outline: dropped.
+    OutsideOutline = 8,
+}
+
+impl NodeStatus {
+    /// All statuses, in code order.
+    pub const ALL: [NodeStatus; 9] = [
+        NodeStatus::Placed,
+        NodeStatus::Pending,
+        NodeStatus::OffTool,
+        NodeStatus::NoRoot,
+        NodeStatus::ShearLimit,
+        NodeStatus::Fold,
+        NodeStatus::SheetJump,
+        NodeStatus::ParentMissing,
+        NodeStatus::OutsideOutline,
+    ];
+    /// Snake-case name used in files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeStatus::Placed => "placed",
+            NodeStatus::Pending => "pending",
+            NodeStatus::OffTool => "off_tool",
+            NodeStatus::NoRoot => "no_root",
+            NodeStatus::ShearLimit => "shear_limit",
+            NodeStatus::Fold => "fold",
+            NodeStatus::SheetJump => "sheet_jump",
+            NodeStatus::ParentMissing => "parent_missing",
+            NodeStatus::OutsideOutline => "outside_outline",
+        }
+    }
+    /// Status from its numeric code.
+    pub fn from_code(code: u8) -> Option<Self> {
+        Self::ALL.get(code as usize).copied()
+    }
+}
+
+/// Wall-clock time per stage, in milliseconds.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct Timing {
+    pub load_ms: f64,
+    pub generators_ms: f64,
+    pub fill_ms: f64,
+    pub total_ms: f64,
+}
+
+/// A draped warp/weft grid. Node (i, j) is at index `i * nv + j`; i runs along the warp.
+/// A node's position is meaningful only where its status is [`NodeStatus::Placed`].
+#[derive(Debug, Clone)]
+pub struct DrapeNet {
+    pub name: String,
+    pub method: Method,
+    /// Fibre segment length d (m).
+    pub spacing: f64,
+    pub nu: usize,
+    pub nv: usize,
+    /// Grid indices of the origin node.
+    pub origin_node: (usize, usize),
+    pub positions: Vec<Point>,
+    /// Triangle of the tool each placed node lies in.
+    pub triangles: Vec<u32>,
+    pub status: Vec<NodeStatus>,
+    pub timing: Timing,
+    /// Free-form provenance written with the net (tool file, generators, directions...).
+    pub meta: serde_json::Map<String, serde_json::Value>,
+}
+
+impl DrapeNet {
+    /// An empty (all pending) net.
+    pub fn new(name: &str, spacing: f64, nu: usize, nv: usize, origin_node: (usize, usize)) -> Self {
+        let n = nu * nv;
+        DrapeNet {
+            name: name.to_string(),
+            method: Method::Kinematic,
+            spacing,
+            nu,
+            nv,
+            origin_node,
+            positions: vec![Point::origin(); n],
+            triangles: vec![u32::MAX; n],
+            status: vec![NodeStatus::Pending; n],
+            timing: Timing::default(),
+            meta: Default::default(),
+        }
+    }
+
+    /// Linear index of node (i, j).
+    #[inline]
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        i * self.nv + j
+    }
+
+    /// Position of node (i, j) if it was placed.
+    #[inline]
+    pub fn node(&self, i: usize, j: usize) -> Option<Point> {
+        let k = self.index(i, j);
+        (self.status[k] == NodeStatus::Placed).then(|| self.positions[k])
+    }
+
+    /// Number of cells, `(nu - 1) * (nv - 1)`.
+    pub fn num_cells(&self) -> usize {
+        (self.nu - 1) * (self.nv - 1)
+    }
+
+    /// The four corners of cell (i, j) if all are placed: [(i,j), (i+1,j), (i,j+1), (i+1,j+1)].
+    #[inline]
+    pub fn cell_corners(&self, i: usize, j: usize) -> Option<[Point; 4]> {
+        Some([self.node(i, j)?, self.node(i + 1, j)?, self.node(i, j + 1)?, self.node(i + 1, j + 1)?])
+    }
+
+    /// Mean shear angle of cell (i, j) in radians: the mean over its four corners of
+    /// pi/2 - angle(warp edge, weft edge), edges oriented along +i and +j.
+    pub fn cell_shear(&self, i: usize, j: usize) -> Option<f64> {
+        let [p00, p10, p01, p11] = self.cell_corners(i, j)?;
+        let (w0, w1) = (p10 - p00, p11 - p01); // warp edges (bottom, top)
+        let (f0, f1) = (p01 - p00, p11 - p10); // weft edges (left, right)
+        let g = corner_shear(&w0, &f0) + corner_shear(&w0, &f1) + corner_shear(&w1, &f0) + corner_shear(&w1, &f1);
+        Some(0.25 * g)
+    }
+
+    /// Unit warp and weft directions and unit normal (warp x weft) of cell (i, j).
+    pub fn cell_frame(&self, i: usize, j: usize) -> Option<CellFrame> {
+        let [p00, p10, p01, p11] = self.cell_corners(i, j)?;
+        let warp = ((p10 - p00) + (p11 - p01)).try_normalize(0.0)?;
+        let weft = ((p01 - p00) + (p11 - p10)).try_normalize(0.0)?;
+        let normal = warp.cross(&weft).try_normalize(0.0)?;
+        let centre = Point::from((p00.coords + p10.coords + p01.coords + p11.coords) * 0.25);
+        Some(CellFrame { centre, warp, weft, normal })
+    }
+
+    /// Count of nodes by status.
+    pub fn status_counts(&self) -> Vec<(NodeStatus, usize)> {
+        let mut counts = [0usize; NodeStatus::ALL.len()];
+        for s in &self.status {
+            counts[*s as usize] += 1;
+        }
+        NodeStatus::ALL.iter().zip(counts).filter(|(_, c)| *c > 0).map(|(s, c)| (*s, c)).collect()
+    }
+
+    /// Shear statistics over all complete cells.
+    pub fn shear_stats(&self, locking_angle: f64) -> ShearStats {
+        let mut s = ShearStats::default();
+        let mut sum = 0.0;
+        for i in 0..self.nu.saturating_sub(1) {
+            for j in 0..self.nv.saturating_sub(1) {
+                if let Some(g) = self.cell_shear(i, j) {
+                    s.cells += 1;
+                    sum += g.abs();
+                    s.max_abs = s.max_abs.max(g.abs());
+                    if g.abs() > locking_angle {
+                        s.over_locking += 1;
+                    }
+                }
+            }
+        }
+        if s.cells > 0 {
+            s.mean_abs = sum / s.cells as f64;
+        }
+        s
+    }
+}
+
+/// Local fibre frame of one cell.
+#[derive(Debug, Clone, Copy)]
+pub struct CellFrame {
+    pub centre: Point,
+    pub warp: Vector,
+    pub weft: Vector,
+    pub normal: Vector,
+}
+
+/// Shear statistics of a net (radians).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ShearStats {
+    pub cells: usize,
+    pub max_abs: f64,
+    pub mean_abs: f64,
+    pub over_locking: usize,
+}
+
+/// Shear of one corner: pi/2 minus the angle between the warp and weft edges, radians.
+#[inline]
+pub fn corner_shear(warp: &Vector, weft: &Vector) -> f64 {
+    // atan2 form: accurate near 0 and near 90 deg, unlike acos of a dot product.
+    let angle = warp.cross(weft).norm().atan2(warp.dot(weft));
+    std::f64::consts::FRAC_PI_2 - angle
+}

@@ -1,0 +1,1 @@
+//! Scenes: the tool and the plies to drape on it.

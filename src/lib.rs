@@ -1,0 +1,13 @@
+//! `drape`: plans how composite plies lie on a part.
+//!
+//! The pipeline: a [`geometry::ToolSurface`] (checked OBJ mesh + BVH + topology) is draped by the
+//! kinematic fishnet mapper ([`kinematic::drape`]) into a [`kinematic::DrapeNet`], the one grid
+//! type that every later stage reads; [`export`] writes it out.
+pub mod cli;
+pub mod export;
+pub mod geometry;
+pub mod kinematic;
+pub mod layup;
+
+pub use geometry::ToolSurface;
+pub use kinematic::{drape, DrapeNet, KinematicSettings};
