@@ -1,1 +1,94 @@
 //! The `drape` command line: argument parsing and subcommands; nothing numerical lives here.
+mod bench;
+mod kinematic;
+mod scene;
+mod summary;
+
+use clap::{Parser, Subcommand};
+
+/// Exit code for bad input (arguments, files, scenes).
+pub const EXIT_BAD_INPUT: i32 = 2;
+/// Exit code for a computation that failed.
+pub const EXIT_FAILED: i32 = 1;
+
+/// A failed command: what went wrong and which exit code it earns.
+#[derive(Debug)]
+pub enum Failure {
+    /// The input is wrong; the message says how to fix it (exit code 2).
+    Input(anyhow::Error),
+    /// The computation failed (exit code 1).
+    Compute(anyhow::Error),
+}
+
+impl Failure {
+    /// Process exit code.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Failure::Input(_) => EXIT_BAD_INPUT,
+            Failure::Compute(_) => EXIT_FAILED,
+        }
+    }
+    /// The message shown to the user.
+    pub fn message(&self) -> String {
+        match self {
+            Failure::Input(e) | Failure::Compute(e) => format!("{e:#}"),
+        }
+    }
+}
+
+/// Tag an error as bad input.
+pub(crate) fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
+    Failure::Input(e.into())
+}
+/// Tag an error as a failed computation.
+pub(crate) fn compute<E: Into<anyhow::Error>>(e: E) -> Failure {
+    Failure::Compute(e.into())
+}
+
+/// Plan how composite plies lie on a part: kinematic (fishnet) drape on OBJ tool surfaces.
+#[derive(Debug, Parser)]
+#[command(name = "drape", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Drape one ply on a tool with the kinematic (pin-jointed net) method.
+    Kinematic(kinematic::KinematicArgs),
+    /// Drape every ply of a scene file.
+    Run(scene::RunArgs),
+    /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
+    Bench(bench::BenchArgs),
+}
+
+/// Run a parsed command line.
+pub fn run(cli: Cli) -> Result<(), Failure> {
+    match cli.command {
+        Command::Kinematic(a) => kinematic::run(a),
+        Command::Run(a) => scene::run(a),
+        Command::Bench(a) => bench::run(a),
+    }
+}
+
+/// Parse `X,Y,Z` into three finite numbers.
+pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let nums: Result<Vec<f64>, _> = parts.iter().map(|p| p.parse::<f64>()).collect();
+    match nums {
+        Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => Ok([v[0], v[1], v[2]]),
+        _ => Err(format!("'{s}' is not a vector: give three finite numbers separated by commas, like 0,0,1.5")),
+    }
+}
+
+/// Parse `A,B` into two whole numbers.
+pub fn parse_pair(s: &str) -> Result<[usize; 2], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let nums: Result<Vec<usize>, _> = parts.iter().map(|p| p.parse::<usize>()).collect();
+    match nums {
+        Ok(v) if v.len() == 2 => Ok([v[0], v[1]]),
+        _ => Err(format!("'{s}' is not a pair: give two whole numbers separated by a comma, like 101,101")),
+    }
+}

@@ -77,7 +77,15 @@ impl std::fmt::Debug for ToolSurface {
 impl ToolSurface {
     /// Load, check and mend an OBJ file.
     pub fn from_obj(path: &Path) -> Result<Self, ObjError> {
-        let (raw, report) = read_obj(path)?;
+        Self::from_obj_scaled(path, 1.0)
+    }
+
+    /// Load an OBJ whose coordinates are in units of `scale` metres (0.001 for millimetres).
+    pub fn from_obj_scaled(path: &Path, scale: f64) -> Result<Self, ObjError> {
+        let (mut raw, report) = read_obj(path)?;
+        if scale != 1.0 {
+            raw.vertices.iter_mut().for_each(|v| *v *= scale);
+        }
         Self::from_raw(raw, report, path)
     }
 

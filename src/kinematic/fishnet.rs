@@ -1,16 +1,432 @@
-//! Fishnet cell completion, quadrant by quadrant, one anti-diagonal wavefront at a time.
-use super::{DrapeNet, KinematicSettings};
-use crate::geometry::ToolSurface;
+//! Fishnet cell completion: every node off the generators is the point of the tool at distance d
+//! from its two placed neighbours (the intersection of the tool with a circle), on the side away
+//! from the diagonal node. Quadrants are filled in parallel, each one anti-diagonal at a time
+//! (every node of an anti-diagonal depends only on the one before), so the result does not depend
+//! on the number of threads.
+use super::generators::{lay_generators, Generators};
+use super::net::{corner_shear, DrapeNet, Method, NodeStatus};
+use super::{Extent, KinematicSettings};
+use crate::geometry::surface::{Circle, CircleRoot};
+use crate::geometry::{Point, ToolSurface, Vector};
+use rayon::prelude::*;
+use std::cell::RefCell;
+use std::time::Instant;
 
-/// Why a drape could not start (bad settings or seed); per-node failures are recorded in the net.
+/// A root whose circle parameter is past this cosine (about 120 deg from straight ahead) would
+/// fold the cell back towards its diagonal node: it is never taken.
+pub const COS_FOLD: f64 = -0.5;
+/// Roots this close to the diagonal node's side of the circle are the diagonal node itself
+/// (cos of about 162 deg): their presence alone is not a fold.
+const COS_DIAGONAL: f64 = -0.95;
+/// Parents farther apart than this fraction of 2 d leave no usable circle (cell collapsed).
+const MAX_PARENT_GAP: f64 = 1.0 - 1e-12;
+/// Anti-diagonals shorter than this are filled on one thread (parallel overhead dominates).
+const PARALLEL_DIAGONAL: usize = 256;
+/// Bytes of memory per node while a net is being built (positions, triangle, status, quadrant copy).
+pub const BYTES_PER_NODE: usize = 2 * (24 + 4 + 1) + 8;
+
+/// Why a drape could not start. Per-node failures are not errors: they are recorded in the net.
 #[derive(Debug, thiserror::Error)]
 pub enum DrapeError {
+    #[error("spacing must be a positive length, got {0}. Give the fibre segment length d, e.g. --spacing 0.005")]
+    Spacing(f64),
+    #[error("grid must be at least 2 x 2 nodes, got {0} x {1}")]
+    GridTooSmall(usize, usize),
+    #[error("origin node ({0}, {1}) is outside the {2} x {3} grid: use 0..{2} and 0..{3}")]
+    OriginNode(usize, usize, usize, usize),
+    #[error("a {nu} x {nv} net needs about {need_mb} MB but only {have_mb} MB of memory are available: use a larger spacing or a smaller grid")]
+    TooLarge { nu: usize, nv: usize, need_mb: u64, have_mb: u64 },
+    #[error("the origin ({x}, {y}, {z}) is {distance:.4} from the tool, more than one spacing ({spacing}): give a seed point on (or within one spacing of) the tool surface, in the tool's units")]
+    OriginOffTool { x: f64, y: f64, z: f64, distance: f64, spacing: f64 },
+    #[error("the warp direction {0:?} is normal to the tool at the origin (or zero): give a direction along the surface")]
+    WarpNormal([f64; 3]),
+    #[error("pre-shear must lie strictly between -90 and 90 degrees, got {0} deg")]
+    PreShear(f64),
+    #[error("the shear limit must lie strictly between 0 and 90 degrees, got {0} deg")]
+    MaxShear(f64),
     #[error("{0}")]
-    Settings(String),
+    Outline(String),
+    #[error("{0}")]
+    Steering(String),
 }
 
-/// Drape one ply on the tool.
+/// A node placed on the tool.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placed {
+    pub point: Point,
+    pub triangle: u32,
+}
+
+/// Per-thread scratch for the local root search (triangle visit stamps, stack, roots).
+#[derive(Default)]
+struct Scratch {
+    stamps: Vec<u32>,
+    stamp: u32,
+    stack: Vec<u32>,
+    roots: Vec<CircleRoot>,
+}
+
+impl Scratch {
+    fn next_stamp(&mut self, n: usize) -> u32 {
+        if self.stamps.len() < n {
+            self.stamps.resize(n, 0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.stamps.iter_mut().for_each(|s| *s = 0);
+            self.stamp = 1;
+        }
+        self.stamp
+    }
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// The fishnet step. `a` is the warp parent (differs from the new node in i), `b` the weft parent
+/// (differs in j), `c` the diagonal node; `si`, `sj` (+1 or -1) say in which direction i and j
+/// grow from the parents to the new node. Returns the new node or why it cannot be placed.
+pub fn place_node(
+    tool: &ToolSurface,
+    d: f64,
+    max_shear: f64,
+    a: &Placed,
+    b: &Placed,
+    c: &Point,
+    si: f64,
+    sj: f64,
+) -> Result<Placed, NodeStatus> {
+    let ab = a.point - b.point;
+    let gap = ab.norm();
+    if gap >= 2.0 * d * MAX_PARENT_GAP {
+        return Err(NodeStatus::ShearLimit);
+    }
+    let axis = ab / gap;
+    let center = Point::from((a.point.coords + b.point.coords) * 0.5);
+    let radius = (d * d - 0.25 * gap * gap).sqrt();
+    let mc = center - c;
+    let e1 = (mc - axis * axis.dot(&mc)).try_normalize(1e-14 * d).ok_or(NodeStatus::ShearLimit)?;
+    let e2 = axis.cross(&e1);
+    let circle = Circle { center, e1, e2, radius };
+    let reach = radius.max(0.5 * gap);
+
+    let root = circle_root(tool, &circle, reach, [a.triangle, b.triangle])?;
+    let x = root.point;
+    // Fold: the new cell must keep the net's orientation (warp x weft along the tool normal).
+    let warp_x = (x - a.point) * si;
+    let weft_x = (x - b.point) * sj;
+    if warp_x.cross(&weft_x).dot(&tool.normal(root.triangle)) <= 0.0 {
+        return Err(NodeStatus::Fold);
+    }
+    let warp_c = (b.point - c) * si;
+    let weft_c = (a.point - c) * sj;
+    if corner_shear(&warp_x, &weft_x).abs() > max_shear || corner_shear(&warp_c, &weft_c).abs() > max_shear {
+        return Err(NodeStatus::ShearLimit);
+    }
+    Ok(Placed { point: x, triangle: root.triangle })
+}
+
+/// The acceptable crossing of `circle` with the tool farthest along `e1` (largest cos of the circle
+/// parameter): first on the patch of triangles connected to `seeds` within `reach` of the circle's
+/// centre, then, if that patch has none, among all triangles near the circle (BVH). A root found
+/// only by the BVH whose triangle faces away from the first seed's is on another sheet.
+pub fn circle_root(tool: &ToolSurface, circle: &Circle, reach: f64, seeds: [u32; 2]) -> Result<CircleRoot, NodeStatus> {
+    SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        if let Some(r) = local_roots(tool, circle, reach, seeds, s) {
+            return Ok(r);
+        }
+        let r = all_roots_near(tool, circle, reach, s)?;
+        if tool.normal(r.triangle).dot(&tool.normal(seeds[0])) < 0.0 {
+            return Err(NodeStatus::SheetJump);
+        }
+        Ok(r)
+    })
+}
+
+/// Best acceptable root among triangles connected to `seeds` that may meet the ball around the
+/// circle, by flood fill over edge neighbours.
+fn local_roots(tool: &ToolSurface, circle: &Circle, reach: f64, seeds: [u32; 2], s: &mut Scratch) -> Option<CircleRoot> {
+    let stamp = s.next_stamp(tool.num_triangles());
+    s.stack.clear();
+    s.roots.clear();
+    for t in seeds {
+        if s.stamps[t as usize] != stamp {
+            s.stamps[t as usize] = stamp;
+            s.stack.push(t);
+        }
+    }
+    while let Some(t) = s.stack.pop() {
+        tool.circle_roots(t, circle, &mut s.roots);
+        for n in tool.neighbours(t) {
+            if n != crate::geometry::NO_NEIGHBOUR
+                && s.stamps[n as usize] != stamp
+                && tool.triangle_may_meet_ball(n, &circle.center, reach)
+            {
+                s.stamps[n as usize] = stamp;
+                s.stack.push(n);
+            }
+        }
+    }
+    best_root(&s.roots)
+}
+
+/// Best acceptable root among all triangles near the circle (BVH query), or why there is none.
+fn all_roots_near(tool: &ToolSurface, circle: &Circle, reach: f64, s: &mut Scratch) -> Result<CircleRoot, NodeStatus> {
+    s.roots.clear();
+    for t in tool.triangles_near(&circle.center, reach) {
+        tool.circle_roots(t, circle, &mut s.roots);
+    }
+    if let Some(r) = best_root(&s.roots) {
+        return Ok(r);
+    }
+    // Roots between "ahead" and "back at the diagonal node" mean the fabric would fold back.
+    if s.roots.iter().any(|r| r.cos_t > COS_DIAGONAL) {
+        Err(NodeStatus::Fold)
+    } else {
+        Err(NodeStatus::NoRoot)
+    }
+}
+
+/// The root farthest from the diagonal node (largest cos of the circle parameter), if it is ahead
+/// enough not to fold the cell. Ties are broken by triangle index so results are deterministic.
+fn best_root(roots: &[CircleRoot]) -> Option<CircleRoot> {
+    roots
+        .iter()
+        .filter(|r| r.cos_t >= COS_FOLD)
+        .max_by(|p, q| p.cos_t.total_cmp(&q.cos_t).then(q.triangle.cmp(&p.triangle)))
+        .copied()
+}
+
+/// One quadrant of the grid seen from the origin node: i = i0 + si * a, j = j0 + sj * b.
+struct Quadrant {
+    si: i64,
+    sj: i64,
+    /// Nodes along a (warp) and b (weft), including the generator row/column at 0.
+    na: usize,
+    nb: usize,
+}
+
+/// Quadrant-local node storage, index a * nb + b.
+struct QuadrantNodes {
+    placed: Vec<Option<Placed>>,
+    status: Vec<NodeStatus>,
+}
+
+/// Drape one ply on the tool with the kinematic (fishnet) method.
 pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNet, DrapeError> {
-    let _ = (tool, settings);
-    todo!()
+    let start = Instant::now();
+    let d = settings.spacing;
+    if !(d.is_finite() && d > 0.0) {
+        return Err(DrapeError::Spacing(d));
+    }
+    if !(settings.pre_shear.abs() < std::f64::consts::FRAC_PI_2) {
+        return Err(DrapeError::PreShear(settings.pre_shear.to_degrees()));
+    }
+    if !(settings.max_shear > 0.0 && settings.max_shear < std::f64::consts::FRAC_PI_2) {
+        return Err(DrapeError::MaxShear(settings.max_shear.to_degrees()));
+    }
+    let seed = tool.closest_point(&settings.origin);
+    if !(seed.distance <= d) {
+        let o = settings.origin;
+        return Err(DrapeError::OriginOffTool { x: o.x, y: o.y, z: o.z, distance: seed.distance, spacing: d });
+    }
+    let outline = match &settings.extent {
+        Extent::Outline(points) => Some(super::outline::Outline::new(tool, points, d)?),
+        Extent::Grid { .. } => None,
+    };
+    let (nu, nv, (i0, j0)) = match (&settings.extent, &outline) {
+        (Extent::Grid { nu, nv, origin_node }, _) => {
+            let (nu, nv) = (*nu, *nv);
+            if nu < 2 || nv < 2 {
+                return Err(DrapeError::GridTooSmall(nu, nv));
+            }
+            let on = origin_node.unwrap_or((nu / 2, nv / 2));
+            if on.0 >= nu || on.1 >= nv {
+                return Err(DrapeError::OriginNode(on.0, on.1, nu, nv));
+            }
+            (nu, nv, on)
+        }
+        (_, Some(o)) => {
+            let half = o.half_size(&seed.point, d);
+            (2 * half + 1, 2 * half + 1, (half, half))
+        }
+        _ => unreachable!("an outline extent always builds an outline"),
+    };
+    check_memory(nu, nv)?;
+
+    let t_gen = Instant::now();
+    let generators = lay_generators(tool, settings, &seed, (nu, nv), (i0, j0))?;
+    let generators_ms = ms(t_gen);
+
+    let t_fill = Instant::now();
+    let mut net = DrapeNet::new(&settings.name, d, nu, nv, (i0, j0));
+    net.method = Method::Kinematic;
+    write_generators(&mut net, &generators);
+    let quadrants: Vec<Quadrant> = [(1i64, 1i64), (-1, 1), (-1, -1), (1, -1)]
+        .into_iter()
+        .map(|(si, sj)| Quadrant {
+            si,
+            sj,
+            na: if si > 0 { nu - i0 } else { i0 + 1 },
+            nb: if sj > 0 { nv - j0 } else { j0 + 1 },
+        })
+        .collect();
+    let filled: Vec<QuadrantNodes> = quadrants
+        .par_iter()
+        .map(|q| fill_quadrant(tool, settings, &net, q))
+        .collect();
+    for (q, nodes) in quadrants.iter().zip(&filled) {
+        for a in 1..q.na {
+            for b in 1..q.nb {
+                let k = a * q.nb + b;
+                let i = (i0 as i64 + q.si * a as i64) as usize;
+                let j = (j0 as i64 + q.sj * b as i64) as usize;
+                let g = net.index(i, j);
+                net.status[g] = nodes.status[k];
+                if let Some(p) = nodes.placed[k] {
+                    net.positions[g] = p.point;
+                    net.triangles[g] = p.triangle;
+                }
+            }
+        }
+    }
+    if let Some(o) = &outline {
+        o.drop_outside(&mut net);
+    }
+    net.timing.generators_ms = generators_ms;
+    net.timing.fill_ms = ms(t_fill);
+    net.timing.total_ms = ms(start);
+    let w = generators.warp_dir;
+    net.meta.insert("warp_direction".into(), serde_json::json!([w.x, w.y, w.z]));
+    let p = seed.point;
+    net.meta.insert("origin".into(), serde_json::json!([p.x, p.y, p.z]));
+    net.meta.insert("pre_shear_deg".into(), serde_json::json!(settings.pre_shear.to_degrees()));
+    net.meta.insert("generators".into(), serde_json::json!(generators.kind));
+    net.meta.insert("max_shear_deg".into(), serde_json::json!(settings.max_shear.to_degrees()));
+    Ok(net)
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Refuse nets that cannot fit in the memory this machine has free.
+pub fn check_memory(nu: usize, nv: usize) -> Result<(), DrapeError> {
+    let need = (nu as u128 * nv as u128 * BYTES_PER_NODE as u128) as f64;
+    let have = available_memory_bytes().unwrap_or(u64::MAX) as f64;
+    if need > 0.8 * have || nu.checked_mul(nv).is_none() {
+        return Err(DrapeError::TooLarge {
+            nu,
+            nv,
+            need_mb: (need / 1e6).ceil() as u64,
+            have_mb: (have / 1e6) as u64,
+        });
+    }
+    Ok(())
+}
+
+/// Memory available to new allocations (Linux /proc/meminfo), if known.
+pub fn available_memory_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Put the origin and generator nodes into the net.
+fn write_generators(net: &mut DrapeNet, g: &Generators) {
+    let (i0, j0) = net.origin_node;
+    let k0 = net.index(i0, j0);
+    net.positions[k0] = g.origin.point;
+    net.triangles[k0] = g.origin.triangle;
+    net.status[k0] = NodeStatus::Placed;
+    let halves: [(&Vec<Result<Placed, NodeStatus>>, i64, i64); 4] =
+        [(&g.warp_pos, 1, 0), (&g.warp_neg, -1, 0), (&g.weft_pos, 0, 1), (&g.weft_neg, 0, -1)];
+    for (nodes, di, dj) in halves {
+        for (k, node) in nodes.iter().enumerate() {
+            let step = k as i64 + 1;
+            let i = (i0 as i64 + di * step) as usize;
+            let j = (j0 as i64 + dj * step) as usize;
+            let idx = net.index(i, j);
+            match node {
+                Ok(p) => {
+                    net.positions[idx] = p.point;
+                    net.triangles[idx] = p.triangle;
+                    net.status[idx] = NodeStatus::Placed;
+                }
+                Err(s) => net.status[idx] = *s,
+            }
+        }
+    }
+}
+
+/// Fill one quadrant, anti-diagonal by anti-diagonal.
+fn fill_quadrant(tool: &ToolSurface, settings: &KinematicSettings, net: &DrapeNet, q: &Quadrant) -> QuadrantNodes {
+    let (na, nb) = (q.na, q.nb);
+    let (i0, j0) = net.origin_node;
+    let mut nodes = QuadrantNodes { placed: vec![None; na * nb], status: vec![NodeStatus::Pending; na * nb] };
+    // Row a = 0 and column b = 0 come from the generators.
+    for a in 0..na {
+        for b in [0usize].into_iter().chain(if a == 0 { 1..nb } else { 0..0 }) {
+            let i = (i0 as i64 + q.si * a as i64) as usize;
+            let j = (j0 as i64 + q.sj * b as i64) as usize;
+            let k = net.index(i, j);
+            nodes.status[a * nb + b] = net.status[k];
+            if net.status[k] == NodeStatus::Placed {
+                nodes.placed[a * nb + b] = Some(Placed { point: net.positions[k], triangle: net.triangles[k] });
+            }
+        }
+    }
+    let (si, sj) = (q.si as f64, q.sj as f64);
+    let d = settings.spacing;
+    let max_shear = settings.max_shear;
+    let solve = |nodes: &QuadrantNodes, a: usize, b: usize| -> Result<Placed, NodeStatus> {
+        let pa = nodes.placed[(a - 1) * nb + b];
+        let pb = nodes.placed[a * nb + b - 1];
+        let pc = nodes.placed[(a - 1) * nb + b - 1];
+        match (pa, pb, pc) {
+            (Some(pa), Some(pb), Some(pc)) => place_node(tool, d, max_shear, &pa, &pb, &pc.point, si, sj),
+            _ => Err(NodeStatus::ParentMissing),
+        }
+    };
+    let mut results: Vec<Result<Placed, NodeStatus>> = Vec::new();
+    for k in 2..(na + nb - 1) {
+        // Nodes with a + b = k, 1 <= a < na, 1 <= b < nb.
+        let a_lo = k.saturating_sub(nb - 1).max(1);
+        let a_hi = (k - 1).min(na - 1);
+        if a_lo > a_hi {
+            continue;
+        }
+        let len = a_hi - a_lo + 1;
+        if len >= PARALLEL_DIAGONAL {
+            (a_lo..a_hi + 1).into_par_iter().map(|a| solve(&nodes, a, k - a)).collect_into_vec(&mut results);
+        } else {
+            results.clear();
+            results.extend((a_lo..=a_hi).map(|a| solve(&nodes, a, k - a)));
+        }
+        for (off, r) in results.iter().enumerate() {
+            let a = a_lo + off;
+            let idx = a * nb + (k - a);
+            match r {
+                Ok(p) => {
+                    nodes.placed[idx] = Some(*p);
+                    nodes.status[idx] = NodeStatus::Placed;
+                }
+                Err(s) => nodes.status[idx] = *s,
+            }
+        }
+    }
+    nodes
+}
+
+/// Mean shear (radians) of the cell with warp parent `a`, weft parent `b`, diagonal `c` and new
+/// node `x`, for a quadrant growing along (`si`, `sj`).
+pub fn cell_shear_of(a: &Point, b: &Point, c: &Point, x: &Point, si: f64, sj: f64) -> f64 {
+    let w0: Vector = (b - c) * si; // warp edges
+    let w1: Vector = (x - a) * si;
+    let f0: Vector = (a - c) * sj; // weft edges
+    let f1: Vector = (x - b) * sj;
+    0.25 * (corner_shear(&w0, &f0) + corner_shear(&w0, &f1) + corner_shear(&w1, &f0) + corner_shear(&w1, &f1))
 }

@@ -4,6 +4,7 @@
 pub mod fishnet;
 pub mod generators;
 pub mod net;
+pub mod outline;
 
 pub use fishnet::{drape, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};

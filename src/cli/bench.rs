@@ -1,0 +1,75 @@
+//! `drape bench`: throughput of the kinematic engine on a generated hemisphere.
+use super::{input, Failure};
+use crate::geometry::shapes;
+use crate::geometry::{Point, Vector};
+use crate::kinematic::{drape, KinematicSettings};
+use clap::Args;
+use std::time::Instant;
+
+/// Arguments of `drape bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Least number of triangles of the hemisphere (radius 1 m).
+    #[arg(long, default_value_t = 200_000)]
+    pub triangles: usize,
+    /// Nodes along each side of the net (covers the hemisphere from pole to rim).
+    #[arg(long, default_value_t = 1000)]
+    pub nodes: usize,
+    /// Timed repetitions (the best is reported too).
+    #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+pub fn run(a: BenchArgs) -> Result<(), Failure> {
+    if a.nodes < 2 || a.repeat == 0 {
+        return Err(input(anyhow::anyhow!("--nodes must be at least 2 and --repeat at least 1")));
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| input(anyhow::anyhow!("cannot start {} threads: {e}", a.threads.unwrap_or(0))))?;
+    let t = Instant::now();
+    let tool = shapes::hemisphere_with_triangles(1.0, a.triangles).into_surface().map_err(input)?;
+    println!("hemisphere R = 1 m: {} triangles, built in {:.0} ms", tool.num_triangles(), t.elapsed().as_secs_f64() * 1e3);
+    // Spacing so the generators reach from the pole to the rim: quarter circumference / half-size.
+    let half = (a.nodes - 1) / 2;
+    let spacing = std::f64::consts::FRAC_PI_2 / half.max(1) as f64 * 0.999;
+    let settings = KinematicSettings::grid("bench", Point::new(0.0, 0.0, 1.0), Vector::new(1.0, 0.0, 0.0), spacing, a.nodes, a.nodes);
+    let mut best = f64::INFINITY;
+    let mut total = 0.0;
+    let mut placed_cells = 0;
+    for _ in 0..a.repeat {
+        let t = Instant::now();
+        let net = pool.install(|| drape(&tool, &settings)).map_err(input)?;
+        let s = t.elapsed().as_secs_f64();
+        best = best.min(s);
+        total += s;
+        placed_cells = net.shear_stats(1.0).cells;
+    }
+    let cells = (a.nodes - 1) * (a.nodes - 1);
+    println!(
+        "net {n} x {n} nodes, spacing {spacing:.6} m, {threads} thread(s): {placed_cells} of {cells} cells on the tool",
+        n = a.nodes,
+        threads = pool.current_num_threads()
+    );
+    println!(
+        "time per drape: best {:.1} ms, mean {:.1} ms; throughput {:.2} M cells/s (best), {:.2} M cells/s (mean)",
+        best * 1e3,
+        total / a.repeat as f64 * 1e3,
+        cells as f64 / best / 1e6,
+        cells as f64 * a.repeat as f64 / total / 1e6
+    );
+    if let Some(kb) = peak_memory_kb() {
+        println!("peak memory (VmHWM): {:.0} MB", kb as f64 / 1024.0);
+    }
+    Ok(())
+}
+
+/// Peak resident memory of this process (Linux), in kB.
+fn peak_memory_kb() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    s.lines().find(|l| l.starts_with("VmHWM:"))?.split_whitespace().nth(1)?.parse().ok()
+}

@@ -1,0 +1,151 @@
+//! `drape kinematic`: one ply from command-line arguments.
+use super::summary::summary;
+use super::{compute, input, parse_pair, parse_vec3, Failure};
+use crate::export::{write_net, Format};
+use crate::geometry::{Point, ToolSurface, Vector};
+use crate::kinematic::{drape, DrapeError, Extent, KinematicSettings};
+use crate::layup::{parse_generators, read_points, scene::DEFAULT_LOCKING_ANGLE_DEG, unit_scale};
+use clap::Args;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `drape kinematic`.
+#[derive(Debug, Args)]
+pub struct KinematicArgs {
+    /// Tool surface (Wavefront OBJ).
+    #[arg(long)]
+    pub tool: PathBuf,
+    /// Seed point X,Y,Z (projected onto the tool; must lie within one spacing of it).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub origin: [f64; 3],
+    /// Warp direction DX,DY,DZ (projected onto the tangent plane at the origin).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub warp: [f64; 3],
+    /// Fibre segment length d.
+    #[arg(long, allow_hyphen_values = true)]
+    pub spacing: f64,
+    /// Grid size NU,NV (nodes along warp, weft).
+    #[arg(long, value_parser = parse_pair, required_unless_present = "outline", conflicts_with = "outline")]
+    pub grid: Option<[usize; 2]>,
+    /// Ply outline instead of a grid: a closed polyline on the tool, x,y,z per line.
+    #[arg(long)]
+    pub outline: Option<PathBuf>,
+    /// Grid indices I,J of the origin node (default: the centre).
+    #[arg(long, value_parser = parse_pair)]
+    pub origin_node: Option<[usize; 2]>,
+    /// Pre-shear in degrees: the generators meet at 90 - pre-shear.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub pre_shear: f64,
+    /// Generators: geodesic, min-shear, or steer:FILE (warp follows the curve in FILE).
+    #[arg(long, default_value = "geodesic")]
+    pub generators: String,
+    /// Shear (degrees) at which a node is refused as a collapsing cell.
+    #[arg(long, default_value_t = crate::kinematic::DEFAULT_MAX_SHEAR_DEG)]
+    pub max_shear: f64,
+    /// Locking angle (degrees) for the summary's count of cells over it.
+    #[arg(long, default_value_t = DEFAULT_LOCKING_ANGLE_DEG)]
+    pub locking_angle: f64,
+    /// Units of the OBJ and of the lengths given here: m or mm (output is always in metres).
+    #[arg(long, default_value = "m")]
+    pub units: String,
+    /// Ply name (file names derive from it).
+    #[arg(long, default_value = "ply")]
+    pub name: String,
+    /// Output formats: comma-separated json,vtu,csv, or none.
+    #[arg(long, default_value = "json")]
+    pub format: String,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+pub fn run(a: KinematicArgs) -> Result<(), Failure> {
+    let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
+    let scale = unit_scale(&a.units).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?;
+    if !(a.locking_angle > 0.0 && a.locking_angle < 90.0) {
+        return Err(input(anyhow::anyhow!("--locking-angle must lie strictly between 0 and 90 degrees, got {}", a.locking_angle)));
+    }
+    let base = std::env::current_dir().unwrap_or_default();
+    let generators = parse_generators(&a.generators, &base, scale).map_err(|m| input(anyhow::anyhow!("--generators: {m}")))?;
+    let extent = match (&a.grid, &a.outline) {
+        (Some([nu, nv]), _) => Extent::Grid { nu: *nu, nv: *nv, origin_node: a.origin_node.map(|[i, j]| (i, j)) },
+        (None, Some(f)) => Extent::Outline(read_points(f, scale).map_err(|m| input(anyhow::anyhow!("--outline: {m}")))?),
+        (None, None) => return Err(input(anyhow::anyhow!("give --grid NU,NV or --outline FILE"))),
+    };
+    let settings = KinematicSettings {
+        name: a.name.clone(),
+        origin: Point::from(Vector::from(a.origin) * scale),
+        warp: Vector::from(a.warp),
+        spacing: a.spacing * scale,
+        extent,
+        pre_shear: a.pre_shear.to_radians(),
+        generators,
+        max_shear: a.max_shear.to_radians(),
+    };
+    // Cheap argument checks come before the (possibly slow) tool load.
+    precheck(&settings).map_err(input)?;
+    let t_load = Instant::now();
+    let tool = ToolSurface::from_obj_scaled(&a.tool, scale).map_err(input)?;
+    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
+    print_tool_report(&a.tool, &tool);
+    let mut net = drape(&tool, &settings).map_err(input)?;
+    net.timing.load_ms = load_ms;
+    net.meta.insert("tool".into(), serde_json::json!(a.tool.display().to_string()));
+    let t_write = Instant::now();
+    let written = write_net(&net, &a.out, &formats).map_err(compute)?;
+    let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
+    println!("{}", summary(&net, a.locking_angle.to_radians(), load_ms, write_ms));
+    for p in written {
+        println!("  wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// Checks that need no tool: spacing, grid size, memory, angles.
+pub(crate) fn precheck(s: &KinematicSettings) -> Result<(), DrapeError> {
+    if !(s.spacing.is_finite() && s.spacing > 0.0) {
+        return Err(DrapeError::Spacing(s.spacing));
+    }
+    if let Extent::Grid { nu, nv, origin_node } = s.extent {
+        if nu < 2 || nv < 2 {
+            return Err(DrapeError::GridTooSmall(nu, nv));
+        }
+        if let Some((i, j)) = origin_node {
+            if i >= nu || j >= nv {
+                return Err(DrapeError::OriginNode(i, j, nu, nv));
+            }
+        }
+        crate::kinematic::fishnet::check_memory(nu, nv)?;
+    }
+    if s.warp.norm() == 0.0 {
+        return Err(DrapeError::WarpNormal([s.warp.x, s.warp.y, s.warp.z]));
+    }
+    Ok(())
+}
+
+/// One line on what the mesh checks found.
+pub(crate) fn print_tool_report(path: &std::path::Path, tool: &ToolSurface) {
+    let r = tool.report();
+    let mut notes = Vec::new();
+    for (n, what) in [
+        (r.polygons_triangulated, "polygons triangulated"),
+        (r.vertices_welded, "vertices welded"),
+        (r.degenerate_faces_dropped, "degenerate faces dropped"),
+        (r.duplicate_faces_dropped, "duplicate faces dropped"),
+        (r.non_manifold_edges, "non-manifold edges"),
+        (r.flipped_faces, "flipped faces turned over"),
+    ] {
+        if n > 0 {
+            notes.push(format!("{n} {what}"));
+        }
+    }
+    println!(
+        "tool {}: {} triangles, {} vertices, {} boundary edges, {} component(s){}",
+        path.display(),
+        r.triangles,
+        r.vertices,
+        r.boundary_edges,
+        r.components,
+        if notes.is_empty() { String::new() } else { format!("; {}", notes.join(", ")) }
+    );
+}

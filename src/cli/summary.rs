@@ -1,0 +1,34 @@
+//! The short summary printed after a drape.
+use crate::kinematic::{DrapeNet, NodeStatus};
+
+/// One block of text: nodes placed and failed by reason, shear statistics, time per stage.
+pub fn summary(net: &DrapeNet, locking_angle: f64, load_ms: f64, write_ms: f64) -> String {
+    let counts = net.status_counts();
+    let total = net.nu * net.nv;
+    let placed = counts.iter().find(|(s, _)| *s == NodeStatus::Placed).map_or(0, |c| c.1);
+    let failed: Vec<String> = counts
+        .iter()
+        .filter(|(s, _)| *s != NodeStatus::Placed)
+        .map(|(s, c)| format!("{} {c}", s.name()))
+        .collect();
+    let stats = net.shear_stats(locking_angle);
+    let mut out = format!("ply {}: {} x {} nodes, spacing {} m\n", net.name, net.nu, net.nv, net.spacing);
+    out += &format!(
+        "  nodes placed {placed} of {total}{}\n",
+        if failed.is_empty() { String::new() } else { format!("; not placed: {}", failed.join(", ")) }
+    );
+    out += &format!(
+        "  cells {}; |shear| max {:.2} deg, mean {:.2} deg; {} cells over the locking angle {:.1} deg\n",
+        stats.cells,
+        stats.max_abs.to_degrees(),
+        stats.mean_abs.to_degrees(),
+        stats.over_locking,
+        locking_angle.to_degrees()
+    );
+    let t = &net.timing;
+    out += &format!(
+        "  time: load {:.1} ms, generators {:.1} ms, fill {:.1} ms, write {:.1} ms",
+        load_ms, t.generators_ms, t.fill_ms, write_ms
+    );
+    out
+}
