@@ -131,26 +131,39 @@ impl TraceState {
         Some(s)
     }
 
-    /// A trace leaving vertex `v` in the fan sector that best holds direction `dir`.
+    /// A trace leaving vertex `v` along direction `dir`. The direction is projected onto the
+    /// vertex's tangent plane (angle-weighted normal) and located among the projected fan edges;
+    /// it then leaves at the same fraction of that sector's true angle. A direction along a
+    /// projected mesh edge thus leaves exactly along that edge, whatever the facets' tilt.
     fn at_vertex_towards(tool: &ToolSurface, t: u32, v: u32, dir: &Vector) -> Option<Self> {
         let (fan, _) = vertex_fan(tool, t, v);
+        let normal = fan
+            .iter()
+            .fold(Vector::zeros(), |s, (ti, a, b)| s + tool.normal(*ti) * angle_between(a, b))
+            .try_normalize(1e-300)?;
+        let flat = |w: &Vector| w - normal * normal.dot(w);
+        let target = flat(dir).try_normalize(1e-12 * dir.norm())?;
+        // Counter-clockwise angle from x to y in the tangent plane, in [0, 2 pi).
+        let ccw = |x: &Vector, y: &Vector| x.cross(y).dot(&normal).atan2(x.dot(y)).rem_euclid(std::f64::consts::TAU);
         let vp = tool.vertices()[v as usize];
-        // Prefer a sector containing the projected direction; else the closest sector edge.
-        let mut best: Option<(f64, u32, Vector)> = None;
         for &(ti, a, b) in &fan {
-            let n = tool.normal(ti);
-            let Some(d) = (dir - n * n.dot(dir)).try_normalize(1e-12) else { continue };
-            let sector = angle_between(&a, &b);
-            let (da, db) = (angle_between(&a, &d), angle_between(&d, &b));
-            let miss = (da + db - sector).max(0.0);
-            let cand = if miss <= 1e-12 { d } else if da < db { a } else { b };
-            if best.as_ref().is_none_or(|(m, _, _)| miss < *m) {
-                best = Some((miss, ti, cand));
+            let (fa, fb) = (flat(&a), flat(&b));
+            let (sector, to_dir) = (ccw(&fa, &fb), ccw(&fa, &target));
+            if to_dir <= sector && sector > 0.0 {
+                let d = rotate_towards(&a, &b, angle_between(&a, &b) * (to_dir / sector));
+                let c = corner_of(tool, ti, v)?;
+                return Some(TraceState { point: vp, triangle: ti, dir: d, entry_edge: None, at_corner: Some(c) });
             }
         }
-        let (_, ti, d) = best?;
-        let c = corner_of(tool, ti, v)?;
-        Some(TraceState { point: vp, triangle: ti, dir: d, entry_edge: None, at_corner: Some(c) })
+        // An open fan that does not hold the direction: leave along the nearer end edge.
+        let (t_first, a_first, _) = *fan.first()?;
+        let (t_last, _, b_last) = *fan.last()?;
+        let (ti, d) = if angle_between(&a_first, &target) <= angle_between(&b_last, &target) {
+            (t_first, a_first)
+        } else {
+            (t_last, b_last)
+        };
+        Some(TraceState { point: vp, triangle: ti, dir: d, entry_edge: None, at_corner: Some(corner_of(tool, ti, v)?) })
     }
 
     /// The same point, heading in the direction turned counter-clockwise (about the tool normal)
