@@ -1,0 +1,160 @@
+//! The `drape` command line: the one-ply contract, scenes, and bad input (exit code 2, a clear
+//! message, nothing written).
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+fn drape() -> Command {
+    Command::cargo_bin("drape").unwrap()
+}
+
+/// A 1 m plate in z = 0, 10 x 10 quads.
+fn plate_obj(dir: &Path) -> PathBuf {
+    let mut s = String::new();
+    let n = 10;
+    for i in 0..=n {
+        for j in 0..=n {
+            s += &format!("v {} {} 0\n", i as f64 / n as f64 - 0.5, j as f64 / n as f64 - 0.5);
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            let a = i * (n + 1) + j + 1;
+            let b = a + n + 1;
+            s += &format!("f {a} {b} {}\nf {a} {} {}\n", b + 1, b + 1, a + 1);
+        }
+    }
+    let p = dir.join("plate.obj");
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+fn kinematic_args<'a>(tool: &'a str, out: &'a str) -> Vec<&'a str> {
+    vec!["kinematic", "--tool", tool, "--origin", "0,0,0", "--warp", "1,1,0", "--spacing", "0.02", "--grid", "21,21", "--out", out]
+}
+
+/// Run with `args` changed by `edit`, expect exit code 2, a message containing `needle`, and no
+/// output directory.
+fn refused(edit: impl FnOnce(&mut Vec<String>), needle: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let out = dir.path().join("out");
+    let mut args: Vec<String> = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap()).into_iter().map(String::from).collect();
+    edit(&mut args);
+    let assert = drape().args(&args).assert().code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains(needle), "expected '{needle}' in: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().count() == 0, "output left behind");
+}
+
+fn set(args: &mut [String], flag: &str, value: &str) {
+    let k = args.iter().position(|a| a == flag).unwrap();
+    args[k + 1] = value.to_string();
+}
+
+#[test]
+fn help_and_version() {
+    let out = drape().arg("--help").assert().success().get_output().stdout.clone();
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains("kinematic") && text.contains("run"));
+    let out = drape().arg("--version").assert().success().get_output().stdout.clone();
+    assert!(String::from_utf8(out).unwrap().contains(env!("CARGO_PKG_VERSION")));
+}
+
+#[test]
+fn one_ply_writes_the_contract_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let out = dir.path().join("out");
+    let mut args = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap());
+    args.extend(["--name", "ply0", "--format", "json,vtu,csv", "--origin-node", "5,12", "--pre-shear", "10"]);
+    let assert = drape().args(&args).assert().success();
+    let stdout = String::from_utf8_lossy(&assert.get_output().stdout).to_string();
+    assert!(stdout.contains("nodes placed") && stdout.contains("max") && stdout.contains("locking"), "{stdout}");
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("ply0.drape.json")).unwrap()).unwrap();
+    assert_eq!(json["ply"], "ply0");
+    assert_eq!(json["method"], "kinematic");
+    assert_eq!(json["spacing"], 0.02);
+    assert_eq!(json["grid"], serde_json::json!([21, 21]));
+    assert_eq!(json["origin_node"], serde_json::json!([5, 12]));
+    let nodes = json["nodes"].as_array().unwrap();
+    assert_eq!(nodes.len(), 21 * 21);
+    assert_eq!(json["cell_shear_deg"].as_array().unwrap().len(), 20 * 20);
+    // The origin node sits at index i0 * nv + j0, on the seed point.
+    let o = &nodes[5 * 21 + 12];
+    assert!(o[0].as_f64().unwrap().abs() < 1e-12 && o[1].as_f64().unwrap().abs() < 1e-12);
+    // A flat plate with 10 deg pre-shear: every complete cell is sheared by 10 deg.
+    for g in json["cell_shear_deg"].as_array().unwrap().iter().filter_map(|g| g.as_f64()) {
+        assert!((g - 10.0).abs() < 1e-9, "{g}");
+    }
+    assert!(json["status"].is_object() && json["timing_ms"].is_object());
+    assert!(out.join("ply0.vtu").is_file() && out.join("ply0.cells.csv").is_file());
+    // No temporary files left behind.
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3);
+}
+
+#[test]
+fn bad_numbers_and_vectors_are_refused() {
+    refused(|a| set(a, "--spacing", "0"), "spacing");
+    refused(|a| set(a, "--spacing", "-0.1"), "spacing");
+    refused(|a| set(a, "--grid", "1,5"), "at least 2 x 2");
+    refused(|a| set(a, "--grid", "100000000,100000000"), "memory");
+    refused(|a| set(a, "--origin", "1,2"), "three finite numbers");
+    refused(|a| set(a, "--warp", "a,b,c"), "three finite numbers");
+    refused(|a| set(a, "--warp", "0,0,1"), "normal to the tool");
+    refused(|a| set(a, "--origin", "0,0,0.5"), "from the tool");
+    refused(|a| a.extend(["--origin-node".into(), "30,3".into()]), "outside the 21 x 21 grid");
+    refused(|a| a.extend(["--format".into(), "stl".into()]), "unknown output format");
+    refused(|a| a.extend(["--generators".into(), "spline".into()]), "unknown generators");
+    refused(|a| a.extend(["--pre-shear".into(), "95".into()]), "pre-shear");
+}
+
+#[test]
+fn bad_tool_files_are_refused() {
+    refused(|a| set(a, "--tool", "/nonexistent/tool.obj"), "/nonexistent/tool.obj");
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("empty.obj");
+    std::fs::write(&empty, "# nothing here\n").unwrap();
+    refused(|a| set(a, "--tool", empty.to_str().unwrap()), "no faces");
+    let garbage = dir.path().join("garbage.obj");
+    std::fs::write(&garbage, [0u8, 159, 146, 150, 255, 0, 1, 2]).unwrap();
+    refused(|a| set(a, "--tool", garbage.to_str().unwrap()), "garbage.obj");
+    let nan = dir.path().join("nan.obj");
+    std::fs::write(&nan, "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n").unwrap();
+    refused(|a| set(a, "--tool", nan.to_str().unwrap()), "non-finite");
+    let bad_index = dir.path().join("bad_index.obj");
+    std::fs::write(&bad_index, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
+    refused(|a| set(a, "--tool", bad_index.to_str().unwrap()), "vertex");
+}
+
+#[test]
+fn scenes_run_and_bad_scenes_name_the_field_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let good = "units = \"mm\"\ntool = \"plate.obj\"\n\n[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.02\ngrid = [11, 11]\n\n[[ply]]\nname = \"b\"\norigin = [0, 0, 0]\nwarp = [1, 1, 0]\nspacing = 0.02\ngrid = [11, 11]\n";
+    std::fs::write(&scene, good).unwrap();
+    let out = dir.path().join("out");
+    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("b.drape.json")).unwrap()).unwrap();
+    // Millimetres in, metres out.
+    assert_eq!(json["spacing"], 2e-5);
+    assert!(out.join("a.vtu").is_file());
+
+    let check = |text: &str, needles: &[&str]| {
+        std::fs::write(&scene, text).unwrap();
+        let out = dir.path().join("bad");
+        let a = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        for n in needles {
+            assert!(err.contains(n), "expected '{n}' in: {err}");
+        }
+        assert!(!out.exists());
+    };
+    check(&good.replace("spacing = 0.02\ngrid = [11, 11]\n\n[[ply]]", "spacing = -1\ngrid = [11, 11]\n\n[[ply]]"), &["ply 'a'", "line 4", "spacing"]);
+    check(&good.replace("warp = [1, 1, 0]", "warp = [1, 1]"), &["line 14", "warp"]);
+    check(&good.replace("name = \"b\"", "name = \"b\"\ncolour = \"red\""), &["colour"]);
+    check(&good.replace("tool = \"plate.obj\"", "tool = \"missing.obj\""), &["missing.obj"]);
+    check(&good.replace("units = \"mm\"", "units = \"inch\""), &["units"]);
+    check(&good.replace("origin = [0, 0, 0]\nwarp = [1, 1, 0]", "origin = [0, 0, 400]\nwarp = [1, 1, 0]"), &["ply 'b'", "from the tool"]);
+}
