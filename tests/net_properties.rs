@@ -77,7 +77,7 @@ fn mirror_symmetric_tool_gives_a_mirror_symmetric_net() {
     // +y, so node (i0 + a, j0 + b) mirrors node (i0 + a, j0 - b).
     let s = KinematicSettings::grid("h", Point::new(0.0, 0.0, 1.0), Vector::x(), 0.05, 51, 51);
     let net = drape(hemisphere(), &s).unwrap();
-    let (i0, j0) = net.origin_node;
+    let (_, j0) = net.origin_node;
     let mut checked = 0;
     for i in 0..net.nu {
         for b in 1..=j0 {
@@ -237,4 +237,32 @@ fn steered_warp_follows_the_curve() {
     }
     let (e, _) = segment_error(&net);
     assert!(e < LENGTH_TOLERANCE);
+}
+
+#[test]
+fn an_outline_sizes_the_grid_and_drops_the_nodes_outside_it() {
+    use drape::kinematic::Extent;
+    let tool = shapes::plate(1.0, 1.0, 10, 10).into_surface().unwrap();
+    let r = 0.3;
+    let outline: Vec<Point> = (0..96)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 96.0;
+            Point::new(r * a.cos(), r * a.sin(), 0.0)
+        })
+        .collect();
+    let d = 0.01;
+    let mut s = KinematicSettings::grid("o", Point::new(0.05, -0.02, 0.0), Vector::new(1.0, 1.0, 0.0), d, 2, 2);
+    s.extent = Extent::Outline(outline);
+    let net = drape(&tool, &s).unwrap();
+    let placed: Vec<Point> = (0..net.positions.len()).filter(|&k| net.status[k] == NodeStatus::Placed).map(|k| net.positions[k]).collect();
+    // Inside the 96-gon (inscribed in the circle of radius r).
+    assert!(placed.iter().all(|p| p.x.hypot(p.y) < r));
+    // One node per d^2 of the polygon's area (to within its perimeter's worth of nodes).
+    let area = 0.5 * 96.0 * r * r * (std::f64::consts::TAU / 96.0).sin();
+    let expected = area / (d * d);
+    let perimeter_nodes = std::f64::consts::TAU * r / d;
+    assert!((placed.len() as f64 - expected).abs() < perimeter_nodes, "{} vs {expected}", placed.len());
+    // Everything not placed is outside the outline: the net covers the whole ply.
+    let counts = net.status_counts();
+    assert!(counts.iter().all(|(s, _)| matches!(s, NodeStatus::Placed | NodeStatus::OutsideOutline)), "{counts:?}");
 }

@@ -121,7 +121,10 @@ pub fn place_node(
     }
     let warp_c = (b.point - c) * si;
     let weft_c = (a.point - c) * sj;
-    if corner_shear(&warp_x, &weft_x).abs() > max_shear || corner_shear(&warp_c, &weft_c).abs() > max_shear {
+    // |shear| > limit  <=>  |cos(angle between the fibres)| > sin(limit): no trigonometry here.
+    let limit = max_shear.sin();
+    let over = |w: &Vector, f: &Vector| w.dot(f).abs() > limit * (w.norm_squared() * f.norm_squared()).sqrt();
+    if over(&warp_x, &weft_x) || over(&warp_c, &weft_c) {
         return Err(NodeStatus::ShearLimit);
     }
     Ok(Placed { point: x, triangle: root.triangle })

@@ -1,0 +1,94 @@
+//! Checks run before any output file is opened: a net that would need NaN, infinity or a
+//! made-up value in a file is refused with an error naming the node or cell.
+use super::ExportError;
+use crate::kinematic::DrapeNet;
+
+/// Number of cells, `(nu - 1) * (nv - 1)`, zero for a degenerate grid (never underflows).
+pub(crate) fn cell_count(net: &DrapeNet) -> usize {
+    net.nu.saturating_sub(1) * net.nv.saturating_sub(1)
+}
+
+/// Cells (i, j) in file order (index i * (nv - 1) + j).
+pub(crate) fn cells(net: &DrapeNet) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let (cu, cv) = (net.nu.saturating_sub(1), net.nv.saturating_sub(1));
+    (0..cu).flat_map(move |i| (0..cv).map(move |j| (i, j)))
+}
+
+/// The ply name must be usable as a file name inside the output directory.
+pub(crate) fn check_name(net: &DrapeNet) -> Result<(), ExportError> {
+    let bad = |reason: &str| Err(ExportError::BadName { ply: net.name.clone(), reason: reason.to_string() });
+    if net.name.is_empty() {
+        return bad("it is empty");
+    }
+    if net.name == "." || net.name == ".." {
+        return bad("it is a directory name");
+    }
+    if net.name.chars().any(|c| matches!(c, '/' | '\\' | '\0') || c.is_control()) {
+        return bad("it contains a path separator or a control character");
+    }
+    Ok(())
+}
+
+/// Consistency and finiteness of everything a writer reads. `frames`: also check each complete
+/// cell's fibre frame (VTU, CSV).
+pub(crate) fn check_net(net: &DrapeNet, frames: bool) -> Result<(), ExportError> {
+    let bad = |reason: String| Err(ExportError::BadNet { ply: net.name.clone(), reason });
+    if net.nu == 0 || net.nv == 0 {
+        return bad(format!("the grid is empty ({} x {} nodes)", net.nu, net.nv));
+    }
+    let Some(n) = net.nu.checked_mul(net.nv) else {
+        return bad(format!("the grid {} x {} is too large", net.nu, net.nv));
+    };
+    for (what, len) in
+        [("positions", net.positions.len()), ("status", net.status.len()), ("triangles", net.triangles.len())]
+    {
+        if len != n {
+            return bad(format!("it has {len} {what} for a {} x {} grid ({n} nodes)", net.nu, net.nv));
+        }
+    }
+    let (i0, j0) = net.origin_node;
+    if i0 >= net.nu || j0 >= net.nv {
+        return bad(format!("the origin node ({i0}, {j0}) lies outside the {} x {} grid", net.nu, net.nv));
+    }
+    if !(net.spacing.is_finite() && net.spacing > 0.0) {
+        return bad(format!("the spacing is {} (must be finite and positive)", net.spacing));
+    }
+    let t = &net.timing;
+    for (what, v) in [("load", t.load_ms), ("generators", t.generators_ms), ("fill", t.fill_ms), ("total", t.total_ms)]
+    {
+        if !v.is_finite() {
+            return bad(format!("the {what} time is {v} ms"));
+        }
+    }
+    for i in 0..net.nu {
+        for j in 0..net.nv {
+            if let Some(p) = net.node(i, j) {
+                if !p.coords.iter().all(|c| c.is_finite()) {
+                    return bad(format!("node ({i}, {j}) is placed but its position is ({}, {}, {})", p.x, p.y, p.z));
+                }
+            }
+        }
+    }
+    for (i, j) in cells(net) {
+        let Some(g) = net.cell_shear(i, j) else { continue };
+        if !g.to_degrees().is_finite() {
+            return bad(format!("cell ({i}, {j}) has a shear angle of {g} rad"));
+        }
+        if frames {
+            match net.cell_frame(i, j) {
+                None => {
+                    return bad(format!(
+                        "cell ({i}, {j}) is degenerate: its warp, weft or normal direction has zero length"
+                    ))
+                }
+                Some(f) => {
+                    let all = f.centre.coords.iter().chain(&f.warp).chain(&f.weft).chain(&f.normal);
+                    if !all.into_iter().all(|c| c.is_finite()) {
+                        return bad(format!("cell ({i}, {j}) has a non-finite centre or fibre direction"));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}

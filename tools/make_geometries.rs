@@ -1,0 +1,97 @@
+//! Writes the bundled tool meshes in `geometries/` from the analytic shapes in
+//! `drape::geometry::shapes`.
+//!
+//! ```text
+//! cargo run --release --example make_geometries -- [--large] [--out DIR]
+//! ```
+//!
+//! Without `--large` it (re)writes the small, committed meshes, one folder per tool:
+//!
+//! | file                                  | shape                                                   |
+//! |---------------------------------------|---------------------------------------------------------|
+//! | `hemisphere/hemisphere-2k.obj`        | hemisphere R = 0.1 m, 23 subdivisions (2 116 triangles) |
+//! | `hemisphere/hemisphere-20k.obj`       | hemisphere R = 0.1 m, 71 subdivisions (20 164)          |
+//! | `plate/plate.obj`                     | 0.4 x 0.3 m flat plate, 80 x 60 quads                   |
+//! | `cylinder/cylinder.obj`               | half cylinder R = 0.1 m, 0.3 m long, axis y             |
+//! | `cone/cone.obj`                       | closed frustum ring r 0.15 -> 0.075 m, 0.1 m high       |
+//! | `saddle/saddle.obj`                   | z = (x^2 - y^2) / (2 * 0.3 m) over 0.3 x 0.3 m          |
+//! | `double-dome/double-dome.obj`         | double-dome benchmark-style part on a 0.47 x 0.37 m flange |
+//! | `hat-box/hat-box.obj`                 | 0.2 x 0.15 x 0.08 m box, vertical walls, 0.07 m flange  |
+//!
+//! With `--large` it also writes `generated/hemisphere-200k.obj` (224 subdivisions, 200 704
+//! triangles) and `generated/hemisphere-800k.obj` (448 subdivisions, 802 816 triangles) for
+//! benchmarks; `geometries/generated/` is git-ignored. The `scene.toml` files and the README next
+//! to the meshes are written by hand and are not touched.
+//!
+//! The output is deterministic: the same build writes byte-identical files. `--out DIR` writes
+//! under `DIR` instead of the crate's `geometries/` folder.
+use drape::geometry::shapes::*;
+use std::f64::consts::{PI, TAU};
+use std::path::{Path, PathBuf};
+
+/// A committed mesh: its path under the output folder and how to build it.
+type Committed = (&'static str, fn() -> TriangleMesh);
+
+/// Hemisphere radius of the bundled hemisphere meshes (m).
+const HEMISPHERE_RADIUS: f64 = 0.1;
+
+fn main() -> anyhow::Result<()> {
+    let mut large = false;
+    let mut out = Path::new(env!("CARGO_MANIFEST_DIR")).join("geometries");
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--large" => large = true,
+            "--out" => {
+                out = PathBuf::from(args.next().ok_or_else(|| anyhow::anyhow!("--out needs a directory"))?)
+            }
+            "-h" | "--help" => {
+                println!("usage: make_geometries [--large] [--out DIR]");
+                return Ok(());
+            }
+            other => {
+                anyhow::bail!("unknown argument {other:?}; usage: make_geometries [--large] [--out DIR]")
+            }
+        }
+    }
+
+    let small: [Committed; 8] = [
+        ("hemisphere/hemisphere-2k.obj", || hemisphere(HEMISPHERE_RADIUS, 23)),
+        ("hemisphere/hemisphere-20k.obj", || hemisphere(HEMISPHERE_RADIUS, 71)),
+        ("plate/plate.obj", || plate(0.4, 0.3, 80, 60)),
+        ("cylinder/cylinder.obj", || cylinder(0.1, 0.3, PI, 100, 96)),
+        ("cone/cone.obj", || cone(0.15, 0.075, 0.1, TAU, 192, 40)),
+        ("saddle/saddle.obj", || saddle(0.3, 0.3, 100)),
+        ("double-dome/double-dome.obj", || double_dome(&DoubleDome::benchmark(), 60)),
+        ("hat-box/hat-box.obj", || hat_box(&HatBox::standard(), 0.004, 8)),
+    ];
+    for (name, make) in &small {
+        write(&out, name, &make())?;
+    }
+    if large {
+        write(&out, "generated/hemisphere-200k.obj", &hemisphere_with_triangles(HEMISPHERE_RADIUS, 200_000))?;
+        write(&out, "generated/hemisphere-800k.obj", &hemisphere_with_triangles(HEMISPHERE_RADIUS, 800_000))?;
+    }
+    Ok(())
+}
+
+/// Write `mesh` as OBJ to `root/name` (creating folders) and print a one-line summary.
+fn write(root: &Path, name: &str, mesh: &TriangleMesh) -> anyhow::Result<()> {
+    let path = root.join(name);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let text = format!(
+        "# {name}: written by `cargo run --release --example make_geometries`\n{}",
+        mesh.to_obj_string()
+    );
+    std::fs::write(&path, &text).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    println!(
+        "{:<36} {:>8} triangles {:>8} vertices {:>10} bytes",
+        name,
+        mesh.triangles.len(),
+        mesh.vertices.len(),
+        text.len()
+    );
+    Ok(())
+}
