@@ -62,6 +62,7 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         cells as f64 / best / 1e6,
         cells as f64 * a.repeat as f64 / total / 1e6
     );
+    println!("placed cells per second (best): {:.2} M", placed_cells as f64 / best / 1e6);
     if let Some(kb) = peak_memory_kb() {
         println!("peak memory (VmHWM): {:.0} MB", kb as f64 / 1024.0);
     }
