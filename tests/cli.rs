@@ -158,3 +158,33 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
     check(&good.replace("units = \"mm\"", "units = \"inch\""), &["units"]);
     check(&good.replace("origin = [0, 0, 0]\nwarp = [1, 1, 0]", "origin = [0, 0, 400]\nwarp = [1, 1, 0]"), &["ply 'b'", "from the tool"]);
 }
+
+#[test]
+fn steering_curve_and_outline_files_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    // A curve at 30 deg to x through the origin, and a square outline of half-size 0.2.
+    let curve: String = (-10..=10).map(|k| format!("{},{},0\n", 0.04 * k as f64 * 0.866, 0.04 * k as f64 * 0.5)).collect();
+    std::fs::write(dir.path().join("curve.csv"), format!("x,y,z\n{curve}")).unwrap();
+    std::fs::write(dir.path().join("outline.txt"), "# square\n-0.2 -0.2 0\n0.2 -0.2 0\n0.2 0.2 0\n-0.2 0.2 0\n").unwrap();
+    let out = dir.path().join("out");
+    let steer = format!("steer:{}", dir.path().join("curve.csv").display());
+    let outline = dir.path().join("outline.txt");
+    let args = [
+        "kinematic", "--tool", tool.to_str().unwrap(), "--origin", "0,0,0", "--warp", "1,0,0", "--spacing", "0.02",
+        "--outline", outline.to_str().unwrap(), "--generators", &steer, "--name", "s",
+        "--out", out.to_str().unwrap(),
+    ];
+    drape().args(args).assert().success();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("s.drape.json")).unwrap()).unwrap();
+    let nodes: Vec<Option<[f64; 3]>> = json["nodes"].as_array().unwrap().iter().map(|n| serde_json::from_value(n.clone()).ok()).collect();
+    let placed: Vec<[f64; 3]> = nodes.iter().flatten().copied().collect();
+    // Every placed node inside the outline; about (0.4 / 0.02)^2 of them.
+    assert!(placed.iter().all(|p| p[0].abs() < 0.2 && p[1].abs() < 0.2));
+    assert!((placed.len() as f64 - 400.0).abs() < 60.0, "{}", placed.len());
+    // The warp follows the 30 deg curve: node (i0 + 1, j0) - origin is at 30 deg.
+    let nv = json["grid"][1].as_u64().unwrap() as usize;
+    let [i0, j0] = [json["origin_node"][0].as_u64().unwrap() as usize, json["origin_node"][1].as_u64().unwrap() as usize];
+    let (o, w) = (nodes[i0 * nv + j0].unwrap(), nodes[(i0 + 1) * nv + j0].unwrap());
+    assert!(((w[1] - o[1]).atan2(w[0] - o[0]).to_degrees() - 30.0).abs() < 0.01);
+}

@@ -266,3 +266,23 @@ fn an_outline_sizes_the_grid_and_drops_the_nodes_outside_it() {
     let counts = net.status_counts();
     assert!(counts.iter().all(|(s, _)| matches!(s, NodeStatus::Placed | NodeStatus::OutsideOutline)), "{counts:?}");
 }
+
+#[test]
+fn a_closed_sphere_is_draped_past_its_equator_into_the_undercut() {
+    // Close the hemisphere with its mirror image (rim vertices are welded by the mesh checks).
+    let top = shapes::hemisphere(1.0, 40);
+    let mut vertices = top.vertices.clone();
+    let n = vertices.len() as u32;
+    vertices.extend(top.vertices.iter().map(|p| Point::new(p.x, p.y, -p.z)));
+    let mut triangles = top.triangles.clone();
+    triangles.extend(top.triangles.iter().map(|t| [t[0] + n, t[2] + n, t[1] + n]));
+    let tool = ToolSurface::from_triangles(vertices, triangles).unwrap();
+    assert_eq!(tool.report().boundary_edges, 0, "{:?}", tool.report());
+    assert_eq!(tool.report().flipped_faces, 0);
+    // Generators of 40 x 0.05 = 2.0 > pi/2: past the equator on every side.
+    let net = drape(&tool, &KinematicSettings::grid("ball", Point::new(0.0, 0.0, 1.0), Vector::x(), 0.05, 81, 81)).unwrap();
+    let below = (0..net.positions.len()).filter(|&k| net.status[k] == NodeStatus::Placed && net.positions[k].z < -0.3).count();
+    assert!(below > 8, "{below} nodes below the equator");
+    let (e, _) = segment_error(&net);
+    assert!(e < LENGTH_TOLERANCE);
+}
