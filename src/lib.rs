@@ -8,6 +8,8 @@ pub mod export;
 pub mod geometry;
 pub mod kinematic;
 pub mod layup;
+pub mod material;
+pub mod mechanics;
 
 pub use geometry::ToolSurface;
 pub use kinematic::{drape, DrapeNet, KinematicSettings};

@@ -1,0 +1,1 @@
+//! Energy terms on the grid, with analytic gradients and sparse Hessians.
