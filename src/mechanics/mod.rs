@@ -2,3 +2,8 @@
 //! with locking, bending, gravity) with tool contact, minimised by sequential convex subproblems
 //! solved with Clarabel.
 pub mod energy;
+pub mod contact;
+pub mod solver;
+
+pub use contact::{ContactMode, Freedom, NodeBasis};
+pub use solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Outcome, SolveReport, SolverSettings};

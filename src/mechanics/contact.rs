@@ -1,0 +1,135 @@
+//! Contact with the tool and fixed nodes, as per-node bases of allowed motion (pressed contact
+//! and fixed directions) and linearised one-sided constraints (free contact).
+use crate::geometry::{Point, ToolSurface, Vector};
+use nalgebra::Matrix3;
+
+/// How the ply meets the tool.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactMode {
+    /// Held against the tool (hand lay-up, vacuum): nodes stay on the surface and slide on it.
+    Pressed,
+    /// Gravity drape with one-sided contact: no node inside the tool.
+    Free,
+    /// No tool (virtual material tests).
+    None,
+}
+
+/// How one node may move in a step: `dofs` orthonormal directions (the first `dofs` columns of
+/// `basis`); 0 = fixed, 2 = sliding on the tool, 3 = free.
+#[derive(Debug, Clone, Copy)]
+pub struct NodeBasis {
+    pub dofs: usize,
+    pub basis: Matrix3<f64>,
+}
+
+impl NodeBasis {
+    pub const FIXED: NodeBasis = NodeBasis { dofs: 0, basis: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
+
+    /// Free in all three directions.
+    pub fn free() -> Self {
+        NodeBasis { dofs: 3, basis: Matrix3::identity() }
+    }
+
+    /// Free to slide in the plane normal to `n`.
+    pub fn tangent(n: &Vector) -> Self {
+        let (t1, t2) = tangent_pair(n);
+        NodeBasis { dofs: 2, basis: Matrix3::from_columns(&[t1, t2, *n]) }
+    }
+
+    /// Free to move along `t` only.
+    pub fn line(t: &Vector) -> Self {
+        let t = t.normalize();
+        let (a, b) = tangent_pair(&t);
+        NodeBasis { dofs: 1, basis: Matrix3::from_columns(&[t, a, b]) }
+    }
+
+    /// Column k of the basis.
+    #[inline]
+    pub fn dir(&self, k: usize) -> Vector {
+        self.basis.column(k).into()
+    }
+}
+
+/// How a node may move.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Freedom {
+    /// Held where it is.
+    Fixed,
+    /// Free in space.
+    Free,
+    /// Along a fixed direction only.
+    Line(Vector),
+    /// Sliding on the tool (pressed contact).
+    OnTool,
+    /// Sliding on the tool within the plane with this normal (keeps a direction fixed).
+    OnToolInPlane(Vector),
+}
+
+impl Freedom {
+    /// Number of free directions.
+    pub fn dofs(&self) -> usize {
+        match self {
+            Freedom::Fixed => 0,
+            Freedom::Line(_) | Freedom::OnToolInPlane(_) => 1,
+            Freedom::OnTool => 2,
+            Freedom::Free => 3,
+        }
+    }
+
+    /// The basis of allowed motion at position `p` (tool normals for the on-tool kinds).
+    pub fn basis(&self, p: &Point, tool: Option<&ToolSurface>) -> NodeBasis {
+        let normal = || tool.map(|t| t.closest_point(p).normal).unwrap_or_else(Vector::z);
+        match self {
+            Freedom::Fixed => NodeBasis::FIXED,
+            Freedom::Free => NodeBasis::free(),
+            Freedom::Line(t) => NodeBasis::line(t),
+            Freedom::OnTool => NodeBasis::tangent(&normal()),
+            Freedom::OnToolInPlane(m) => {
+                let n = normal();
+                match n.cross(m).try_normalize(1e-9) {
+                    Some(t) => NodeBasis::line(&t),
+                    None => NodeBasis::FIXED,
+                }
+            }
+        }
+    }
+}
+
+/// Two unit vectors completing `n` (unit) to an orthonormal frame.
+pub fn tangent_pair(n: &Vector) -> (Vector, Vector) {
+    let helper = if n.x.abs() < 0.6 { Vector::x() } else { Vector::y() };
+    let t1 = n.cross(&helper).normalize();
+    let t2 = n.cross(&t1);
+    (t1, t2)
+}
+
+/// A linearised one-sided contact constraint: `normal . (x + delta - point) >= 0`.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactRow {
+    pub node: usize,
+    pub normal: Vector,
+    /// Signed gap `normal . (x - point)` at the current state (>= 0 when outside the tool).
+    pub gap: f64,
+}
+
+/// Nodes within this many spacings of the tool get a contact row in free drape.
+pub const CONTACT_RANGE: f64 = 2.0;
+
+/// Linearised contact rows for the free-drape nodes near the tool.
+pub fn contact_rows(tool: &ToolSurface, x: &[Point], movable: &[bool], spacing: f64) -> Vec<ContactRow> {
+    let mut rows = Vec::new();
+    for (k, p) in x.iter().enumerate() {
+        if !movable[k] {
+            continue;
+        }
+        let sp = tool.closest_point(p);
+        if sp.distance > CONTACT_RANGE * spacing {
+            continue;
+        }
+        // On the tool or outside: the tool's outward normal; a node found inside gets a row that
+        // pushes it back out.
+        let gap = sp.normal.dot(&(p - sp.point));
+        rows.push(ContactRow { node: k, normal: sp.normal, gap });
+    }
+    rows
+}

@@ -1,0 +1,528 @@
+//! Sequential convex subproblems: at each iterate a quadratic model of the energy (convexified
+//! Hessian plus Levenberg-Marquardt damping) with the linearised contact constraints is solved by
+//! Clarabel; the step is accepted if the energy falls as predicted, else the damping grows.
+use super::contact::{contact_rows, ContactMode, ContactRow, Freedom, NodeBasis};
+use crate::geometry::{Point, ToolSurface, Vector};
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT,
+};
+use nalgebra::Matrix3;
+use serde::Serialize;
+
+/// The energy of a net and its derivatives, as the solver needs them.
+pub trait Objective: Sync {
+    /// Energy, gradient of the internal energy, external loads P, and (if asked) the convexified
+    /// Hessian of the total energy.
+    fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation;
+    /// Node pairs (a <= b) that may couple in the Hessian.
+    fn coupled_pairs(&self) -> Vec<(usize, usize)>;
+}
+
+/// Hessian storage the solver reads block by block.
+pub trait HessianBlocks {
+    /// The 3x3 block coupling nodes `a` and `b` (a <= b).
+    fn block(&self, a: usize, b: usize) -> Matrix3<f64>;
+}
+
+/// One evaluation of the objective.
+pub struct Evaluation {
+    /// Total energy (internal minus the work of the loads).
+    pub energy: f64,
+    /// Gradient of the internal energy per node (the internal forces F).
+    pub internal: Vec<Vector>,
+    /// External loads per node (P).
+    pub external: Vec<Vector>,
+    pub hessian: Option<Box<dyn HessianBlocks>>,
+}
+
+/// Settings of the solver (builder style: `SolverSettings::default().max_iterations(80)`).
+#[derive(Debug, Clone)]
+pub struct SolverSettings {
+    pub max_iterations: usize,
+    /// Converged when |F - P| / max(|P|, |F|) <= tolerance (seed 000 eq. 20 uses 1e-4).
+    pub tolerance: f64,
+    /// Converged too when the energy changes by less than this (relative) over `stall_window`
+    /// accepted steps.
+    pub stall_tolerance: f64,
+    pub stall_window: usize,
+    /// Initial Levenberg-Marquardt damping, relative to the Hessian's mean diagonal.
+    pub initial_damping: f64,
+    /// Largest damping before the solver gives up (stalled line search).
+    pub max_damping: f64,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            max_iterations: 100,
+            tolerance: 1e-4,
+            stall_tolerance: 1e-13,
+            stall_window: 3,
+            initial_damping: 1e-6,
+            max_damping: 1e12,
+        }
+    }
+}
+
+impl SolverSettings {
+    pub fn max_iterations(mut self, n: usize) -> Self {
+        self.max_iterations = n;
+        self
+    }
+    pub fn tolerance(mut self, t: f64) -> Self {
+        self.tolerance = t;
+        self
+    }
+}
+
+/// One solver iteration, for the log.
+#[derive(Debug, Clone, Serialize)]
+pub struct IterationLog {
+    pub iteration: usize,
+    pub energy: f64,
+    pub residual: f64,
+    pub step: f64,
+    pub damping: f64,
+    pub active_contacts: usize,
+    pub accepted: bool,
+    pub qp_iterations: u32,
+    pub time_ms: f64,
+}
+
+/// How a solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// |F - P| / |P| below the tolerance.
+    Converged,
+    /// The energy stopped changing.
+    Stalled,
+    /// Iteration limit reached.
+    IterationLimit,
+    /// The damping grew past its limit without an acceptable step.
+    LineSearchFailed,
+    /// Clarabel could not solve a subproblem (infeasible constraints).
+    SubproblemFailed,
+}
+
+/// What a solve did.
+#[derive(Debug, Clone, Serialize)]
+pub struct SolveReport {
+    pub outcome: Outcome,
+    pub energy_start: f64,
+    pub energy_end: f64,
+    pub residual: f64,
+    pub iterations: Vec<IterationLog>,
+    pub time_ms: f64,
+}
+
+impl SolveReport {
+    /// Whether the final state is an equilibrium (converged or stalled at a minimum).
+    pub fn ok(&self) -> bool {
+        matches!(self.outcome, Outcome::Converged | Outcome::Stalled)
+    }
+}
+
+/// What the solver moves and how: each node's freedom, the tool for contact.
+pub struct Constraints<'a> {
+    pub freedom: Vec<Freedom>,
+    pub mode: ContactMode,
+    pub tool: Option<&'a ToolSurface>,
+    /// Length scale for contact search (the net's spacing).
+    pub spacing: f64,
+}
+
+/// Reduced (free) variables: node k's components start at `offset[k]` and number `bases[k].dofs`.
+struct Reduction {
+    offset: Vec<usize>,
+    n: usize,
+    /// Upper-triangular CSC pattern over the reduced variables.
+    colptr: Vec<usize>,
+    rowval: Vec<usize>,
+    /// For each stored entry: (node a, node b, component p of a, component q of b).
+    source: Vec<(u32, u32, u8, u8)>,
+    /// Position of each column's diagonal entry.
+    diag: Vec<usize>,
+}
+
+impl Reduction {
+    fn new(freedom: &[Freedom], pairs: &[(usize, usize)]) -> Self {
+        let mut offset = Vec::with_capacity(freedom.len());
+        let mut n = 0;
+        for f in freedom {
+            offset.push(n);
+            n += f.dofs();
+        }
+        let dofs: Vec<usize> = freedom.iter().map(Freedom::dofs).collect();
+        // Column-wise lists of (row variable, source).
+        let mut columns: Vec<Vec<(usize, (u32, u32, u8, u8))>> = vec![Vec::new(); n];
+        for &(a, b) in pairs {
+            let (a, b) = if a <= b { (a, b) } else { (b, a) };
+            for p in 0..dofs[a] {
+                for q in 0..dofs[b] {
+                    let (r, c) = (offset[a] + p, offset[b] + q);
+                    if a == b && p > q {
+                        continue;
+                    }
+                    // Upper triangle: row <= column.
+                    let (r, c, src) = if r <= c { (r, c, (a as u32, b as u32, p as u8, q as u8)) } else { (c, r, (a as u32, b as u32, p as u8, q as u8)) };
+                    columns[c].push((r, src));
+                }
+            }
+        }
+        let mut colptr = vec![0];
+        let mut rowval = Vec::new();
+        let mut source = Vec::new();
+        let mut diag = vec![usize::MAX; n];
+        for (c, mut col) in columns.into_iter().enumerate() {
+            col.sort_by_key(|e| e.0);
+            col.dedup_by_key(|e| e.0);
+            for (r, src) in col {
+                if r == c {
+                    diag[c] = rowval.len();
+                }
+                rowval.push(r);
+                source.push(src);
+            }
+            colptr.push(rowval.len());
+        }
+        Reduction { offset, n, colptr, rowval, source, diag }
+    }
+
+    /// Reduced Hessian values B^T H B.
+    fn values(&self, h: &dyn HessianBlocks, bases: &[NodeBasis]) -> Vec<f64> {
+        let mut cache: Option<((u32, u32), Matrix3<f64>)> = None;
+        self.source
+            .iter()
+            .map(|&(a, b, p, q)| {
+                let blk = match cache {
+                    Some((key, m)) if key == (a, b) => m,
+                    _ => {
+                        let m = bases[a as usize].basis.transpose() * h.block(a as usize, b as usize) * bases[b as usize].basis;
+                        cache = Some(((a, b), m));
+                        m
+                    }
+                };
+                blk[(p as usize, q as usize)]
+            })
+            .collect()
+    }
+
+    fn reduce(&self, v: &[Vector], bases: &[NodeBasis]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n];
+        for (k, b) in bases.iter().enumerate() {
+            for p in 0..b.dofs {
+                out[self.offset[k] + p] = b.dir(p).dot(&v[k]);
+            }
+        }
+        out
+    }
+
+    fn expand(&self, y: &[f64], bases: &[NodeBasis]) -> Vec<Vector> {
+        bases
+            .iter()
+            .enumerate()
+            .map(|(k, b)| (0..b.dofs).fold(Vector::zeros(), |s, p| s + b.dir(p) * y[self.offset[k] + p]))
+            .collect()
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Minimise the objective from `x` (modified in place to the last accepted state).
+pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, settings: &SolverSettings) -> SolveReport {
+    let start = std::time::Instant::now();
+    let reduction = Reduction::new(&cons.freedom, &objective.coupled_pairs());
+    let movable: Vec<bool> = cons.freedom.iter().map(|f| f.dofs() > 0).collect();
+    let bases_at = |x: &[Point]| -> Vec<NodeBasis> { cons.freedom.iter().zip(x).map(|(f, p)| f.basis(p, cons.tool)).collect() };
+    let rows_at = |x: &[Point]| -> Vec<ContactRow> {
+        match (cons.mode, cons.tool) {
+            (ContactMode::Free, Some(tool)) => contact_rows(tool, x, &movable, cons.spacing),
+            _ => Vec::new(),
+        }
+    };
+    let mut bases = bases_at(x);
+    let mut rows = rows_at(x);
+    let mut eval = objective.evaluate(x, true);
+    let energy_start = eval.energy;
+    let mut iterations = Vec::new();
+    let mut damping = settings.initial_damping;
+    let mut history = vec![eval.energy];
+    let mut residual = residual(&reduction, &eval, &bases, &rows, cons.spacing);
+    let mut outcome = Outcome::IterationLimit;
+    for it in 0..settings.max_iterations {
+        if residual <= settings.tolerance || reduction.n == 0 {
+            outcome = Outcome::Converged;
+            break;
+        }
+        let t_it = std::time::Instant::now();
+        let grad: Vec<Vector> = eval.internal.iter().zip(&eval.external).map(|(f, p)| f - p).collect();
+        let g = reduction.reduce(&grad, &bases);
+        let mut pvals = reduction.values(eval.hessian.as_deref().expect("hessian requested"), &bases);
+        let mean_diag = reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| pvals[k].abs()).sum::<f64>()
+            / reduction.n.max(1) as f64;
+        let scale = mean_diag.max(f64::MIN_POSITIVE);
+        // Try steps with growing damping until one lowers the energy.
+        let mut accepted = false;
+        let mut stationary = false;
+        let mut qp_iterations = 0;
+        let mut step_norm = 0.0;
+        let mut qp_failed = false;
+        while damping <= settings.max_damping {
+            for &k in reduction.diag.iter() {
+                if k != usize::MAX {
+                    pvals[k] += damping * scale;
+                }
+            }
+            let qp = solve_qp(&reduction, &pvals, &g, &rows, &bases);
+            let predicted = qp.as_ref().map(|(y, _)| -(dot(&g, y) + 0.5 * quad(&reduction, &pvals, y)));
+            for &k in reduction.diag.iter() {
+                if k != usize::MAX {
+                    pvals[k] -= damping * scale;
+                }
+            }
+            let (Some((y, iters)), Some(predicted)) = (qp, predicted) else {
+                // A failed subproblem: more damping conditions it better.
+                qp_failed = true;
+                damping *= 10.0;
+                continue;
+            };
+            qp_failed = false;
+            qp_iterations += iters;
+            let floor = ENERGY_ROUNDING * eval.energy.abs().max(f64::MIN_POSITIVE);
+            if predicted <= floor {
+                stationary = true; // the model sees nothing left to gain
+                break;
+            }
+            let delta = reduction.expand(&y, &bases);
+            let mut trial: Vec<Point> = x.iter().zip(&delta).map(|(p, d)| p + d).collect();
+            if let (ContactMode::Pressed, Some(tool)) = (cons.mode, cons.tool) {
+                for (k, p) in trial.iter_mut().enumerate() {
+                    if matches!(cons.freedom[k], Freedom::OnTool | Freedom::OnToolInPlane(_)) {
+                        *p = tool.closest_point(p).point;
+                    }
+                }
+            }
+            let trial_eval = objective.evaluate(&trial, true);
+            let actual = eval.energy - trial_eval.energy;
+            if actual >= ACCEPT_RATIO * predicted || (actual >= 0.0 && predicted <= 100.0 * floor) {
+                step_norm = norm(&y);
+                x.copy_from_slice(&trial);
+                eval = trial_eval;
+                bases = bases_at(x);
+                rows = rows_at(x);
+                if actual >= 0.75 * predicted {
+                    damping = (damping / 4.0).max(1e-12);
+                }
+                accepted = true;
+                break;
+            }
+            damping *= 5.0;
+        }
+        residual = self::residual(&reduction, &eval, &bases, &rows, cons.spacing);
+        iterations.push(IterationLog {
+            iteration: it + 1,
+            energy: eval.energy,
+            residual,
+            step: step_norm,
+            damping,
+            active_contacts: rows.iter().filter(|r| r.gap <= ACTIVE_GAP * cons.spacing).count(),
+            accepted,
+            qp_iterations,
+            time_ms: t_it.elapsed().as_secs_f64() * 1e3,
+        });
+        if stationary {
+            outcome = if residual <= settings.tolerance { Outcome::Converged } else { Outcome::Stalled };
+            break;
+        }
+        if !accepted {
+            outcome = if qp_failed { Outcome::SubproblemFailed } else { Outcome::LineSearchFailed };
+            break;
+        }
+        history.push(eval.energy);
+        if residual <= settings.tolerance {
+            outcome = Outcome::Converged;
+            break;
+        }
+        if history.len() > settings.stall_window {
+            let old = history[history.len() - 1 - settings.stall_window];
+            if (old - eval.energy).abs() <= settings.stall_tolerance * old.abs().max(eval.energy.abs()) {
+                outcome = Outcome::Stalled;
+                break;
+            }
+        }
+    }
+    SolveReport {
+        outcome,
+        energy_start,
+        energy_end: eval.energy,
+        residual,
+        iterations,
+        time_ms: start.elapsed().as_secs_f64() * 1e3,
+    }
+}
+
+/// A step is accepted when the energy falls by at least this fraction of the predicted fall.
+const ACCEPT_RATIO: f64 = 0.1;
+/// Relative energy changes below this are rounding.
+const ENERGY_ROUNDING: f64 = 1e-14;
+/// A contact is active when its gap is below this fraction of the spacing.
+const ACTIVE_GAP: f64 = 1e-9;
+
+/// |F - P - R| / max(|F|, |P|) over the free directions, where R are the contact reactions (the
+/// part of F - P pushing active contact nodes into the tool, which the tool takes).
+fn residual(r: &Reduction, e: &Evaluation, bases: &[NodeBasis], rows: &[ContactRow], spacing: f64) -> f64 {
+    let mut unbalanced: Vec<Vector> = e.internal.iter().zip(&e.external).map(|(f, p)| f - p).collect();
+    for row in rows.iter().filter(|row| row.gap <= ACTIVE_GAP * spacing) {
+        let g = &mut unbalanced[row.node];
+        let push = row.normal.dot(g);
+        if push > 0.0 {
+            *g -= row.normal * push;
+        }
+    }
+    let num = norm(&r.reduce(&unbalanced, bases));
+    let den = norm(&r.reduce(&e.internal, bases)).max(norm(&r.reduce(&e.external, bases)));
+    num / den.max(f64::MIN_POSITIVE)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// y^T P y for the upper-triangular CSC P.
+fn quad(r: &Reduction, p: &[f64], y: &[f64]) -> f64 {
+    let mut s = 0.0;
+    for c in 0..r.n {
+        for k in r.colptr[c]..r.colptr[c + 1] {
+            let row = r.rowval[k];
+            let v = p[k] * y[row] * y[c];
+            s += if row == c { v } else { 2.0 * v };
+        }
+    }
+    s
+}
+
+/// Solve min 1/2 y^T P y + g^T y subject to the linearised contact rows, with Clarabel.
+/// Returns the step and Clarabel's iteration count, or None if it failed.
+fn solve_qp(r: &Reduction, pvals: &[f64], g: &[f64], rows: &[ContactRow], bases: &[NodeBasis]) -> Option<(Vec<f64>, u32)> {
+    let p = CscMatrix::new(r.n, r.n, r.colptr.clone(), r.rowval.clone(), pvals.to_vec());
+    // Contact: normal . (B_k y_k) + gap >= 0  ->  -normal^T B_k y_k + s = gap, s >= 0.
+    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); r.n];
+    let mut b = Vec::with_capacity(rows.len());
+    for (m, row) in rows.iter().enumerate() {
+        let basis = &bases[row.node];
+        for q in 0..basis.dofs {
+            let a = -row.normal.dot(&basis.dir(q));
+            if a != 0.0 {
+                cols[r.offset[row.node] + q].push((m, a));
+            }
+        }
+        b.push(row.gap);
+    }
+    let mut colptr = vec![0];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for col in cols {
+        for (m, a) in col {
+            rowval.push(m);
+            nzval.push(a);
+        }
+        colptr.push(rowval.len());
+    }
+    let a = CscMatrix::new(rows.len(), r.n, colptr, rowval, nzval);
+    let cones: Vec<SupportedConeT<f64>> = if rows.is_empty() { vec![] } else { vec![NonnegativeConeT(rows.len())] };
+    let settings = DefaultSettingsBuilder::default().verbose(false).max_iter(100).build().ok()?;
+    let mut solver = DefaultSolver::new(&p, g, &a, &b, &cones, settings).ok()?;
+    solver.solve();
+    match solver.solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => Some((solver.solution.x.clone(), solver.solution.iterations)),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::shapes;
+
+    /// 1/2 sum k |x - target|^2: each node pulled to its target by a spring.
+    struct Springs {
+        targets: Vec<Point>,
+        k: f64,
+    }
+    struct Diagonal(f64);
+    impl HessianBlocks for Diagonal {
+        fn block(&self, a: usize, b: usize) -> Matrix3<f64> {
+            if a == b {
+                Matrix3::identity() * self.0
+            } else {
+                Matrix3::zeros()
+            }
+        }
+    }
+    impl Objective for Springs {
+        fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation {
+            let internal: Vec<Vector> = x.iter().zip(&self.targets).map(|(p, t)| (p - t) * self.k).collect();
+            let energy = x.iter().zip(&self.targets).map(|(p, t)| 0.5 * self.k * (p - t).norm_squared()).sum();
+            Evaluation {
+                energy,
+                internal,
+                external: vec![Vector::zeros(); x.len()],
+                hessian: hessian.then(|| Box::new(Diagonal(self.k)) as Box<dyn HessianBlocks>),
+            }
+        }
+        fn coupled_pairs(&self) -> Vec<(usize, usize)> {
+            (0..self.targets.len()).map(|k| (k, k)).collect()
+        }
+    }
+
+    #[test]
+    fn unconstrained_springs_reach_their_targets_and_fixed_nodes_stay() {
+        let targets = vec![Point::new(1.0, 2.0, 3.0), Point::new(-1.0, 0.5, 0.0), Point::new(0.0, 0.0, 1.0)];
+        let obj = Springs { targets: targets.clone(), k: 100.0 };
+        let mut x = vec![Point::origin(); 3];
+        let freedom = vec![Freedom::Free, Freedom::Fixed, Freedom::Line(Vector::z())];
+        let cons = Constraints { freedom, mode: ContactMode::None, tool: None, spacing: 1.0 };
+        let report = solve(&obj, &mut x, &cons, &SolverSettings::default());
+        assert!(report.ok(), "{report:?}");
+        assert!((x[0] - targets[0]).norm() < 1e-6);
+        assert_eq!(x[1], Point::origin());
+        assert!((x[2] - Point::new(0.0, 0.0, 1.0)).norm() < 1e-6);
+        assert!(report.energy_end <= report.energy_start);
+    }
+
+    #[test]
+    fn free_contact_keeps_nodes_out_of_the_tool() {
+        let tool = shapes::plate(4.0, 4.0, 4, 4).into_surface().unwrap();
+        // Springs pull the nodes 1 m below the plate; contact must stop them on it.
+        let targets = vec![Point::new(0.2, 0.1, -1.0), Point::new(-0.5, 0.3, -0.5), Point::new(0.1, 0.1, 2.0)];
+        let obj = Springs { targets, k: 10.0 };
+        let mut x = vec![Point::new(0.0, 0.0, 0.5), Point::new(0.0, 0.0, 0.3), Point::new(0.0, 0.0, 0.1)];
+        let cons = Constraints { freedom: vec![Freedom::Free; 3], mode: ContactMode::Free, tool: Some(&tool), spacing: 1.0 };
+        let report = solve(&obj, &mut x, &cons, &SolverSettings::default());
+        assert!(report.ok(), "{report:?}");
+        assert!(x[0].z.abs() < 1e-6 && (x[0].x - 0.2).abs() < 1e-6, "{}", x[0]);
+        assert!(x[1].z.abs() < 1e-6);
+        assert!((x[2].z - 2.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn pressed_nodes_slide_on_the_tool() {
+        let tool = shapes::hemisphere(1.0, 20).into_surface().unwrap();
+        // A target off the sphere: the pressed node ends at the closest point of the tool to it.
+        let target = Point::new(0.6, 0.0, 1.2);
+        let obj = Springs { targets: vec![target], k: 1.0 };
+        let start = tool.closest_point(&Point::new(0.0, 0.0, 1.0));
+        let mut x = vec![start.point];
+        let cons = Constraints { freedom: vec![Freedom::OnTool], mode: ContactMode::Pressed, tool: Some(&tool), spacing: 0.1 };
+        let report = solve(&obj, &mut x, &cons, &SolverSettings::default());
+        assert!(report.ok(), "{report:?}");
+        assert!(tool.closest_point(&x[0]).distance < 1e-12);
+        // The closest point of the (faceted) sphere to the target: along the target's direction.
+        let expected = tool.closest_point(&target).point;
+        assert!((x[0] - expected).norm() < 1e-4, "{} vs {}", x[0], expected);
+    }
+}
