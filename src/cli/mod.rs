@@ -1,6 +1,7 @@
 //! The `drape` command line: argument parsing and subcommands; nothing numerical lives here.
 mod bench;
 mod kinematic;
+mod refine;
 mod scene;
 mod summary;
 
@@ -60,6 +61,8 @@ pub enum Command {
     Kinematic(kinematic::KinematicArgs),
     /// Drape every ply of a scene file.
     Run(scene::RunArgs),
+    /// Refine a kinematic net mechanically (tension, shear, bending, gravity, tool contact).
+    Refine(refine::RefineArgs),
     /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
     Bench(bench::BenchArgs),
 }
@@ -69,6 +72,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Kinematic(a) => kinematic::run(a),
         Command::Run(a) => scene::run(a),
+        Command::Refine(a) => refine::run(a),
         Command::Bench(a) => bench::run(a),
     }
 }

@@ -59,6 +59,8 @@ pub enum Freedom {
     Free,
     /// Along a fixed direction only.
     Line(Vector),
+    /// Within the plane with this normal.
+    InPlane(Vector),
     /// Sliding on the tool (pressed contact).
     OnTool,
     /// Sliding on the tool within the plane with this normal (keeps a direction fixed).
@@ -71,7 +73,7 @@ impl Freedom {
         match self {
             Freedom::Fixed => 0,
             Freedom::Line(_) | Freedom::OnToolInPlane(_) => 1,
-            Freedom::OnTool => 2,
+            Freedom::OnTool | Freedom::InPlane(_) => 2,
             Freedom::Free => 3,
         }
     }
@@ -83,6 +85,7 @@ impl Freedom {
             Freedom::Fixed => NodeBasis::FIXED,
             Freedom::Free => NodeBasis::free(),
             Freedom::Line(t) => NodeBasis::line(t),
+            Freedom::InPlane(m) => NodeBasis::tangent(&m.normalize()),
             Freedom::OnTool => NodeBasis::tangent(&normal()),
             Freedom::OnToolInPlane(m) => {
                 let n = normal();

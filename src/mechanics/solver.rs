@@ -434,7 +434,12 @@ fn solve_qp(r: &Reduction, pvals: &[f64], g: &[f64], rows: &[ContactRow], bases:
     }
     let a = CscMatrix::new(rows.len(), r.n, colptr, rowval, nzval);
     let cones: Vec<SupportedConeT<f64>> = if rows.is_empty() { vec![] } else { vec![NonnegativeConeT(rows.len())] };
-    let settings = DefaultSettingsBuilder::default().verbose(false).max_iter(100).build().ok()?;
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(100)
+        .direct_solve_method("faer".to_string())
+        .build()
+        .ok()?;
     let mut solver = DefaultSolver::new(&p, g, &a, &b, &cones, settings).ok()?;
     solver.solve();
     match solver.solution.status {

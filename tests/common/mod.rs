@@ -2,3 +2,5 @@
 #![allow(dead_code)]
 
 pub mod chebyshev;
+pub mod elastica;
+pub mod shear_frames;

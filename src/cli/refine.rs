@@ -1,0 +1,136 @@
+//! `drape refine`: mechanical refinement of a kinematic net.
+use super::kinematic::print_tool_report;
+use super::summary::summary;
+use super::{compute, input, parse_vec3, Failure};
+use crate::export::{read_net, write_net, Format};
+use crate::geometry::{ToolSurface, Vector};
+use crate::kinematic::DrapeNet;
+use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::material::MaterialCard;
+use crate::mechanics::refine::{cell_changes, refine, RefineSettings, Refined};
+use crate::mechanics::{ContactMode, SolverSettings};
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Contact mode on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum Mode {
+    /// Held against the tool: nodes slide on it.
+    Pressed,
+    /// Gravity drape with one-sided contact.
+    Free,
+}
+
+/// Arguments of `drape refine`.
+#[derive(Debug, Args)]
+pub struct RefineArgs {
+    /// Kinematic net (`<ply>.drape.json` from `drape kinematic` or `drape run`).
+    #[arg(long)]
+    pub net: PathBuf,
+    /// Tool surface (OBJ), in the net's units (metres).
+    #[arg(long)]
+    pub tool: PathBuf,
+    /// Material card (TOML).
+    #[arg(long)]
+    pub material: PathBuf,
+    /// Contact with the tool.
+    #[arg(long, value_enum)]
+    pub mode: Mode,
+    /// Gravity vector, m/s^2.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,-9.80665")]
+    pub gravity: [f64; 3],
+    /// Gravity is applied in this many steps.
+    #[arg(long, default_value_t = 1)]
+    pub load_steps: usize,
+    /// Solver iteration limit per load step.
+    #[arg(long, default_value_t = 100)]
+    pub max_iterations: usize,
+    /// Output formats: comma-separated json,vtu,csv, or none.
+    #[arg(long, default_value = "json")]
+    pub format: String,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+pub fn run(a: RefineArgs) -> Result<(), Failure> {
+    let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
+    if a.load_steps == 0 {
+        return Err(input(anyhow::anyhow!("--load-steps must be at least 1")));
+    }
+    let net = read_net(&a.net).map_err(input)?;
+    let material = MaterialCard::load(&a.material).map_err(input)?;
+    let t_load = Instant::now();
+    let tool = ToolSurface::from_obj(&a.tool).map_err(input)?;
+    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
+    print_tool_report(&a.tool, &tool);
+    let settings = RefineSettings {
+        mode: match a.mode {
+            Mode::Pressed => ContactMode::Pressed,
+            Mode::Free => ContactMode::Free,
+        },
+        gravity: Vector::from(a.gravity),
+        load_steps: a.load_steps,
+        solver: SolverSettings::default().max_iterations(a.max_iterations),
+    };
+    let t = Instant::now();
+    let refined = refine(&net, &tool, &material, &settings).map_err(input)?;
+    let solve_ms = t.elapsed().as_secs_f64() * 1e3;
+    let mut out = refined.net.clone();
+    annotate(&mut out, &net, &refined, &a.material);
+    out.timing.load_ms = load_ms;
+    out.timing.fill_ms = solve_ms;
+    out.timing.total_ms = load_ms + solve_ms;
+    // The last consistent state is written even when the solver did not converge.
+    let t_write = Instant::now();
+    let written = write_net(&out, &a.out, &formats).map_err(compute)?;
+    println!("{}", summary(&out, DEFAULT_LOCKING_ANGLE_DEG.to_radians(), load_ms, t_write.elapsed().as_secs_f64() * 1e3));
+    print_solver(&refined);
+    for p in written {
+        println!("  wrote {}", p.display());
+    }
+    if !refined.ok() {
+        return Err(compute(anyhow::anyhow!(
+            "the mechanical solver stopped without equilibrium ({:?}); the last accepted state was written. Try more --load-steps or --max-iterations",
+            refined.outcome()
+        )));
+    }
+    Ok(())
+}
+
+/// Record the solver's work and the per-cell change from the kinematic net in the net's meta.
+pub(crate) fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, material: &std::path::Path) {
+    let changes = cell_changes(kinematic, &refined.net);
+    let shear: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(g, _)| g.to_degrees())).collect();
+    let angle: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(_, a)| a.to_degrees())).collect();
+    out.meta.insert(
+        "change_from_kinematic".into(),
+        serde_json::json!({"shear_deg": shear, "warp_angle_deg": angle}),
+    );
+    out.meta.insert("material".into(), serde_json::json!(material.display().to_string()));
+    out.meta.insert(
+        "solver".into(),
+        serde_json::json!({
+            "outcome": refined.outcome(),
+            "energy_kinematic": refined.energy_kinematic,
+            "energy_final": refined.energy_final,
+            "load_steps": refined.steps,
+        }),
+    );
+}
+
+fn print_solver(r: &Refined) {
+    let iterations: usize = r.steps.iter().map(|s| s.iterations.len()).sum();
+    let ms: f64 = r.steps.iter().map(|s| s.time_ms).sum();
+    let residual = r.steps.last().map_or(0.0, |s| s.residual);
+    println!(
+        "  solver: {:?} after {iterations} iterations in {} load step(s), {:.0} ms; |F-P|/|P| {:.2e}; energy {:.6e} -> {:.6e} J",
+        r.outcome(),
+        r.steps.len(),
+        ms,
+        residual,
+        r.energy_kinematic,
+        r.energy_final
+    );
+}

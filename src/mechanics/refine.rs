@@ -1,0 +1,226 @@
+//! Mechanical refinement of a draped net: the energy model on its grid, minimised from the
+//! kinematic state with the tool as contact, under load steps of gravity.
+use super::contact::{ContactMode, Freedom};
+use super::energy::{Grid, HessianKind, Laws, Model};
+use super::solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Outcome, SolveReport, SolverSettings};
+use crate::geometry::{Point, ToolSurface, Vector};
+use crate::kinematic::{DrapeNet, Method, NodeStatus};
+
+/// Standard gravity, m/s^2.
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// The energy of a net's grid as the solver sees it: internal energy from the model, and
+/// gravity as constant nodal loads P = m g.
+pub struct NetObjective<'a> {
+    model: Model<'a>,
+    loads: Vec<Vector>,
+    pairs: Vec<(usize, usize)>,
+}
+
+impl<'a> NetObjective<'a> {
+    /// Stretch, shear and bending of `laws` on `grid`, loaded by `gravity` (m/s^2) times
+    /// `load_factor`.
+    pub fn new<L: Laws + ?Sized>(grid: Grid, laws: &'a L, gravity: Vector) -> Self {
+        let areas = grid.nodal_areas();
+        let loads = areas.iter().map(|a| gravity * (a * laws.areal_mass())).collect();
+        let pairs = coupled_pairs(grid.nu, grid.nv);
+        NetObjective { model: Model::new(grid, laws, Vector::zeros()), loads, pairs }
+    }
+
+    /// Scale the loads (load stepping).
+    pub fn scale_loads(&mut self, factor: f64) {
+        self.loads.iter_mut().for_each(|l| *l *= factor);
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.model.grid
+    }
+
+    /// Internal forces (energy gradient without loads) at `x`.
+    pub fn internal_forces(&self, x: &[Point]) -> Vec<Vector> {
+        self.model.evaluate(x, None).gradient
+    }
+
+    /// The energy terms at `x`, by name.
+    pub fn energy_terms(&self, x: &[Point]) -> Vec<(&'static str, f64)> {
+        self.model.evaluate(x, None).terms
+    }
+}
+
+impl Objective for NetObjective<'_> {
+    fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation {
+        let ev = self.model.evaluate(x, hessian.then_some(HessianKind::Convex));
+        let work: f64 = self.loads.iter().zip(x).map(|(l, p)| l.dot(&p.coords)).sum();
+        Evaluation {
+            energy: ev.energy - work,
+            internal: ev.gradient,
+            external: self.loads.clone(),
+            hessian: ev.hessian.map(|h| Box::new(h) as Box<dyn HessianBlocks>),
+        }
+    }
+    fn coupled_pairs(&self) -> Vec<(usize, usize)> {
+        self.pairs.clone()
+    }
+}
+
+/// Node pairs (a <= b) of a grid that the energy couples: cell neighbours and nodes two apart
+/// along a fibre (bending).
+pub fn coupled_pairs(nu: usize, nv: usize) -> Vec<(usize, usize)> {
+    let offsets: [(i64, i64); 7] = [(0, 0), (0, 1), (1, -1), (1, 0), (1, 1), (0, 2), (2, 0)];
+    let mut pairs = Vec::new();
+    for i in 0..nu as i64 {
+        for j in 0..nv as i64 {
+            for (di, dj) in offsets {
+                let (a, b) = (i + di, j + dj);
+                if a >= 0 && b >= 0 && a < nu as i64 && b < nv as i64 {
+                    let p = (i * nv as i64 + j) as usize;
+                    let q = (a * nv as i64 + b) as usize;
+                    pairs.push((p.min(q), p.max(q)));
+                }
+            }
+        }
+    }
+    pairs
+}
+
+/// How to refine.
+#[derive(Debug, Clone)]
+pub struct RefineSettings {
+    pub mode: ContactMode,
+    /// Gravity, m/s^2.
+    pub gravity: Vector,
+    /// Gravity is applied in this many equal steps.
+    pub load_steps: usize,
+    pub solver: SolverSettings,
+}
+
+impl Default for RefineSettings {
+    fn default() -> Self {
+        RefineSettings {
+            mode: ContactMode::Pressed,
+            gravity: Vector::new(0.0, 0.0, -STANDARD_GRAVITY),
+            load_steps: 1,
+            solver: SolverSettings::default(),
+        }
+    }
+}
+
+/// A refined net and what the solver did.
+#[derive(Debug, Clone)]
+pub struct Refined {
+    pub net: DrapeNet,
+    /// One report per load step.
+    pub steps: Vec<SolveReport>,
+    pub energy_kinematic: f64,
+    pub energy_final: f64,
+}
+
+impl Refined {
+    /// Whether every load step reached equilibrium.
+    pub fn ok(&self) -> bool {
+        self.steps.iter().all(SolveReport::ok)
+    }
+    /// How the last load step ended.
+    pub fn outcome(&self) -> Outcome {
+        self.steps.last().map_or(Outcome::Converged, |s| s.outcome)
+    }
+}
+
+/// Why a refinement could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum RefineError {
+    #[error("the net has no placed nodes to refine")]
+    Empty,
+    #[error("load steps must be at least 1")]
+    LoadSteps,
+}
+
+/// Refine a kinematic net on its tool. Pressed: every node slides on the tool, the origin node
+/// is held and its warp neighbour stays in the plane of the initial warp direction and normal.
+/// Free: nodes move freely with one-sided contact, the origin node held likewise.
+pub fn refine<L: Laws + ?Sized>(
+    kinematic: &DrapeNet,
+    tool: &ToolSurface,
+    laws: &L,
+    settings: &RefineSettings,
+) -> Result<Refined, RefineError> {
+    if settings.load_steps == 0 {
+        return Err(RefineError::LoadSteps);
+    }
+    let active: Vec<bool> = kinematic.status.iter().map(|s| *s == NodeStatus::Placed).collect();
+    if !active.iter().any(|a| *a) {
+        return Err(RefineError::Empty);
+    }
+    let grid = Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone());
+    let (i0, j0) = kinematic.origin_node;
+    let origin = kinematic.index(i0, j0);
+    let warp_neighbour = if i0 + 1 < kinematic.nu { Some(kinematic.index(i0 + 1, j0)) } else { None };
+    let n0 = tool.closest_point(&kinematic.positions[origin]).normal;
+    let plane_normal = warp_neighbour
+        .filter(|&k| active[k])
+        .and_then(|k| (kinematic.positions[k] - kinematic.positions[origin]).cross(&n0).try_normalize(1e-12));
+    let freedom: Vec<Freedom> = (0..active.len())
+        .map(|k| {
+            if !active[k] || k == origin {
+                Freedom::Fixed
+            } else if Some(k) == warp_neighbour && plane_normal.is_some() {
+                match settings.mode {
+                    ContactMode::Pressed => Freedom::OnToolInPlane(plane_normal.unwrap()),
+                    _ => Freedom::InPlane(plane_normal.unwrap()),
+                }
+            } else {
+                match settings.mode {
+                    ContactMode::Pressed => Freedom::OnTool,
+                    _ => Freedom::Free,
+                }
+            }
+        })
+        .collect();
+    let cons = Constraints { freedom, mode: settings.mode, tool: Some(tool), spacing: kinematic.spacing };
+    let mut x = kinematic.positions.clone();
+    let mut steps = Vec::new();
+    let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
+    // Energy of the kinematic state under the full load, for comparison with the result.
+    let energy_kinematic = {
+        let full = NetObjective::new(Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone()), laws, settings.gravity);
+        full.evaluate(&x, false).energy
+    };
+    for step in 1..=settings.load_steps {
+        if step > 1 {
+            objective.scale_loads(step as f64 / (step - 1) as f64);
+        }
+        let report = solve(&objective, &mut x, &cons, &settings.solver);
+        let ok = report.ok();
+        steps.push(report);
+        if !ok {
+            break;
+        }
+    }
+    let energy_final = objective.evaluate(&x, false).energy;
+    let mut net = kinematic.clone();
+    net.method = Method::Mechanical;
+    for (k, p) in x.iter().enumerate() {
+        if active[k] {
+            net.positions[k] = *p;
+            net.triangles[k] = tool.closest_point(p).triangle;
+        }
+    }
+    Ok(Refined { net, steps, energy_kinematic, energy_final })
+}
+
+/// Per-cell change from `before` to `after` (same grid): (shear difference, angle between the
+/// warp directions), radians; None where a cell is missing in either.
+pub fn cell_changes(before: &DrapeNet, after: &DrapeNet) -> Vec<Option<(f64, f64)>> {
+    let mut out = Vec::with_capacity(before.num_cells());
+    for i in 0..before.nu - 1 {
+        for j in 0..before.nv - 1 {
+            let c = match (before.cell_shear(i, j), after.cell_shear(i, j), before.cell_frame(i, j), after.cell_frame(i, j)) {
+                (Some(g0), Some(g1), Some(f0), Some(f1)) => Some((g1 - g0, f0.warp.angle(&f1.warp))),
+                _ => None,
+            };
+            out.push(c);
+        }
+    }
+    out
+}
