@@ -1,9 +1,11 @@
 //! The `drape` command line: argument parsing and subcommands; nothing numerical lives here.
 mod bench;
+mod calibrate;
 mod kinematic;
 mod refine;
 mod scene;
 mod summary;
+mod virtual_test;
 
 use clap::{Parser, Subcommand};
 
@@ -63,6 +65,10 @@ pub enum Command {
     Run(scene::RunArgs),
     /// Refine a kinematic net mechanically (tension, shear, bending, gravity, tool contact).
     Refine(refine::RefineArgs),
+    /// Fit a material card's shear or knit tension law to test data.
+    Calibrate(calibrate::CalibrateArgs),
+    /// Virtual material tests on the mechanical model.
+    Test(virtual_test::TestArgs),
     /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
     Bench(bench::BenchArgs),
 }
@@ -74,6 +80,8 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Run(a) => scene::run(a),
         Command::Refine(a) => refine::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Test(a) => virtual_test::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
     }
 }
 

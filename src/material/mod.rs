@@ -1,5 +1,10 @@
 //! Fabric material cards (TOML, SI units) and their constitutive laws; fitting laws to test data.
+//!
+//! [`MaterialCard`] reads a card (schema in [`card`]) and evaluates its laws with exact
+//! derivatives: `tension(fibre, e)`, `shear(g)`, `bending(fibre)`. [`calibrate`] fits the shear
+//! law to picture-frame or bias-extension data and the knit tension law to uniaxial data.
+//! Bundled cards live in `materials/` at the crate root.
 pub mod calibrate;
 pub mod card;
 
-pub use card::{Fibre, MaterialCard, MaterialError};
+pub use card::{Bending, Fibre, KnitParams, MaterialCard, MaterialError, ShearLaw, ShearTable, Tension, TensionLaw};

@@ -2,8 +2,11 @@
 //! with locking, bending, gravity) with tool contact, minimised by sequential convex subproblems
 //! solved with Clarabel.
 pub mod energy;
+pub mod sparse;
 pub mod contact;
+pub mod refine;
 pub mod solver;
+pub mod virtual_tests;
 
 pub use contact::{ContactMode, Freedom, NodeBasis};
 pub use solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Outcome, SolveReport, SolverSettings};
