@@ -1,0 +1,81 @@
+//! Fibre stretching [000 eqs. 14-17]: per fibre segment between neighbours along i (warp) or j
+//! (weft), Green strain `e = (|xb - xa|^2 - d^2) / (2 d^2)` and energy `d * d * W(e)` (reference
+//! length d times tributary width d), `(W, W', W'') = tension(fibre, e)`.
+//!
+//! With `r = xb - xa`: `grad_b e = r / d^2 = -grad_a e`, `hess e = [I, -I; -I, I] / d^2` (PSD).
+//! Exact Hessian block `K = W'' r r^T / d^2 + W' I`, placed as `[K, -K; -K, K]`;
+//! Convex: `max(W'', 0) r r^T / d^2 + max(W', 0) I` (PSD).
+use super::{EnergyTerm, Grid, HessianKind, Laws, Sink};
+use crate::geometry::{Point, Vector};
+use crate::material::Fibre;
+use nalgebra::Matrix3;
+use std::ops::Range;
+
+/// The stretch term.
+pub struct Stretch<'a, L: Laws + ?Sized> {
+    pub material: &'a L,
+}
+
+impl<'a, L: Laws + ?Sized> Stretch<'a, L> {
+    pub fn new(material: &'a L) -> Self {
+        Stretch { material }
+    }
+
+    #[inline]
+    fn segment(&self, fibre: Fibre, d2: f64, a: usize, b: usize, x: &[Point], sink: &mut Sink<'_>) {
+        let r = x[b] - x[a];
+        let e = (r.norm_squared() - d2) / (2.0 * d2);
+        let (w, w1, w2) = self.material.tension(fibre, e);
+        sink.add_energy(a.min(b), d2 * w);
+        if sink.wants_gradient() {
+            let g: Vector = r * w1;
+            sink.add_gradient(b, &g);
+            sink.add_gradient(a, &-g);
+        }
+        if let Some(kind) = sink.hessian_kind() {
+            let (c2, c1) = match kind {
+                HessianKind::Exact => (w2, w1),
+                HessianKind::Convex => (w2.max(0.0), w1.max(0.0)),
+            };
+            let k: Matrix3<f64> = r * r.transpose() * (c2 / d2) + Matrix3::from_diagonal_element(c1);
+            sink.add_block(a, a, &k);
+            sink.add_block(b, b, &k);
+            sink.add_block(a, b, &-k);
+        }
+    }
+}
+
+impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
+    fn name(&self) -> &'static str {
+        "stretch"
+    }
+
+    fn row_span(&self) -> usize {
+        1
+    }
+
+    fn add(&self, grid: &Grid, x: &[Point], base: Range<usize>, sink: &mut Sink<'_>) {
+        let (nu, nv) = (grid.nu, grid.nv);
+        let d2 = grid.spacing * grid.spacing;
+        let act = &grid.active;
+        // Warp segments (i, j)-(i + 1, j).
+        for i in sink.element_rows(&base, 1, nu) {
+            for j in 0..nv {
+                let a = i * nv + j;
+                let b = a + nv;
+                if act[a] && act[b] {
+                    self.segment(Fibre::Warp, d2, a, b, x, sink);
+                }
+            }
+        }
+        // Weft segments (i, j)-(i, j + 1).
+        for i in sink.element_rows(&base, 0, nu) {
+            for j in 0..nv.saturating_sub(1) {
+                let a = i * nv + j;
+                if act[a] && act[a + 1] {
+                    self.segment(Fibre::Weft, d2, a, a + 1, x, sink);
+                }
+            }
+        }
+    }
+}
