@@ -6,6 +6,9 @@ use super::solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Ou
 use crate::geometry::{Point, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
+/// Which Hessian the quadratic models use.
+const HESSIAN: HessianKind = HessianKind::Exact;
+
 /// Standard gravity, m/s^2.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
 
@@ -50,7 +53,7 @@ impl<'a> NetObjective<'a> {
 
 impl Objective for NetObjective<'_> {
     fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation {
-        let ev = self.model.evaluate(x, hessian.then_some(HessianKind::Convex));
+        let ev = self.model.evaluate(x, hessian.then_some(HESSIAN));
         let work: f64 = self.loads.iter().zip(x).map(|(l, p)| l.dot(&p.coords)).sum();
         Evaluation {
             energy: ev.energy - work,
