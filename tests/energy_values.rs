@@ -57,8 +57,9 @@ fn uniform_stretch_energy() {
     for (lu, lv) in [(1.02, 1.0), (1.0, 0.97), (1.05, 1.01), (0.9, 1.1)] {
         let x = sheared(&grid, 0.0, (lu, lv));
         let (eu, ev_) = ((lu * lu - 1.0) / 2.0, (lv * lv - 1.0) / 2.0);
-        let expected =
-            D * D * (((nu - 1) * nv) as f64 * m.tension(Fibre::Warp, eu).0 + (nu * (nv - 1)) as f64 * m.tension(Fibre::Weft, ev_).0);
+        // Edge fibres carry half the width: both families add up to the fabric's area.
+        let area_cells = ((nu - 1) * (nv - 1)) as f64;
+        let expected = D * D * area_cells * (m.tension(Fibre::Warp, eu).0 + m.tension(Fibre::Weft, ev_).0);
         let e = stretch_only(&grid, &m).energy(&x);
         assert!((e - expected).abs() <= 1e-12 * expected.abs(), "({lu}, {lv}): {e} vs {expected}");
         assert!(shear_only(&grid, &m).energy(&x).abs() < 1e-12 * expected);
@@ -81,14 +82,14 @@ fn cylinder_bending_energy_is_half_d_kappa_squared_times_area() {
             })
             .collect();
         let e = bending_only(&grid, &m).energy(&x);
-        // Each warp triple's zone is d long (l/2 = d) and d wide.
-        let area = ((nu - 2) * nv) as f64 * D * D;
+        // Each warp triple's zone is d long (l/2 = d) and d wide (d/2 on the fabric's edges).
+        let area = ((nu - 2) * (nv - 1)) as f64 * D * D;
         let continuum = 0.5 * m.bending(Fibre::Warp) / (r * r) * area;
         let rel = (e - continuum).abs() / continuum;
         assert!(rel <= (D / r).powi(2), "R = {r}: {e} vs {continuum} (rel {rel:e})");
         // The discrete value exactly: w = R (1 - cos(d/R)) per triple.
         let w = r * (1.0 - (D / r).cos());
-        let exact = ((nu - 2) * nv) as f64 * 2.0 * m.bending(Fibre::Warp) * w * w / (D * D);
+        let exact = ((nu - 2) * (nv - 1)) as f64 * 2.0 * m.bending(Fibre::Warp) * w * w / (D * D);
         assert!((e - exact).abs() <= 1e-10 * exact, "R = {r}: {e} vs {exact}");
     }
 }

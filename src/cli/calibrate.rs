@@ -1,8 +1,10 @@
 //! `drape calibrate`: fit a law of a material card to test data and write the updated card.
 //!
-//!     drape calibrate picture-frame --data CSV --side L [--law polynomial:3|two-slope] --card BASE.toml --out NEW.toml
-//!     drape calibrate bias-extension --data CSV --length L --width W [--law ...] --card BASE.toml --out NEW.toml
-//!     drape calibrate knit --data CSV --direction warp|weft --card BASE.toml --out NEW.toml
+//! ```text
+//! drape calibrate picture-frame --data CSV --side L [--law polynomial:3|two-slope] --card BASE.toml --out NEW.toml
+//! drape calibrate bias-extension --data CSV --length L --width W [--law ...] --card BASE.toml --out NEW.toml
+//! drape calibrate knit --data CSV --direction warp|weft --card BASE.toml --out NEW.toml
+//! ```
 use super::{compute, input, Failure};
 use crate::export::write_atomic;
 use crate::layup::unit_scale;

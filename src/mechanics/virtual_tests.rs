@@ -25,9 +25,10 @@ impl Cantilever {
     }
 }
 
-/// A strip of `length` with `nodes` nodes along `fibre`, one cell wide, clamped horizontally at
-/// x = 0 (its first two node columns held), hanging under gravity along -z. The strip lies along
-/// +x; the returned centre line runs from the clamp to the tip.
+/// A strip with free length `length` and `nodes` nodes along `fibre`, one cell wide, clamped
+/// horizontally at x = 0 (its first two node columns, at x = -d/2 and d/2, held level), hanging
+/// under gravity along -z. The strip lies along +x; the returned centre line runs from the clamp
+/// (first node, inside the clamp at x = -d/2) to the tip.
 pub fn cantilever<L: Laws + ?Sized>(laws: &L, fibre: Fibre, length: f64, nodes: usize) -> Result<Cantilever, String> {
     if nodes < 3 {
         return Err(format!("a cantilever needs at least 3 nodes, got {nodes}"));
@@ -35,7 +36,10 @@ pub fn cantilever<L: Laws + ?Sized>(laws: &L, fibre: Fibre, length: f64, nodes: 
     if !(length.is_finite() && length > 0.0) {
         return Err(format!("the strip length must be positive, got {length}"));
     }
-    let d = length / (nodes - 1) as f64;
+    // The clamp holds the first two node columns level; its edge (where the free length
+    // starts, x = 0) is midway between them, which keeps the discrete clamp second-order
+    // accurate. The nodes sit at x = (k - 1/2) d, k = 0..nodes-1, the last at the tip x = L.
+    let d = length / (nodes as f64 - 1.5);
     // The strip runs along the grid's i (warp) or j (weft) direction.
     let (nu, nv) = match fibre {
         Fibre::Warp => (nodes, 2),
@@ -54,8 +58,8 @@ pub fn cantilever<L: Laws + ?Sized>(laws: &L, fibre: Fibre, length: f64, nodes: 
             // Warp strip: i along +x, j across (+y). Weft strip: j along +x, i across (-y), so
             // that warp x weft stays +z.
             x[k] = match fibre {
-                Fibre::Warp => Point::new(s as f64 * d, w as f64 * d, 0.0),
-                Fibre::Weft => Point::new(s as f64 * d, -(w as f64) * d, 0.0),
+                Fibre::Warp => Point::new((s as f64 - 0.5) * d, w as f64 * d, 0.0),
+                Fibre::Weft => Point::new((s as f64 - 0.5) * d, -(w as f64) * d, 0.0),
             };
             if s < 2 {
                 freedom[k] = Freedom::Fixed;

@@ -1,7 +1,7 @@
 //! Fibre bending without rotational DOFs [000 eqs. 7-12]: for every node O whose two neighbours
 //! A, B along a fibre are active, the deviation of O from the chord midpoint
 //! `w = xO - (xA + xB) / 2` gives the curvature `k = 2 |w| / (a b)`; with a = b = d, l = 2 d and
-//! width L = d the energy `(D_k / 2) k^2 l L = l L D_k |w|^2 / (a^2 b^2) = 2 D_k |w|^2 / d^2`,
+//! width L = f d (f = 1 inside the fabric, 1/2 along its edges; see [`Grid::warp_triple_width`]) the energy `(D_k / 2) k^2 l L = l L D_k |w|^2 / (a^2 b^2) = 2 D_k |w|^2 / d^2`,
 //! D_k the flexural rigidity of that fibre family. Quadratic: the exact Hessian is constant and
 //! PSD (`2 c N^T N`, `N = [-1/2, 1, -1/2]` over (A, O, B), `c = 2 D_k / d^2`), Convex = Exact.
 use super::{EnergyTerm, Grid, Laws, Sink};
@@ -61,8 +61,9 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Bending<'a, L> {
                 for j in 0..nv {
                     let a = i * nv + j;
                     let (o, b) = (a + nv, a + 2 * nv);
-                    if act[a] && act[o] && act[b] {
-                        triple(cw, a, o, b, x, sink);
+                    let width = grid.warp_triple_width(i, j);
+                    if act[a] && act[o] && act[b] && width > 0.0 {
+                        triple(cw * width, a, o, b, x, sink);
                     }
                 }
             }
@@ -73,8 +74,9 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Bending<'a, L> {
             for i in sink.element_rows(&base, 0, nu) {
                 for j in 0..nv.saturating_sub(2) {
                     let a = i * nv + j;
-                    if act[a] && act[a + 1] && act[a + 2] {
-                        triple(cf, a, a + 1, a + 2, x, sink);
+                    let width = grid.weft_triple_width(i, j);
+                    if act[a] && act[a + 1] && act[a + 2] && width > 0.0 {
+                        triple(cf * width, a, a + 1, a + 2, x, sink);
                     }
                 }
             }

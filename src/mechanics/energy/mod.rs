@@ -125,6 +125,34 @@ impl Grid {
         let nv = self.nv;
         self.active[k] && self.active[k + 1] && self.active[k + nv] && self.active[k + nv + 1]
     }
+    /// Whether cell (i, j) exists and is complete (out-of-range indices: false).
+    fn cell_on(&self, i: isize, j: isize) -> f64 {
+        let inside = i >= 0 && j >= 0 && (i as usize) + 1 < self.nu && (j as usize) + 1 < self.nv;
+        if inside && self.cell_active(i as usize, j as usize) { 1.0 } else { 0.0 }
+    }
+    /// Share of the tributary width d carried by the warp segment (i, j)-(i+1, j): half for each
+    /// complete cell beside it, so edge fibres of the fabric carry d/2 and the widths of all
+    /// segments add up to the fabric's area.
+    pub fn warp_segment_width(&self, i: usize, j: usize) -> f64 {
+        let (i, j) = (i as isize, j as isize);
+        0.5 * (self.cell_on(i, j - 1) + self.cell_on(i, j))
+    }
+    /// As [`Grid::warp_segment_width`] for the weft segment (i, j)-(i, j+1).
+    pub fn weft_segment_width(&self, i: usize, j: usize) -> f64 {
+        let (i, j) = (i as isize, j as isize);
+        0.5 * (self.cell_on(i - 1, j) + self.cell_on(i, j))
+    }
+    /// Share of the width d carried by the warp bending triple (i, j), (i+1, j), (i+2, j): a
+    /// quarter for each complete cell around its middle node along that line.
+    pub fn warp_triple_width(&self, i: usize, j: usize) -> f64 {
+        let (i, j) = (i as isize, j as isize);
+        0.25 * (self.cell_on(i, j - 1) + self.cell_on(i, j) + self.cell_on(i + 1, j - 1) + self.cell_on(i + 1, j))
+    }
+    /// As [`Grid::warp_triple_width`] for the weft triple (i, j), (i, j+1), (i, j+2).
+    pub fn weft_triple_width(&self, i: usize, j: usize) -> f64 {
+        let (i, j) = (i as isize, j as isize);
+        0.25 * (self.cell_on(i - 1, j) + self.cell_on(i, j) + self.cell_on(i - 1, j + 1) + self.cell_on(i, j + 1))
+    }
     /// Area attributed to each node: a quarter of each complete cell it is a corner of (d^2 for
     /// interior nodes of a full grid, d^2/2 on edges, d^2/4 at corners, 0 for nodes without a
     /// complete cell). Sums to the area of the complete cells.

@@ -1,6 +1,7 @@
 //! Fibre stretching [000 eqs. 14-17]: per fibre segment between neighbours along i (warp) or j
-//! (weft), Green strain `e = (|xb - xa|^2 - d^2) / (2 d^2)` and energy `d * d * W(e)` (reference
-//! length d times tributary width d), `(W, W', W'') = tension(fibre, e)`.
+//! (weft), Green strain `e = (|xb - xa|^2 - d^2) / (2 d^2)` and energy `d * (f d) * W(e)` (reference
+//! length d times tributary width f d, f = 1 inside the fabric and 1/2 along its edges; see
+//! [`Grid::warp_segment_width`]), `(W, W', W'') = tension(fibre, e)`.
 //!
 //! With `r = xb - xa`: `grad_b e = r / d^2 = -grad_a e`, `hess e = [I, -I; -I, I] / d^2` (PSD).
 //! Exact Hessian block `K = W'' r r^T / d^2 + W' I`, placed as `[K, -K; -K, K]`;
@@ -22,10 +23,12 @@ impl<'a, L: Laws + ?Sized> Stretch<'a, L> {
     }
 
     #[inline]
-    fn segment(&self, fibre: Fibre, d2: f64, a: usize, b: usize, x: &[Point], sink: &mut Sink<'_>) {
+    #[allow(clippy::too_many_arguments)]
+    fn segment(&self, fibre: Fibre, d2: f64, width: f64, a: usize, b: usize, x: &[Point], sink: &mut Sink<'_>) {
         let r = x[b] - x[a];
         let e = (r.norm_squared() - d2) / (2.0 * d2);
         let (w, w1, w2) = self.material.tension(fibre, e);
+        let (w, w1, w2) = (w * width, w1 * width, w2 * width);
         sink.add_energy(a.min(b), d2 * w);
         if sink.wants_gradient() {
             let g: Vector = r * w1;
@@ -63,8 +66,9 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
             for j in 0..nv {
                 let a = i * nv + j;
                 let b = a + nv;
-                if act[a] && act[b] {
-                    self.segment(Fibre::Warp, d2, a, b, x, sink);
+                let width = grid.warp_segment_width(i, j);
+                if act[a] && act[b] && width > 0.0 {
+                    self.segment(Fibre::Warp, d2, width, a, b, x, sink);
                 }
             }
         }
@@ -72,8 +76,9 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
         for i in sink.element_rows(&base, 0, nu) {
             for j in 0..nv.saturating_sub(1) {
                 let a = i * nv + j;
-                if act[a] && act[a + 1] {
-                    self.segment(Fibre::Weft, d2, a, a + 1, x, sink);
+                let width = grid.weft_segment_width(i, j);
+                if act[a] && act[a + 1] && width > 0.0 {
+                    self.segment(Fibre::Weft, d2, width, a, a + 1, x, sink);
                 }
             }
         }
