@@ -188,3 +188,41 @@ fn steering_curve_and_outline_files_from_the_command_line() {
     let (o, w) = (nodes[i0 * nv + j0].unwrap(), nodes[(i0 + 1) * nv + j0].unwrap());
     assert!(((w[1] - o[1]).atan2(w[0] - o[0]).to_degrees() - 30.0).abs() < 0.01);
 }
+
+#[test]
+fn refine_and_cantilever_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let out = dir.path().join("out");
+    let mut args = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap());
+    args.extend(["--name", "k", "--pre-shear", "20"]);
+    drape().args(&args).assert().success();
+    let card = concat!(env!("CARGO_MANIFEST_DIR"), "/materials/glass-plain-weave.toml");
+    let net = out.join("k.drape.json");
+    let mech = dir.path().join("mech");
+    drape()
+        .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card, "--mode", "pressed", "--max-iterations", "400", "--out", mech.to_str().unwrap()])
+        .assert()
+        .success();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(mech.join("k.drape.json")).unwrap()).unwrap();
+    assert_eq!(json["method"], "mechanical");
+    // A 20 deg pre-sheared net pressed on a plate relaxes to no shear (it is held only at the
+    // origin and in the warp direction there).
+    let shear: Vec<f64> = json["cell_shear_deg"].as_array().unwrap().iter().filter_map(|g| g.as_f64()).collect();
+    let mean = shear.iter().map(|g| g.abs()).sum::<f64>() / shear.len() as f64;
+    assert!(mean < 0.01, "mean shear {mean}");
+    assert_eq!(json["meta"]["solver"]["outcome"], "converged");
+    assert_eq!(json["meta"]["change_from_kinematic"]["shear_deg"].as_array().unwrap().len(), 20 * 20);
+    // Bad input: a missing card is refused with exit code 2.
+    drape()
+        .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", "/no/card.toml", "--mode", "free", "--out", mech.to_str().unwrap()])
+        .assert()
+        .code(2);
+    let cant = dir.path().join("cant.json");
+    drape()
+        .args(["test", "cantilever", "--material", card, "--direction", "warp", "--length", "0.05", "--nodes", "11", "--out", cant.to_str().unwrap()])
+        .assert()
+        .success();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&cant).unwrap()).unwrap();
+    assert_eq!(json["nodes"].as_array().unwrap().len(), 11);
+}
