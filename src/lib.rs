@@ -10,6 +10,7 @@ pub mod kinematic;
 pub mod layup;
 pub mod material;
 pub mod mechanics;
+pub mod numeric;
 
 pub use geometry::ToolSurface;
 pub use kinematic::{drape, DrapeNet, KinematicSettings};

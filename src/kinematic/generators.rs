@@ -7,6 +7,7 @@ use super::{GeneratorKind, KinematicSettings};
 use crate::geometry::geodesic::TraceState;
 use crate::geometry::surface::Circle;
 use crate::geometry::{Point, SurfacePoint, ToolSurface, Vector};
+use crate::numeric::golden_section_min;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Largest turn of one minimum-shear generator segment away from the geodesic (radians).
@@ -169,7 +170,7 @@ fn min_shear_half(
                 None => f64::INFINITY,
             }
         };
-        let turn = if out.is_empty() { 0.0 } else { golden_min(&cost, -MAX_STEER_TURN, MAX_STEER_TURN) };
+        let turn = if out.is_empty() { 0.0 } else { golden_section_min(cost, -MAX_STEER_TURN, MAX_STEER_TURN, GOLDEN_ITERATIONS, 0.0).0 };
         let turn = if cost(turn) <= cost(0.0) { turn } else { 0.0 };
         let Some((s, x)) = shoot(turn) else { break };
         let (_, next) = evaluate(&prev, &x, &strip);
@@ -180,30 +181,6 @@ fn min_shear_half(
     }
     out.resize(n, Err(NodeStatus::OffTool));
     out
-}
-
-/// Minimum of `f` on [lo, hi] by golden-section search.
-fn golden_min(f: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let mut x1 = hi - r * (hi - lo);
-    let mut x2 = lo + r * (hi - lo);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..GOLDEN_ITERATIONS {
-        if f1 <= f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - r * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + r * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// Warp generator along a user curve; weft generator geodesic.

@@ -16,6 +16,7 @@
 //! section picks the locking angle; a polynomial that comes out non-monotone is refitted with
 //! non-negative coefficients). The knit law is linear in C and beta at fixed alpha:
 //! variable projection (grid + golden section on alpha) then Levenberg-Marquardt on all three.
+use crate::numeric::golden_section_min;
 use super::card::{KnitParams, ShearLaw, KNIT_STRETCH_LIMIT};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, SQRT_2};
@@ -363,32 +364,10 @@ fn refine_min(grid: &[f64], f: impl Fn(f64) -> f64) -> Option<f64> {
     if !best.is_finite() {
         return None;
     }
-    let mut lo = grid[k.saturating_sub(1)];
-    let mut hi = grid[(k + 1).min(grid.len() - 1)];
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let mut x1 = hi - r * (hi - lo);
-    let mut x2 = lo + r * (hi - lo);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..200 {
-        if hi - lo <= 1e-15 * hi.abs().max(1e-300) {
-            break;
-        }
-        if f1 <= f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - r * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + r * (hi - lo);
-            f2 = f(x2);
-        }
-    }
+    let (lo, hi) = (grid[k.saturating_sub(1)], grid[(k + 1).min(grid.len() - 1)]);
+    let (x, fx) = golden_section_min(&f, lo, hi, 200, 1e-15);
     // The best point seen: the bracket's interior points or the grid point.
-    let cands = [(x1, f1), (x2, f2), (grid[k], *best)];
+    let cands = [(x, fx), (grid[k], *best)];
     cands
         .into_iter()
         .filter(|c| c.1.is_finite())
