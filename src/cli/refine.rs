@@ -80,6 +80,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     let mut out = refined.net.clone();
     annotate(&mut out, &net, &refined, &a.material);
     out.timing.load_ms = load_ms;
+    out.timing.generators_ms = 0.0;
     out.timing.fill_ms = solve_ms;
     out.timing.total_ms = load_ms + solve_ms;
     // The last consistent state is written even when the solver did not converge.

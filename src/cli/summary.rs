@@ -1,5 +1,5 @@
 //! The short summary printed after a drape.
-use crate::kinematic::{DrapeNet, NodeStatus};
+use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
 /// One block of text: nodes placed and failed by reason, shear statistics, time per stage.
 pub fn summary(net: &DrapeNet, locking_angle: f64, load_ms: f64, write_ms: f64) -> String {
@@ -26,9 +26,13 @@ pub fn summary(net: &DrapeNet, locking_angle: f64, load_ms: f64, write_ms: f64) 
         locking_angle.to_degrees()
     );
     let t = &net.timing;
-    out += &format!(
-        "  time: load {:.1} ms, generators {:.1} ms, fill {:.1} ms, write {:.1} ms",
-        load_ms, t.generators_ms, t.fill_ms, write_ms
-    );
+    out += &match net.method {
+        Method::Kinematic => format!(
+            "  time: load {:.1} ms, generators {:.1} ms, fill {:.1} ms, write {:.1} ms",
+            load_ms, t.generators_ms, t.fill_ms, write_ms
+        ),
+        // A refined net keeps its solve time where the kinematic stages keep their fill time.
+        Method::Mechanical => format!("  time: load {:.1} ms, solve {:.1} ms, write {:.1} ms", load_ms, t.fill_ms, write_ms),
+    };
     out
 }
