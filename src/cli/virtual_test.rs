@@ -1,8 +1,23 @@
 //! `drape test ...`: virtual material tests writing JSON.
+//!
+//! ```text
+//! drape test cantilever --material CARD --direction warp|weft --length L [--nodes N] --out F
+//! drape test picture-frame --material CARD --side L --displacement D [--steps S] --spacing H --out F
+//! drape test bias-extension --material CARD --length L --width W --displacement D [--steps S] --spacing H --out F
+//! ```
+//!
+//! The two shear tests write `{"displacement": [...], "force": [...], "net": {"grid": [nu, nv],
+//! "nodes": [[x,y,z] | null, ...], ...}, ...}`: the crosshead displacement (m) and force (N, on
+//! the whole sample) with d = 0, F = 0 first and then one entry per completed load step (S + 1
+//! entries when every step converged), and the net in its last consistent state (node (i, j) at
+//! `i * nv + j`, null for nodes outside the sample). Extra keys: `"test"`, `"sample"` (the
+//! dimensions and spacing the net realises), `"net".spacing`, `"net".cell_shear_deg` (final
+//! cell shear, null for incomplete cells), `"steps"` (requested, completed), `"converged"`,
+//! `"iterations"`, `"notes"` (adjustments made to the request).
 use super::{compute, input, Failure};
 use crate::export::write_atomic;
 use crate::material::{Fibre, MaterialCard};
-use crate::mechanics::virtual_tests::cantilever;
+use crate::mechanics::virtual_tests::{bias_extension, cantilever, picture_frame, BiasExtension, PictureFrame, ShearTest};
 use clap::{Args, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
@@ -42,10 +57,73 @@ pub enum VirtualTest {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Picture frame: a square sample clamped in a pin-jointed frame (warp and weft along the
+    /// arms), one corner fixed, the opposite corner pulled along the diagonal.
+    PictureFrame {
+        /// Material card (TOML).
+        #[arg(long)]
+        material: PathBuf,
+        /// Frame side L (hinge to hinge, = sample side), m.
+        #[arg(long)]
+        side: f64,
+        /// Final crosshead displacement, m (below (2 - sqrt 2) L, where the frame closes).
+        #[arg(long)]
+        displacement: f64,
+        /// Equal load steps up to the displacement.
+        #[arg(long, default_value_t = 10)]
+        steps: usize,
+        /// Fibre spacing of the net, m (adjusted to a whole number of cells per side, >= 2).
+        #[arg(long)]
+        spacing: f64,
+        /// Output JSON file.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Bias extension: a rectangular sample with its fibres at +-45 deg to the load, clamped at
+    /// both ends, one clamp pulled along the sample.
+    BiasExtension {
+        /// Material card (TOML).
+        #[arg(long)]
+        material: PathBuf,
+        /// Free length L between the clamps, m (L >= 2 W).
+        #[arg(long)]
+        length: f64,
+        /// Width W, m.
+        #[arg(long)]
+        width: f64,
+        /// Final clamp displacement, m (below (sqrt 2 - 1)(L - W), 90 deg in the central zone).
+        #[arg(long)]
+        displacement: f64,
+        /// Equal load steps up to the displacement.
+        #[arg(long, default_value_t = 10)]
+        steps: usize,
+        /// Fibre spacing of the net, m (adjusted so that the clamp corners are nodes).
+        #[arg(long)]
+        spacing: f64,
+        /// Output JSON file.
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 pub fn run(a: TestArgs) -> Result<(), Failure> {
     match a.test {
+        VirtualTest::PictureFrame { material, side, displacement, steps, spacing, out } => {
+            check_out(&out)?;
+            let card = MaterialCard::load(&material).map_err(input)?;
+            let spec = PictureFrame { side, spacing, displacement, steps };
+            let result = picture_frame(&card, &spec).map_err(|m| input(anyhow::anyhow!(m)))?;
+            let sample = serde_json::json!({"side": result.sample.0, "spacing": result.sample.2});
+            finish_shear_test("picture-frame", &result, sample, &out)
+        }
+        VirtualTest::BiasExtension { material, length, width, displacement, steps, spacing, out } => {
+            check_out(&out)?;
+            let card = MaterialCard::load(&material).map_err(input)?;
+            let spec = BiasExtension { length, width, spacing, displacement, steps };
+            let result = bias_extension(&card, &spec).map_err(|m| input(anyhow::anyhow!(m)))?;
+            let sample = serde_json::json!({"length": result.sample.0, "width": result.sample.1, "spacing": result.sample.2});
+            finish_shear_test("bias-extension", &result, sample, &out)
+        }
         VirtualTest::Cantilever { material, direction, length, nodes, out } => {
             let card = MaterialCard::load(&material).map_err(input)?;
             let fibre = match direction {
@@ -77,4 +155,75 @@ pub fn run(a: TestArgs) -> Result<(), Failure> {
             Ok(())
         }
     }
+}
+
+/// Refuse an output path whose directory does not exist (before any computation).
+fn check_out(out: &std::path::Path) -> Result<(), Failure> {
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(input(anyhow::anyhow!("--out {}: the directory {} does not exist", out.display(), dir.display())));
+    }
+    if out.is_dir() {
+        return Err(input(anyhow::anyhow!("--out {} is a directory: give a file name", out.display())));
+    }
+    Ok(())
+}
+
+/// Write a shear test's JSON, print a summary, and fail (exit code 1) if a load step did not
+/// reach equilibrium (the file then holds the steps up to the last equilibrium).
+fn finish_shear_test(name: &str, r: &ShearTest, sample: serde_json::Value, out: &std::path::Path) -> Result<(), Failure> {
+    let nodes: Vec<serde_json::Value> = r
+        .nodes
+        .iter()
+        .zip(&r.grid.active)
+        .map(|(p, a)| if *a { serde_json::json!([p.x, p.y, p.z]) } else { serde_json::Value::Null })
+        .collect();
+    let shear: Vec<Option<f64>> = r.cell_shears().iter().map(|g| g.map(f64::to_degrees)).collect();
+    let json = serde_json::json!({
+        "test": name,
+        "displacement": r.displacement,
+        "force": r.force,
+        "net": {"grid": [r.grid.nu, r.grid.nv], "spacing": r.grid.spacing, "nodes": nodes, "cell_shear_deg": shear},
+        "sample": sample,
+        "steps": {"requested": r.requested, "completed": r.completed},
+        "converged": r.ok(),
+        "iterations": r.iterations(),
+        "notes": r.notes,
+    });
+    let finite = r.force.iter().all(|f| f.is_finite()) && r.nodes.iter().all(|p| p.coords.iter().all(|c| c.is_finite()));
+    if !finite {
+        return Err(compute(anyhow::anyhow!("the {name} test produced non-finite forces or positions; nothing was written")));
+    }
+    write_atomic(out, |w| w.write_all(serde_json::to_string_pretty(&json).unwrap_or_default().as_bytes())).map_err(compute)?;
+    for note in &r.notes {
+        println!("note: {note}");
+    }
+    let cells = r.cell_shears().iter().flatten().count();
+    let (d, f) = (r.displacement.last().copied().unwrap_or(0.0), r.force.last().copied().unwrap_or(0.0));
+    let gmax = r.cell_shears().iter().flatten().fold(0.0f64, |m, g| m.max(g.abs())).to_degrees();
+    println!(
+        "{name}: {cells} cells, spacing {:.6} m; {} of {} load steps, d = {d:.6} m, force {f:.6e} N, largest cell shear {gmax:.2} deg; \
+         {} iterations; written to {}",
+        r.grid.spacing,
+        r.completed,
+        r.requested,
+        r.iterations(),
+        out.display()
+    );
+    if !r.ok() {
+        let last = r.solves.last().map(|s| format!("{:?}", s.outcome)).unwrap_or_default();
+        return Err(compute(anyhow::anyhow!(
+            "load step {} of {} did not reach equilibrium (solver: {last}) even in {} sub-steps; the state after step {} \
+             (d = {d:.6} m) was written to {}",
+            r.completed + 1,
+            r.requested,
+            1usize << crate::mechanics::virtual_tests::SHEAR_TEST_MAX_HALVINGS,
+            r.completed,
+            out.display()
+        )));
+    }
+    Ok(())
 }

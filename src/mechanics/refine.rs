@@ -7,7 +7,7 @@ use crate::geometry::{Point, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
 /// Which Hessian the quadratic models use.
-const HESSIAN: HessianKind = HessianKind::Exact;
+const HESSIAN: HessianKind = HessianKind::Convex;
 
 /// Standard gravity, m/s^2.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
