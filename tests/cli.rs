@@ -226,3 +226,30 @@ fn refine_and_cantilever_from_the_command_line() {
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&cant).unwrap()).unwrap();
     assert_eq!(json["nodes"].as_array().unwrap().len(), 11);
 }
+
+#[test]
+fn a_mechanical_ply_in_a_scene_is_refined_and_bad_mechanical_fields_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let card = concat!(env!("CARGO_MANIFEST_DIR"), "/materials/glass-plain-weave.toml");
+    let scene = dir.path().join("scene.toml");
+    let text = format!(
+        "tool = \"plate.obj\"\n\n[[ply]]\nname = \"m\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.05\ngrid = [9, 9]\nmethod = \"mechanical\"\nmaterial = \"{card}\"\nmode = \"pressed\"\n"
+    );
+    std::fs::write(&scene, &text).unwrap();
+    let out = dir.path().join("out");
+    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"]).assert().success();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("m.drape.json")).unwrap()).unwrap();
+    assert_eq!(json["method"], "mechanical");
+    assert!(json["meta"]["solver"]["outcome"].is_string());
+    for (bad, needle) in [
+        (text.replace(&format!("material = \"{card}\"\n"), ""), "field `material`"),
+        (text.replace("mode = \"pressed\"", "mode = \"glued\""), "unknown mode 'glued'"),
+        (text.replace("method = \"mechanical\"", "method = \"kinematic\""), "only a ply with method"),
+    ] {
+        std::fs::write(&scene, bad).unwrap();
+        let a = drape().args(["run", scene.to_str().unwrap(), "--out", dir.path().join("bad").to_str().unwrap()]).assert().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert!(err.contains(needle) && err.contains("line 3"), "expected '{needle}' in: {err}");
+    }
+}

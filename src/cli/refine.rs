@@ -121,7 +121,7 @@ pub(crate) fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refin
     );
 }
 
-fn print_solver(r: &Refined) {
+pub(crate) fn print_solver(r: &Refined) {
     let iterations: usize = r.steps.iter().map(|s| s.iterations.len()).sum();
     let ms: f64 = r.steps.iter().map(|s| s.time_ms).sum();
     let residual = r.steps.last().map_or(0.0, |s| s.residual);

@@ -6,6 +6,8 @@ use crate::export::{write_net, Format};
 use crate::geometry::ToolSurface;
 use crate::kinematic::drape;
 use crate::layup::Scene;
+use crate::mechanics::refine::{refine, RefineSettings};
+use super::refine::{annotate, print_solver};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -36,6 +38,7 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     print_tool_report(&scene.tool, &tool);
     // Drape every ply first, so a bad ply is reported before any file is written.
     let mut nets = Vec::new();
+    let mut unconverged = Vec::new();
     for ply in &scene.plies {
         let mut net = drape(&tool, &ply.settings).map_err(|e| {
             input(anyhow::anyhow!("scene {}: ply '{}' (line {}): {e}", a.scene.display(), ply.settings.name, ply.line))
@@ -43,15 +46,39 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
         net.timing.load_ms = load_ms;
         net.meta.insert("tool".into(), serde_json::json!(scene.tool.display().to_string()));
         net.meta.insert("scene".into(), serde_json::json!(a.scene.display().to_string()));
-        nets.push((net, ply.locking_angle));
+        if let Some(r) = &ply.refinement {
+            let settings = RefineSettings { mode: r.mode, ..RefineSettings::default() };
+            let t = Instant::now();
+            let refined = refine(&net, &tool, &r.material, &settings).map_err(input)?;
+            let mut out = refined.net.clone();
+            annotate(&mut out, &net, &refined, &r.material_path);
+            out.timing.load_ms = load_ms;
+            out.timing.generators_ms = 0.0;
+            out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
+            if !refined.ok() {
+                unconverged.push(format!("ply '{}' ({:?})", ply.settings.name, refined.outcome()));
+            }
+            nets.push((out, ply.locking_angle, Some(refined)));
+        } else {
+            nets.push((net, ply.locking_angle, None));
+        }
     }
-    for (net, locking) in &nets {
+    for (net, locking, refined) in &nets {
         let t_write = Instant::now();
         let written = write_net(net, &a.out, &formats).map_err(compute)?;
         println!("{}", summary(net, *locking, load_ms, t_write.elapsed().as_secs_f64() * 1e3));
+        if let Some(r) = refined {
+            print_solver(r);
+        }
         for p in written {
             println!("  wrote {}", p.display());
         }
+    }
+    if !unconverged.is_empty() {
+        return Err(compute(anyhow::anyhow!(
+            "the mechanical solver stopped without equilibrium for {}; the last accepted states were written",
+            unconverged.join(", ")
+        )));
     }
     Ok(())
 }

@@ -14,11 +14,15 @@
 //! generators = "geodesic"     # or "min-shear" or "steer:curve.csv"
 //! locking_angle_deg = 45.0    # optional, for reporting
 //! max_shear_deg = 75.0        # optional: nodes shearing past this are not placed
-//! method = "kinematic"
+//! method = "kinematic"       # or "mechanical": kinematic, then refinement with
+//! # material = "../../materials/glass-plain-weave.toml"   # card, relative to this file
+//! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
 //! ```
 use super::{parse_generators, read_points, unit_scale};
 use crate::geometry::{Point, Vector};
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
+use crate::material::MaterialCard;
+use crate::mechanics::ContactMode;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -68,6 +72,8 @@ struct PlyFile {
     max_shear_deg: Option<f64>,
     #[serde(default = "default_method")]
     method: String,
+    material: Option<String>,
+    mode: Option<String>,
 }
 
 fn default_generators() -> String {
@@ -81,10 +87,20 @@ fn default_method() -> String {
 #[derive(Debug, Clone)]
 pub struct Ply {
     pub settings: KinematicSettings,
+    /// Mechanical refinement after the kinematic drape, if the ply asks for it.
+    pub refinement: Option<Refinement>,
     /// Locking angle for reporting, radians.
     pub locking_angle: f64,
     /// Line of the scene file where the ply starts.
     pub line: usize,
+}
+
+/// A ply's mechanical refinement: the material card and the contact mode.
+#[derive(Debug, Clone)]
+pub struct Refinement {
+    pub material: MaterialCard,
+    pub material_path: PathBuf,
+    pub mode: ContactMode,
 }
 
 /// A scene: the tool and its plies in stacking order.
@@ -142,14 +158,30 @@ impl Scene {
                 _ => return Err(at("grid", "give exactly one of grid, outline or outline_file".into())),
             };
             let generators = parse_generators(&p.generators, base, scale).map_err(|m| at("generators", m))?;
-            if p.method != "kinematic" {
-                let msg = if p.method == "mechanical" {
-                    "mechanical refinement is not available in this version yet; use method = \"kinematic\"".to_string()
-                } else {
-                    format!("unknown method '{}': use \"kinematic\"", p.method)
-                };
-                return Err(at("method", msg));
-            }
+            let refinement = match p.method.as_str() {
+                "kinematic" => {
+                    for (field, given) in [("material", p.material.is_some()), ("mode", p.mode.is_some())] {
+                        if given {
+                            return Err(at(field, "only a ply with method = \"mechanical\" uses it".into()));
+                        }
+                    }
+                    None
+                }
+                "mechanical" => {
+                    let file = p.material.as_ref().ok_or_else(|| {
+                        at("material", "a mechanical ply needs a material card: material = \"card.toml\"".into())
+                    })?;
+                    let material_path = base.join(file);
+                    let material = MaterialCard::load(&material_path).map_err(|e| at("material", e.to_string()))?;
+                    let mode = match p.mode.as_deref().unwrap_or("pressed") {
+                        "pressed" => ContactMode::Pressed,
+                        "free" => ContactMode::Free,
+                        other => return Err(at("mode", format!("unknown mode '{other}': use \"pressed\" or \"free\""))),
+                    };
+                    Some(Refinement { material, material_path, mode })
+                }
+                other => return Err(at("method", format!("unknown method '{other}': use \"kinematic\" or \"mechanical\""))),
+            };
             let max_shear = p.max_shear_deg.unwrap_or(DEFAULT_MAX_SHEAR_DEG);
             if !(max_shear > 0.0 && max_shear < 90.0) {
                 return Err(at("max_shear_deg", format!("must lie strictly between 0 and 90, got {max_shear}")));
@@ -171,7 +203,7 @@ impl Scene {
                 generators,
                 max_shear: max_shear.to_radians(),
             };
-            plies.push(Ply { settings, locking_angle: locking.to_radians(), line });
+            plies.push(Ply { settings, refinement, locking_angle: locking.to_radians(), line });
         }
         Ok(Scene { path: path.into(), scale, tool: base.join(&file.tool), plies })
     }

@@ -254,7 +254,15 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let mut history = vec![eval.energy];
     // Force scale: the larger of the loads and the internal forces at the start, so that a net
     // relaxing towards zero force with no load (P = 0) still measures its progress.
-    let force_scale = norm(&reduction.reduce(&eval.internal, &bases)).max(norm(&reduction.reduce(&eval.external, &bases)));
+    // ... and never below the rounding noise of the forces: what would move the nodes by a
+    // FORCE_NOISE fraction of the spacing through the model's mean stiffness.
+    let mean_stiffness = {
+        let h = reduction.values(eval.hessian.as_deref().expect("hessian requested"), &bases);
+        reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| h[k].abs()).sum::<f64>() / reduction.n.max(1) as f64
+    };
+    let noise = FORCE_NOISE * mean_stiffness * cons.spacing * (reduction.n as f64).sqrt();
+    let force_scale = norm(&reduction.reduce(&eval.internal, &bases)).max(norm(&reduction.reduce(&eval.external, &bases))).max(noise);
+    let energy_noise = FORCE_NOISE * mean_stiffness * cons.spacing * cons.spacing * reduction.n as f64;
     let mut residual = residual(&reduction, &eval, &bases, &rows, cons.spacing, force_scale);
     let mut outcome = Outcome::IterationLimit;
     for it in 0..settings.max_iterations {
@@ -296,7 +304,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             };
             qp_failed = false;
             qp_iterations += iters;
-            let floor = ENERGY_ROUNDING * eval.energy.abs().max(f64::MIN_POSITIVE);
+            let floor = ENERGY_ROUNDING * eval.energy.abs().max(energy_noise).max(f64::MIN_POSITIVE);
             if predicted <= floor {
                 stationary = true; // the model sees nothing left to gain
                 break;
@@ -373,6 +381,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
 const ACCEPT_RATIO: f64 = 0.1;
 /// Relative energy changes below this are rounding.
 const ENERGY_ROUNDING: f64 = 1e-14;
+/// Relative size of the rounding noise in forces and energies (see `solve`).
+const FORCE_NOISE: f64 = 1e-10;
 /// A contact is active when its gap is below this fraction of the spacing.
 const ACTIVE_GAP: f64 = 1e-9;
 
