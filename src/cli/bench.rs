@@ -3,6 +3,9 @@ use super::{input, Failure};
 use crate::geometry::shapes;
 use crate::geometry::{Point, Vector};
 use crate::kinematic::{drape, KinematicSettings};
+use crate::material::MaterialCard;
+use crate::mechanics::refine::{refine, RefineSettings};
+use crate::mechanics::SolverSettings;
 use clap::Args;
 use std::time::Instant;
 
@@ -21,6 +24,13 @@ pub struct BenchArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Also refine the net mechanically (pressed) with this material card, and report
+    /// iterations and time per iteration.
+    #[arg(long)]
+    pub refine: Option<std::path::PathBuf>,
+    /// Iteration limit of the refinement.
+    #[arg(long, default_value_t = 100)]
+    pub max_iterations: usize,
 }
 
 pub fn run(a: BenchArgs) -> Result<(), Failure> {
@@ -63,10 +73,35 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         cells as f64 * a.repeat as f64 / total / 1e6
     );
     println!("placed cells per second (best): {:.2} M", placed_cells as f64 / best / 1e6);
+    if let Some(card) = &a.refine {
+        let material = MaterialCard::load(card).map_err(input)?;
+        let net = pool.install(|| drape(&tool, &settings)).map_err(input)?;
+        let refine_settings = RefineSettings { solver: SolverSettings::default().max_iterations(a.max_iterations), ..RefineSettings::default() };
+        let t = Instant::now();
+        let refined = pool.install(|| refine(&net, &tool, &material, &refine_settings)).map_err(input)?;
+        let total = t.elapsed().as_secs_f64();
+        let iterations: Vec<_> = refined.steps.iter().flat_map(|s| s.iterations.iter()).collect();
+        let qp: u32 = iterations.iter().map(|i| i.qp_iterations).sum();
+        println!(
+            "refinement (pressed, {}): {} placed nodes, {:?} after {} iterations ({} Clarabel iterations) in {:.2} s, {:.0} ms per iteration; |F-P|/|P| {:.1e}",
+            card.display(),
+            placed_nodes(&net),
+            refined.outcome(),
+            iterations.len(),
+            qp,
+            total,
+            total * 1e3 / iterations.len().max(1) as f64,
+            refined.steps.last().map_or(0.0, |s| s.residual)
+        );
+    }
     if let Some(kb) = peak_memory_kb() {
         println!("peak memory (VmHWM): {:.0} MB", kb as f64 / 1024.0);
     }
     Ok(())
+}
+
+fn placed_nodes(net: &crate::kinematic::DrapeNet) -> usize {
+    net.status.iter().filter(|s| **s == crate::kinematic::NodeStatus::Placed).count()
 }
 
 /// Peak resident memory of this process (Linux), in kB.
