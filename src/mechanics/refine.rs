@@ -26,8 +26,9 @@ impl<'a> NetObjective<'a> {
     pub fn new<L: Laws + ?Sized>(grid: Grid, laws: &'a L, gravity: Vector) -> Self {
         let areas = grid.nodal_areas();
         let loads = areas.iter().map(|a| gravity * (a * laws.areal_mass())).collect();
-        let pairs = coupled_pairs(grid.nu, grid.nv);
-        NetObjective { model: Model::new(grid, laws, Vector::zeros()), loads, pairs }
+        let model = Model::new(grid, laws, Vector::zeros());
+        let pairs = model.pattern().coupled_pairs();
+        NetObjective { model, loads, pairs }
     }
 
     /// Scale the loads (load stepping).
@@ -65,26 +66,6 @@ impl Objective for NetObjective<'_> {
     fn coupled_pairs(&self) -> Vec<(usize, usize)> {
         self.pairs.clone()
     }
-}
-
-/// Node pairs (a <= b) of a grid that the energy couples: cell neighbours and nodes two apart
-/// along a fibre (bending).
-pub fn coupled_pairs(nu: usize, nv: usize) -> Vec<(usize, usize)> {
-    let offsets: [(i64, i64); 7] = [(0, 0), (0, 1), (1, -1), (1, 0), (1, 1), (0, 2), (2, 0)];
-    let mut pairs = Vec::new();
-    for i in 0..nu as i64 {
-        for j in 0..nv as i64 {
-            for (di, dj) in offsets {
-                let (a, b) = (i + di, j + dj);
-                if a >= 0 && b >= 0 && a < nu as i64 && b < nv as i64 {
-                    let p = (i * nv as i64 + j) as usize;
-                    let q = (a * nv as i64 + b) as usize;
-                    pairs.push((p.min(q), p.max(q)));
-                }
-            }
-        }
-    }
-    pairs
 }
 
 /// How to refine.

@@ -310,3 +310,9 @@ impl SymmetricMatrix {
         clarabel::algebra::CscMatrix::new(n, n, self.colptr().to_vec(), self.rowval().to_vec(), self.values.clone())
     }
 }
+
+impl crate::mechanics::solver::HessianBlocks for SymmetricMatrix {
+    fn block(&self, a: usize, b: usize) -> Matrix3<f64> {
+        SymmetricMatrix::block(self, a, b)
+    }
+}

@@ -43,8 +43,4 @@ impl EnergyTerm for Gravity {
             }
         }
     }
-
-    fn is_load(&self) -> bool {
-        true
-    }
 }

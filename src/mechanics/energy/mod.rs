@@ -35,7 +35,6 @@ use std::sync::Arc;
 
 mod bending;
 mod gravity;
-mod objective;
 mod shear;
 mod stretch;
 
@@ -271,10 +270,6 @@ pub trait EnergyTerm: Sync {
     /// skipped ([`Sink::element_rows`]). `x` has one position per node (inactive nodes'
     /// positions are ignored).
     fn add(&self, grid: &Grid, x: &[Point], base: Range<usize>, sink: &mut Sink<'_>);
-    /// Is this the potential of an external load (its negative gradient is the load P)?
-    fn is_load(&self) -> bool {
-        false
-    }
 }
 
 /// Energy, gradient and (optionally) Hessian at one configuration.
@@ -365,7 +360,7 @@ impl<'a> Model<'a> {
             (Some(_), _) => out.hessian = Some(SymmetricMatrix::zeros(self.pattern.clone())),
         }
         let values: Option<&mut [f64]> = out.hessian.as_mut().map(|h| &mut h.values[..]);
-        let per_term = self.run(&|_| true, x, Some(&mut out.gradient), values, want);
+        let per_term = self.run(x, Some(&mut out.gradient), values, want);
         out.terms = self.terms.iter().zip(&per_term).map(|(t, e)| (t.name(), *e)).collect();
         out.energy = per_term.iter().sum();
     }
@@ -373,13 +368,12 @@ impl<'a> Model<'a> {
     /// The total energy only (for line searches).
     pub fn energy(&self, x: &[Point]) -> f64 {
         assert_eq!(x.len(), self.grid.num_nodes(), "one position per node");
-        self.run(&|_| true, x, None, None, None).iter().sum()
+        self.run(x, None, None, None).iter().sum()
     }
 
-    /// Runs the selected terms over every strip; returns the energy per term (0 for the others).
-    pub(crate) fn run(
+    /// Runs every term over every strip; returns the energy per term.
+    fn run(
         &self,
-        select: &(dyn Fn(&dyn EnergyTerm) -> bool + Sync),
         x: &[Point],
         grad: Option<&mut [Vector]>,
         values: Option<&mut [f64]>,
@@ -440,11 +434,9 @@ impl<'a> Model<'a> {
                         }
                     }
                     for (t, et) in self.terms.iter().zip(e.iter_mut()) {
-                        if select(t.as_ref()) {
-                            sink.energy = 0.0;
-                            t.add(grid, x, g0..g1, &mut sink);
-                            *et += sink.energy;
-                        }
+                        sink.energy = 0.0;
+                        t.add(grid, x, g0..g1, &mut sink);
+                        *et += sink.energy;
                     }
                     g0 = g1;
                 }
