@@ -3,7 +3,8 @@ use super::summary::summary;
 use super::{compute, input, parse_pair, parse_vec3, Failure};
 use crate::export::{write_net, Format};
 use crate::geometry::{Point, ToolSurface, Vector};
-use crate::kinematic::{drape, DrapeError, Extent, KinematicSettings};
+use crate::kinematic::fishnet::check_settings;
+use crate::kinematic::{drape, Extent, KinematicSettings};
 use crate::layup::{parse_generators, read_points, scene::DEFAULT_LOCKING_ANGLE_DEG, unit_scale};
 use clap::Args;
 use std::path::PathBuf;
@@ -83,7 +84,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
         max_shear: a.max_shear.to_radians(),
     };
     // Cheap argument checks come before the (possibly slow) tool load.
-    precheck(&settings).map_err(input)?;
+    check_settings(&settings).map_err(input)?;
     let t_load = Instant::now();
     let tool = ToolSurface::from_obj_scaled(&a.tool, scale).map_err(input)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
@@ -97,28 +98,6 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     println!("{}", summary(&net, a.locking_angle.to_radians(), load_ms, write_ms));
     for p in written {
         println!("  wrote {}", p.display());
-    }
-    Ok(())
-}
-
-/// Checks that need no tool: spacing, grid size, memory, angles.
-pub(crate) fn precheck(s: &KinematicSettings) -> Result<(), DrapeError> {
-    if !(s.spacing.is_finite() && s.spacing > 0.0) {
-        return Err(DrapeError::Spacing(s.spacing));
-    }
-    if let Extent::Grid { nu, nv, origin_node } = s.extent {
-        if nu < 2 || nv < 2 {
-            return Err(DrapeError::GridTooSmall(nu, nv));
-        }
-        if let Some((i, j)) = origin_node {
-            if i >= nu || j >= nv {
-                return Err(DrapeError::OriginNode(i, j, nu, nv));
-            }
-        }
-        crate::kinematic::fishnet::check_memory(nu, nv)?;
-    }
-    if s.warp.norm() == 0.0 {
-        return Err(DrapeError::WarpNormal([s.warp.x, s.warp.y, s.warp.z]));
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! `drape run SCENE --out DIR`: every ply of a scene.
-use super::kinematic::{precheck, print_tool_report};
+use super::kinematic::print_tool_report;
+use crate::kinematic::fishnet::check_settings;
 use super::summary::summary;
 use super::{compute, input, Failure};
 use crate::export::{write_net, Format};
@@ -29,7 +30,7 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
     let scene = Scene::load(&a.scene).map_err(input)?;
     for ply in &scene.plies {
-        precheck(&ply.settings)
+        check_settings(&ply.settings)
             .map_err(|e| input(anyhow::anyhow!("scene {}: ply '{}' (line {}): {e}", a.scene.display(), ply.settings.name, ply.line)))?;
     }
     let t_load = Instant::now();

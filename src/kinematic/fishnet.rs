@@ -220,16 +220,8 @@ struct QuadrantNodes {
 /// Drape one ply on the tool with the kinematic (fishnet) method.
 pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNet, DrapeError> {
     let start = Instant::now();
+    check_settings(settings)?;
     let d = settings.spacing;
-    if !(d.is_finite() && d > 0.0) {
-        return Err(DrapeError::Spacing(d));
-    }
-    if !(settings.pre_shear.abs() < std::f64::consts::FRAC_PI_2) {
-        return Err(DrapeError::PreShear(settings.pre_shear.to_degrees()));
-    }
-    if !(settings.max_shear > 0.0 && settings.max_shear < std::f64::consts::FRAC_PI_2) {
-        return Err(DrapeError::MaxShear(settings.max_shear.to_degrees()));
-    }
     let seed = tool.closest_point(&settings.origin);
     if !(seed.distance <= d) {
         let o = settings.origin;
@@ -240,24 +232,16 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
         Extent::Grid { .. } => None,
     };
     let (nu, nv, (i0, j0)) = match (&settings.extent, &outline) {
-        (Extent::Grid { nu, nv, origin_node }, _) => {
-            let (nu, nv) = (*nu, *nv);
-            if nu < 2 || nv < 2 {
-                return Err(DrapeError::GridTooSmall(nu, nv));
-            }
-            let on = origin_node.unwrap_or((nu / 2, nv / 2));
-            if on.0 >= nu || on.1 >= nv {
-                return Err(DrapeError::OriginNode(on.0, on.1, nu, nv));
-            }
-            (nu, nv, on)
-        }
+        (Extent::Grid { nu, nv, origin_node }, _) => (*nu, *nv, origin_node.unwrap_or((nu / 2, nv / 2))),
         (_, Some(o)) => {
             let half = o.half_size(&seed.point, d);
             (2 * half + 1, 2 * half + 1, (half, half))
         }
         _ => unreachable!("an outline extent always builds an outline"),
     };
-    check_memory(nu, nv)?;
+    if outline.is_some() {
+        check_memory(nu, nv)?; // a grid was checked with the other settings
+    }
 
     let t_gen = Instant::now();
     let generators = lay_generators(tool, settings, &seed, (nu, nv), (i0, j0))?;
@@ -309,6 +293,35 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
     net.meta.insert("generators".into(), serde_json::json!(generators.kind));
     net.meta.insert("max_shear_deg".into(), serde_json::json!(settings.max_shear.to_degrees()));
     Ok(net)
+}
+
+/// Checks of the settings that need no tool (spacing, angles, warp, grid size and memory), so a
+/// caller can refuse bad input before loading a tool; [`drape`] runs them too.
+pub fn check_settings(s: &KinematicSettings) -> Result<(), DrapeError> {
+    if !(s.spacing.is_finite() && s.spacing > 0.0) {
+        return Err(DrapeError::Spacing(s.spacing));
+    }
+    if !(s.pre_shear.abs() < std::f64::consts::FRAC_PI_2) {
+        return Err(DrapeError::PreShear(s.pre_shear.to_degrees()));
+    }
+    if !(s.max_shear > 0.0 && s.max_shear < std::f64::consts::FRAC_PI_2) {
+        return Err(DrapeError::MaxShear(s.max_shear.to_degrees()));
+    }
+    if s.warp.norm() == 0.0 {
+        return Err(DrapeError::WarpNormal([s.warp.x, s.warp.y, s.warp.z]));
+    }
+    if let Extent::Grid { nu, nv, origin_node } = s.extent {
+        if nu < 2 || nv < 2 {
+            return Err(DrapeError::GridTooSmall(nu, nv));
+        }
+        if let Some((i, j)) = origin_node {
+            if i >= nu || j >= nv {
+                return Err(DrapeError::OriginNode(i, j, nu, nv));
+            }
+        }
+        check_memory(nu, nv)?;
+    }
+    Ok(())
 }
 
 fn ms(t: Instant) -> f64 {
