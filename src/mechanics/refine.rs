@@ -36,6 +36,11 @@ impl<'a> NetObjective<'a> {
         self.loads.iter_mut().for_each(|l| *l *= factor);
     }
 
+    /// Work of the current loads on the displacement to `x`: sum of P . x.
+    pub fn work(&self, x: &[Point]) -> f64 {
+        self.loads.iter().zip(x).map(|(l, p)| l.dot(&p.coords)).sum()
+    }
+
     /// The grid.
     pub fn grid(&self) -> &Grid {
         &self.model.grid
@@ -55,7 +60,7 @@ impl<'a> NetObjective<'a> {
 impl Objective for NetObjective<'_> {
     fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation {
         let ev = self.model.evaluate(x, hessian.then_some(HESSIAN));
-        let work: f64 = self.loads.iter().zip(x).map(|(l, p)| l.dot(&p.coords)).sum();
+        let work = self.work(x);
         Evaluation {
             energy: ev.energy - work,
             internal: ev.gradient,
@@ -166,10 +171,8 @@ pub fn refine<L: Laws + ?Sized>(
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
     // Energy of the kinematic state under the full load, for comparison with the result.
-    let energy_kinematic = {
-        let full = NetObjective::new(Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone()), laws, settings.gravity);
-        full.evaluate(&x, false).energy
-    };
+    // The first step carries 1/S of the load, so the full load does (S - 1) times more work.
+    let energy_kinematic = objective.evaluate(&x, false).energy - (settings.load_steps - 1) as f64 * objective.work(&x);
     for step in 1..=settings.load_steps {
         if step > 1 {
             objective.scale_loads(step as f64 / (step - 1) as f64);
