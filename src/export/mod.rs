@@ -5,7 +5,10 @@ mod atomic;
 mod check;
 pub mod csv;
 mod error;
+pub mod flow;
+pub mod flowmesh;
 pub mod json;
+pub mod map;
 pub mod vtu;
 
 pub use atomic::write_atomic;
