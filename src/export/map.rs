@@ -148,23 +148,47 @@ pub enum MapError {
     Settings { ply: String, message: String },
 }
 
-/// Where a flow element's centroid lands on the net: the cell and the bilinear parameters in it.
-struct NetHit {
-    cell: (usize, usize),
-    s: f64,
-    t: f64,
+/// Where a point lands on a net: the cell, the bilinear parameters in it, the closest point and
+/// the fibre tangents there.
+#[derive(Debug, Clone, Copy)]
+pub struct NetSample {
+    /// Cell (i, j) of the net.
+    pub cell: (usize, usize),
+    /// Bilinear parameters in the cell, along the warp (`s`) and the weft (`t`), in [0, 1].
+    pub s: f64,
+    pub t: f64,
+    /// The closest point of the net.
+    pub point: Point,
+    /// Warp and weft tangents of the bilinear cell patch there (not normalised).
+    pub warp: Vector,
+    pub weft: Vector,
+    /// Unit normal warp x weft.
+    pub normal: Vector,
+    /// Signed distance from the net to the query point along `normal`.
+    pub normal_distance: f64,
+    /// Distance from the net to the query point in the net's tangent plane: 0 inside the net,
+    /// positive when the point lies beyond the net's edge.
+    pub beyond_edge: f64,
 }
 
-/// The net as a triangle mesh (two triangles per complete cell) for closest-point queries.
-struct NetSurface<'a> {
+impl NetSample {
+    /// Shear of the patch here, radians.
+    pub fn shear(&self) -> f64 {
+        crate::kinematic::net::corner_shear(&self.warp, &self.weft)
+    }
+}
+
+/// A net as a triangle mesh (two triangles per complete cell) for closest-point queries.
+pub struct NetSampler<'a> {
     net: &'a DrapeNet,
     mesh: TriMesh,
     /// Cell (i, j) and half (0: corners 00-10-11, 1: corners 00-11-01) of each triangle.
     cells: Vec<(usize, usize, u8)>,
 }
 
-impl<'a> NetSurface<'a> {
-    fn new(net: &'a DrapeNet) -> Option<Self> {
+impl<'a> NetSampler<'a> {
+    /// `None` when the net has no complete cell.
+    pub fn new(net: &'a DrapeNet) -> Option<Self> {
         let mut vertices = Vec::new();
         let mut vertex_of = vec![u32::MAX; net.positions.len()];
         let mut id = |k: usize, vertices: &mut Vec<Point>| {
@@ -193,11 +217,11 @@ impl<'a> NetSurface<'a> {
             return None;
         }
         let mesh = TriMesh::new(vertices, triangles).ok()?;
-        Some(NetSurface { net, mesh, cells })
+        Some(NetSampler { net, mesh, cells })
     }
 
-    /// Closest point of the net to `p`: the hit and the offset vector from the net to `p`.
-    fn locate(&self, p: &Point) -> (NetHit, Point) {
+    /// The net at its closest point to `p`.
+    pub fn sample(&self, p: &Point) -> NetSample {
         let (_, (tri, _)) = self.mesh.project_local_point_and_get_location(p, false);
         let (i, j, half) = self.cells[tri as usize];
         let net = self.net;
@@ -206,20 +230,22 @@ impl<'a> NetSurface<'a> {
         let (a, b, c) = if half == 0 { (p00, p10, p11) } else { (p00, p11, p01) };
         let x = closest_point_on_triangle(p, &a, &b, &c);
         let l = barycentric(&x, &a, &b, &c);
-        // Bilinear parameters (s along the warp, t along the weft) of the point in its cell.
         let (s, t) = if half == 0 { (l[1] + l[2], l[2]) } else { (l[1], l[1] + l[2]) };
-        (NetHit { cell: (i, j), s: s.clamp(0.0, 1.0), t: t.clamp(0.0, 1.0) }, x)
+        let (s, t) = (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
+        let warp = (p10 - p00) * (1.0 - t) + (p11 - p01) * t;
+        let weft = (p01 - p00) * (1.0 - s) + (p11 - p10) * s;
+        let normal = warp.cross(&weft).normalize();
+        let offset = p - x;
+        let normal_distance = offset.dot(&normal);
+        let beyond_edge = (offset - normal * normal_distance).norm();
+        NetSample { cell: (i, j), s, t, point: x, warp, weft, normal, normal_distance, beyond_edge }
     }
 
-    /// Warp and weft tangents of the bilinear cell patch at the hit (not normalised).
-    fn fibres(&self, h: &NetHit) -> (Vector, Vector) {
-        let net = self.net;
-        let (i, j) = h.cell;
-        let q = |a: usize, b: usize| net.positions[net.index(a, b)];
-        let (p00, p10, p11, p01) = (q(i, j), q(i + 1, j), q(i + 1, j + 1), q(i, j + 1));
-        let warp = (p10 - p00) * (1.0 - h.t) + (p11 - p01) * h.t;
-        let weft = (p01 - p00) * (1.0 - h.s) + (p11 - p10) * h.s;
-        (warp, weft)
+    /// The net under `p`, or `None` when `p` lies beyond the net's edge or further than
+    /// `max_distance` from it along the normal.
+    pub fn cover(&self, p: &Point, max_distance: f64) -> Option<NetSample> {
+        let h = self.sample(p);
+        (h.beyond_edge <= EDGE_TOLERANCE_REL * self.net.spacing && h.normal_distance.abs() <= max_distance).then_some(h)
     }
 }
 
@@ -260,24 +286,17 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
     if !(settings.vf > 0.0 && settings.vf < VF_MAX_HEX) {
         return Err(settings_error(format!("fibre volume fraction must lie in (0, {VF_MAX_HEX:.3}), got {}", settings.vf)));
     }
-    let surface = NetSurface::new(net).ok_or_else(|| MapError::EmptyNet { ply: net.name.clone() })?;
-    let edge_tolerance = EDGE_TOLERANCE_REL * net.spacing;
+    let sampler = NetSampler::new(net).ok_or_else(|| MapError::EmptyNet { ply: net.name.clone() })?;
     let elements: Result<Vec<Option<ElementFibres>>, MapError> = (0..mesh.elements.len())
         .into_par_iter()
         .map(|e| {
             let normal = mesh
                 .normal(e)
                 .ok_or_else(|| MapError::DegenerateElement { path: mesh.path.clone(), id: mesh.elements[e].id })?;
-            let centroid = mesh.centroid(e);
-            let (hit, x) = surface.locate(&centroid);
-            let (w3, f3) = surface.fibres(&hit);
-            let cell_normal = w3.cross(&f3).normalize();
-            let offset = centroid - x;
-            let along_normal = offset.dot(&cell_normal);
-            let tangential = (offset - cell_normal * along_normal).norm();
-            if tangential > edge_tolerance || along_normal.abs() > settings.max_distance {
+            let Some(hit) = sampler.cover(&mesh.centroid(e), settings.max_distance) else {
                 return Ok(None);
-            }
+            };
+            let (w3, f3, cell_normal) = (hit.warp, hit.weft, hit.normal);
             // The element normal follows the element's own winding; turn it to the ply's side so
             // angles are measured the same way on every element.
             let normal = if normal.dot(&cell_normal) < 0.0 { -normal } else { normal };

@@ -123,6 +123,17 @@ pub struct MaterialCard {
     pub shear: ShearLaw,
     /// Flexural rigidities per unit width, N m.
     pub bending: Bending,
+    /// What resin-flow exports need (optional `[flow]` section).
+    pub flow: Option<FlowProperties>,
+}
+
+/// The optional `[flow]` section: what resin-flow exports need of the fabric.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlowProperties {
+    /// Fibre volume fraction of the ply as laid flat at its `thickness`.
+    pub fibre_volume_fraction: f64,
+    /// Fibre (filament) radius, m, for the permeability model.
+    pub fibre_radius: f64,
 }
 
 /// The `[tension]` section.
@@ -518,6 +529,9 @@ impl MaterialCard {
         lines.note("bending", raw.bending.span());
         lines.note("bending.warp", raw.bending.get_ref().warp.span());
         lines.note("bending.weft", raw.bending.get_ref().weft.span());
+        if let Some(f) = &raw.flow {
+            lines.note("flow", f.span());
+        }
         let at = |lines: &Lines, field: &str, m: String| {
             let section = field.split('.').next().unwrap_or(field);
             match lines.map.get(field).or_else(|| lines.map.get(section)) {
@@ -681,6 +695,10 @@ impl MaterialCard {
                 warp: b.warp.into_inner(),
                 weft: b.weft.into_inner(),
             },
+            flow: raw.flow.map(|f| {
+                let f = f.into_inner();
+                FlowProperties { fibre_volume_fraction: f.fibre_volume_fraction, fibre_radius: f.fibre_radius }
+            }),
         };
         card.check().map_err(|(f, m)| at(&lines, &f, m))?;
         Ok(card)
@@ -706,6 +724,16 @@ impl MaterialCard {
         }
         positive("areal_mass", self.areal_mass, "kg/m^2")?;
         positive("thickness", self.thickness, "m")?;
+        if let Some(f) = &self.flow {
+            let vf = f.fibre_volume_fraction;
+            if !(vf > 0.0 && vf < crate::export::map::VF_MAX_HEX) {
+                return Err((
+                    "flow.fibre_volume_fraction".into(),
+                    format!("must lie between 0 and {:.4} (fibres touching), got {vf}", crate::export::map::VF_MAX_HEX),
+                ));
+            }
+            positive("flow.fibre_radius", f.fibre_radius, "m")?;
+        }
         let cf = self.tension.compression_factor;
         if !(cf.is_finite() && (0.0..=1.0).contains(&cf)) {
             return Err((
@@ -838,6 +866,11 @@ impl MaterialCard {
         }
         s.push_str("\n[bending] # flexural rigidity per unit width, N m\n");
         let _ = writeln!(s, "warp = {}\nweft = {}", f(self.bending.warp), f(self.bending.weft));
+        if let Some(flow) = &self.flow {
+            s.push_str("\n[flow]\n");
+            let _ = writeln!(s, "fibre_volume_fraction = {}", f(flow.fibre_volume_fraction));
+            let _ = writeln!(s, "fibre_radius = {} # m", f(flow.fibre_radius));
+        }
         s
     }
 }
@@ -867,6 +900,14 @@ struct RawCard {
     tension: Spanned<RawTension>,
     shear: Spanned<RawShear>,
     bending: Spanned<RawBending>,
+    flow: Option<Spanned<RawFlow>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFlow {
+    fibre_volume_fraction: f64,
+    fibre_radius: f64,
 }
 
 #[derive(Deserialize)]
