@@ -2,6 +2,7 @@
 mod bench;
 mod calibrate;
 mod kinematic;
+mod progress;
 mod refine;
 mod scene;
 mod summary;

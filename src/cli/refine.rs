@@ -4,10 +4,9 @@ use super::summary::summary;
 use super::{compute, input, parse_vec3, Failure};
 use crate::export::{read_net, write_net, Format};
 use crate::geometry::{ToolSurface, Vector};
-use crate::kinematic::DrapeNet;
 use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
-use crate::mechanics::refine::{cell_changes, refine, RefineSettings, Refined};
+use crate::mechanics::refine::{annotate, refine, RefineSettings, Refined};
 use crate::mechanics::{ContactMode, SolverSettings};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -98,27 +97,6 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         )));
     }
     Ok(())
-}
-
-/// Record the solver's work and the per-cell change from the kinematic net in the net's meta.
-pub(crate) fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, material: &std::path::Path) {
-    let changes = cell_changes(kinematic, &refined.net);
-    let shear: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(g, _)| g.to_degrees())).collect();
-    let angle: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(_, a)| a.to_degrees())).collect();
-    out.meta.insert(
-        "change_from_kinematic".into(),
-        serde_json::json!({"shear_deg": shear, "warp_angle_deg": angle}),
-    );
-    out.meta.insert("material".into(), serde_json::json!(material.display().to_string()));
-    out.meta.insert(
-        "solver".into(),
-        serde_json::json!({
-            "outcome": refined.outcome(),
-            "energy_kinematic": refined.energy_kinematic,
-            "energy_final": refined.energy_final,
-            "load_steps": refined.steps,
-        }),
-    );
 }
 
 pub(crate) fn print_solver(r: &Refined) {

@@ -1,16 +1,16 @@
-//! `drape run SCENE --out DIR`: every ply of a scene.
+//! `drape run SCENE --out DIR`: drape every ply of a layup, write the nets, the layup table and
+//! (from the scene's `[export]`) the fibre data on the resin-flow mesh.
 use super::kinematic::print_tool_report;
-use crate::kinematic::fishnet::check_settings;
+use super::refine::print_solver;
 use super::summary::summary;
 use super::{compute, input, Failure};
-use crate::export::{write_net, Format};
+use crate::export::{write_atomic, write_net, Format};
 use crate::geometry::ToolSurface;
-use crate::kinematic::drape;
+use crate::kinematic::fishnet::check_settings;
+use crate::layup::stack::{drape_layup, PlyResult};
 use crate::layup::Scene;
-use crate::mechanics::refine::{refine, RefineSettings};
-use super::refine::{annotate, print_solver};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Arguments of `drape run`.
@@ -38,43 +38,44 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&scene.tool, &tool);
     // Drape every ply first, so a bad ply is reported before any file is written.
-    let mut nets = Vec::new();
+    let bar = super::progress::bar(scene.plies.len() as u64, "draping");
+    let mut results = drape_layup(&scene, &tool, |k, name| {
+        bar.set_position(k as u64);
+        bar.set_message(name.to_string());
+    })
+    .map_err(|e| input(anyhow::anyhow!("scene {}: {e}", a.scene.display())))?;
+    bar.finish_and_clear();
     let mut unconverged = Vec::new();
-    for ply in &scene.plies {
-        let mut net = drape(&tool, &ply.settings).map_err(|e| {
-            input(anyhow::anyhow!("scene {}: ply '{}' (line {}): {e}", a.scene.display(), ply.settings.name, ply.line))
-        })?;
-        net.timing.load_ms = load_ms;
-        net.meta.insert("tool".into(), serde_json::json!(scene.tool.display().to_string()));
-        net.meta.insert("scene".into(), serde_json::json!(a.scene.display().to_string()));
-        if let Some(r) = &ply.refinement {
-            let settings = RefineSettings { mode: r.mode, ..RefineSettings::default() };
-            let t = Instant::now();
-            let refined = refine(&net, &tool, &r.material, &settings).map_err(input)?;
-            let mut out = refined.net.clone();
-            annotate(&mut out, &net, &refined, &r.material_path);
-            out.timing.load_ms = load_ms;
-            out.timing.generators_ms = 0.0;
-            out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
+    for (ply, r) in scene.plies.iter().zip(results.iter_mut()) {
+        r.net.timing.load_ms = load_ms;
+        r.net.meta.insert("tool".into(), serde_json::json!(scene.tool.display().to_string()));
+        r.net.meta.insert("scene".into(), serde_json::json!(a.scene.display().to_string()));
+        if let Some(refined) = &r.refined {
             if !refined.ok() {
                 unconverged.push(format!("ply '{}' ({:?})", ply.settings.name, refined.outcome()));
             }
-            nets.push((out, ply.locking_angle, Some(refined)));
-        } else {
-            nets.push((net, ply.locking_angle, None));
         }
     }
-    for (net, locking, refined) in &nets {
+    for (ply, r) in scene.plies.iter().zip(&results) {
         let t_write = Instant::now();
-        let written = write_net(net, &a.out, &formats).map_err(compute)?;
-        println!("{}", summary(net, *locking, load_ms, t_write.elapsed().as_secs_f64() * 1e3));
-        if let Some(r) = refined {
-            print_solver(r);
+        let written = write_net(&r.net, &a.out, &formats).map_err(compute)?;
+        println!("{}", summary(&r.net, ply.locking_angle, load_ms, t_write.elapsed().as_secs_f64() * 1e3));
+        if let Some(refined) = &r.refined {
+            print_solver(refined);
         }
         for p in written {
             println!("  wrote {}", p.display());
         }
     }
+    println!("{}", layup_table(&scene, &results));
+    let table = a.out.join("layup.json");
+    let json = layup_json(&scene, &results);
+    write_atomic(&table, |w| {
+        serde_json::to_writer_pretty(&mut *w, &json)?;
+        std::io::Write::write_all(w, b"\n")
+    })
+    .map_err(compute)?;
+    println!("wrote {}", table.display());
     if !unconverged.is_empty() {
         return Err(compute(anyhow::anyhow!(
             "the mechanical solver stopped without equilibrium for {}; the last accepted states were written",
@@ -82,4 +83,85 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
         )));
     }
     Ok(())
+}
+
+/// The layup table: one row per ply in stacking order.
+fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
+    let mut out = format!(
+        "layup: {} plies on {}\n{:<12} {:>7} {:<10} {:<20} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
+        scene.plies.len(),
+        scene.tool.display(),
+        "ply",
+        "angle",
+        "method",
+        "material",
+        "max|g|",
+        "mean|g|",
+        "over lock",
+        "coverage",
+        "fabric",
+        "mass",
+        "offset"
+    );
+    out += &format!(
+        "{:<12} {:>7} {:<10} {:<20} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
+        "", "deg", "", "", "deg", "deg", "m^2", "%", "m^2", "kg", "mm"
+    );
+    for (ply, r) in scene.plies.iter().zip(results) {
+        let s = &r.stats;
+        out += &format!(
+            "{:<12} {:>7} {:<10} {:<20} {:>9.2} {:>9.2} {:>12.3e} {:>8.1} {:>11.4} {:>9} {:>10.3}\n",
+            ply.settings.name,
+            ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
+            if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
+            ply.material.as_ref().map_or("-", |m| m.name.as_str()),
+            s.max_abs_shear.to_degrees(),
+            s.mean_abs_shear.to_degrees(),
+            s.area_over_locking,
+            100.0 * s.coverage,
+            s.fabric_area,
+            s.fabric_mass.map_or("-".to_string(), |m| format!("{m:.4}")),
+            r.offset.max_distance * 1e3,
+        );
+    }
+    out.trim_end().to_string()
+}
+
+/// `layup.json`: the layup table for reports and other tools.
+fn layup_json(scene: &Scene, results: &[PlyResult]) -> serde_json::Value {
+    let path = |p: &Path| p.display().to_string();
+    let plies: Vec<serde_json::Value> = scene
+        .plies
+        .iter()
+        .zip(results)
+        .map(|(ply, r)| {
+            let s = &r.stats;
+            serde_json::json!({
+                "name": ply.settings.name,
+                "material": ply.material.as_ref().map(|m| m.name.clone()),
+                "material_card": ply.material.as_ref().map(|m| path(&m.path)),
+                "angle_deg": ply.angle_deg(),
+                "warp": [r.warp.x, r.warp.y, r.warp.z],
+                "method": if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
+                "thickness_m": ply.thickness,
+                "locking_angle_deg": ply.locking_angle.to_degrees(),
+                "max_abs_shear_deg": s.max_abs_shear.to_degrees(),
+                "mean_abs_shear_deg": s.mean_abs_shear.to_degrees(),
+                "area_over_locking_m2": s.area_over_locking,
+                "coverage": s.coverage,
+                "cells": s.cells,
+                "draped_area_m2": s.draped_area,
+                "fabric_area_m2": s.fabric_area,
+                "fabric_mass_kg": s.fabric_mass,
+                "offset_m": r.offset.max_distance,
+                "offset_folded_triangles": r.offset.folded,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "scene": path(&scene.path),
+        "tool": path(&scene.tool),
+        "plies": plies,
+        "nesting": serde_json::Value::Null,
+    })
 }

@@ -3,6 +3,7 @@
 pub mod check;
 pub mod geodesic;
 pub mod obj;
+pub mod offset;
 pub mod shapes;
 pub mod surface;
 

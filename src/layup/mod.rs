@@ -1,5 +1,6 @@
 //! Scenes: the tool and the plies to drape on it, read from TOML.
 pub mod scene;
+pub mod stack;
 
 pub use scene::{Ply, Scene, SceneError};
 

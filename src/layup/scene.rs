@@ -1,12 +1,29 @@
-//! The scene file: a tool OBJ and the plies to drape on it.
+//! The scene file: a tool OBJ and the layup to drape on it, plies in stacking order (the first
+//! lies on the tool, each next one on the plies below it).
 //!
 //! ```toml
 //! units = "m"                 # "m" (default) or "mm": lengths here and in the OBJ
 //! tool = "hemisphere-20k.obj" # relative to this file
+//! reference = [1.0, 0.0, 0.0] # optional: the 0 deg direction of ply angles (default +x)
+//! stack_side = "normal"       # optional: plies stack on the side the tool normals point to
+//!                             # ("normal", default) or the other ("opposite")
+//! roll_width = 1.27           # optional: fabric roll width, for nesting the flat patterns
+//! nesting_gap = 0.01          # optional: gap between nested pieces (default 10 mm)
+//! [materials]                 # optional: names for material cards, relative to this file
+//! glass = "../../materials/glass-plain-weave.toml"
+//! [export]                    # optional: map every ply onto a resin-flow mesh
+//! mesh = "part.bdf"           # Nastran, Abaqus .inp, OBJ or Gmsh 4 .msh, in the scene's units
+//! formats = ["vtu", "csv"]    # vtu, nastran, abaqus, optistruct, rtmsim, csv
+//! cavity = "fixed"            # "fixed" (Vf = Vf0 / cos g) or "free" (t = t0 / cos g)
+//! permeability = true         # permeability tensors (needs [flow] in the material cards)
 //! [[ply]]
 //! name = "p0"
 //! origin = [0.0, 0.0, 0.1]
-//! warp = [1.0, 0.0, 0.0]
+//! angle_deg = 0.0             # warp = reference turned by this about the tool normal at the
+//!                             # seed (counter-clockwise seen from the normal side);
+//! # warp = [1.0, 0.0, 0.0]    # or the warp direction itself (not both)
+//! material = "glass"          # a name from [materials] or a card file; gives the thickness
+//! # thickness = 5.0e-4        # optional: overrides the card's thickness (scene units)
 //! spacing = 0.004
 //! grid = [61, 61]             # or outline = [[x,y,z], ...] or outline_file = "outline.csv"
 //! origin_node = [30, 30]      # optional (default: the centre)
@@ -14,8 +31,8 @@
 //! generators = "geodesic"     # or "min-shear" or "steer:curve.csv"
 //! locking_angle_deg = 45.0    # optional, for reporting
 //! max_shear_deg = 75.0        # optional: nodes shearing past this are not placed
-//! method = "kinematic"       # or "mechanical": kinematic, then refinement with
-//! # material = "../../materials/glass-plain-weave.toml"   # card, relative to this file
+//! method = "kinematic"       # or "mechanical": kinematic, then refinement with the
+//!                             # ply's material card
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
 //! ```
 use super::{parse_generators, read_points, unit_scale};
@@ -23,7 +40,10 @@ use crate::geometry::{Point, Vector};
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
 use crate::material::MaterialCard;
 use crate::mechanics::ContactMode;
+use crate::export::flow::FlowFormat;
+use crate::export::map::Cavity;
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Locking angle used for reporting when a ply gives none (degrees; woven glass and carbon
@@ -45,12 +65,37 @@ struct SceneFile {
     #[serde(default = "default_units")]
     units: String,
     tool: String,
+    reference: Option<[f64; 3]>,
+    stack_side: Option<String>,
+    roll_width: Option<f64>,
+    nesting_gap: Option<f64>,
+    #[serde(default)]
+    materials: BTreeMap<String, String>,
+    export: Option<toml::Spanned<ExportFile>>,
     #[serde(default)]
     ply: Vec<toml::Spanned<PlyFile>>,
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExportFile {
+    mesh: String,
+    #[serde(default = "default_export_formats")]
+    formats: Vec<String>,
+    #[serde(default = "default_cavity")]
+    cavity: String,
+    #[serde(default)]
+    permeability: bool,
+}
+
 fn default_units() -> String {
     "m".into()
+}
+fn default_export_formats() -> Vec<String> {
+    vec!["vtu".into()]
+}
+fn default_cavity() -> String {
+    "fixed".into()
 }
 
 #[derive(Deserialize)]
@@ -58,7 +103,8 @@ fn default_units() -> String {
 struct PlyFile {
     name: String,
     origin: [f64; 3],
-    warp: [f64; 3],
+    warp: Option<[f64; 3]>,
+    angle_deg: Option<f64>,
     spacing: f64,
     grid: Option<[usize; 2]>,
     outline: Option<Vec<[f64; 3]>>,
@@ -73,6 +119,7 @@ struct PlyFile {
     #[serde(default = "default_method")]
     method: String,
     material: Option<String>,
+    thickness: Option<f64>,
     mode: Option<String>,
 }
 
@@ -83,16 +130,51 @@ fn default_method() -> String {
     "kinematic".into()
 }
 
+/// How a ply's warp direction is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Orientation {
+    /// The warp direction itself (projected onto the tool at the seed).
+    Warp(Vector),
+    /// The scene's reference direction turned by this angle (radians) about the tool normal at
+    /// the seed, counter-clockwise seen from the side the normal points to.
+    Angle(f64),
+}
+
+/// A material card and the name the scene gives it.
+#[derive(Debug, Clone)]
+pub struct PlyMaterial {
+    /// The name in `[materials]`, or the card's own name when the ply gives a file.
+    pub name: String,
+    pub card: MaterialCard,
+    pub path: PathBuf,
+}
+
 /// One ply of a scene, ready to drape (SI units).
 #[derive(Debug, Clone)]
 pub struct Ply {
+    /// Kinematic settings; `settings.warp` is only final once [`Ply::orientation`] has been
+    /// resolved on the (offset) tool by [`super::stack`].
     pub settings: KinematicSettings,
+    pub orientation: Orientation,
+    pub material: Option<PlyMaterial>,
+    /// Thickness as laid flat, metres: the ply's `thickness`, else its card's; `None` if neither.
+    pub thickness: Option<f64>,
     /// Mechanical refinement after the kinematic drape, if the ply asks for it.
     pub refinement: Option<Refinement>,
     /// Locking angle for reporting, radians.
     pub locking_angle: f64,
     /// Line of the scene file where the ply starts.
     pub line: usize,
+}
+
+impl Ply {
+    /// The ply angle in degrees for tables, `None` when the warp was given as a vector.
+    pub fn angle_deg(&self) -> Option<f64> {
+        match self.orientation {
+            Orientation::Angle(a) => Some(a.to_degrees()),
+            Orientation::Warp(_) => None,
+        }
+    }
 }
 
 /// A ply's mechanical refinement: the material card and the contact mode.
@@ -103,6 +185,27 @@ pub struct Refinement {
     pub mode: ContactMode,
 }
 
+/// Which side of the tool the plies stack on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StackSide {
+    /// The side the tool's facet normals point to.
+    Normal,
+    /// The other side.
+    Opposite,
+}
+
+/// The scene's `[export]` table: map every ply onto a resin-flow mesh.
+#[derive(Debug, Clone)]
+pub struct SceneExport {
+    pub mesh: PathBuf,
+    pub formats: Vec<FlowFormat>,
+    pub cavity: Cavity,
+    pub permeability: bool,
+}
+
+/// Gap between nested flat patterns when the scene gives none, metres.
+pub const DEFAULT_NESTING_GAP: f64 = 0.01;
+
 /// A scene: the tool and its plies in stacking order.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -110,6 +213,14 @@ pub struct Scene {
     /// Metres per unit of the scene and OBJ.
     pub scale: f64,
     pub tool: PathBuf,
+    /// The 0 deg direction of ply angles (unit).
+    pub reference: Vector,
+    pub stack_side: StackSide,
+    /// Fabric roll width for nesting, metres.
+    pub roll_width: Option<f64>,
+    /// Gap between nested pieces, metres.
+    pub nesting_gap: f64,
+    pub export: Option<SceneExport>,
     pub plies: Vec<Ply>,
 }
 
@@ -119,31 +230,95 @@ impl Scene {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
         let invalid = |message: String| SceneError::Invalid { path: path.into(), message };
         let file: SceneFile = toml::from_str(&text).map_err(|e| invalid(e.to_string().trim_end().to_string()))?;
+        let line_of = |offset: usize| 1 + text[..offset].matches('\n').count();
         let scale = unit_scale(&file.units).map_err(|m| invalid(format!("field `units`: {m}")))?;
         let base = path.parent().unwrap_or(Path::new("."));
         if file.ply.is_empty() {
-            return Err(invalid("no [[ply]] table: add at least one ply (name, origin, warp, spacing, grid)".into()));
+            return Err(invalid("no [[ply]] table: add at least one ply (name, origin, angle_deg or warp, spacing, grid)".into()));
         }
+        let v = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
+        let reference = match file.reference {
+            None => Vector::x(),
+            Some(r) if r.iter().all(|x| x.is_finite()) && v(r).norm() > 0.0 => v(r).normalize(),
+            Some(r) => return Err(invalid(format!("field `reference`: must be a non-zero vector of three finite numbers, got {r:?}"))),
+        };
+        let stack_side = match file.stack_side.as_deref().unwrap_or("normal") {
+            "normal" => StackSide::Normal,
+            "opposite" => StackSide::Opposite,
+            other => return Err(invalid(format!("field `stack_side`: unknown side '{other}': use \"normal\" or \"opposite\""))),
+        };
+        let positive_length = |field: &str, x: Option<f64>| -> Result<Option<f64>, SceneError> {
+            match x {
+                None => Ok(None),
+                Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x * scale)),
+                Some(x) => Err(invalid(format!("field `{field}`: must be a positive length, got {x}"))),
+            }
+        };
+        let roll_width = positive_length("roll_width", file.roll_width)?;
+        let nesting_gap = match file.nesting_gap {
+            None => DEFAULT_NESTING_GAP,
+            Some(g) if g.is_finite() && g >= 0.0 => g * scale,
+            Some(g) => return Err(invalid(format!("field `nesting_gap`: must be a length >= 0, got {g}"))),
+        };
+        let mut materials: BTreeMap<String, PlyMaterial> = BTreeMap::new();
+        for (name, file) in &file.materials {
+            let path = base.join(file);
+            let card = MaterialCard::load(&path).map_err(|e| invalid(format!("[materials] `{name}`: {e}")))?;
+            materials.insert(name.clone(), PlyMaterial { name: name.clone(), card, path });
+        }
+        let export = match &file.export {
+            None => None,
+            Some(spanned) => {
+                let e = spanned.get_ref();
+                let line = line_of(spanned.span().start);
+                let at = |field: &str, m: String| invalid(format!("[export] (line {line}), field `{field}`: {m}"));
+                let mut formats = Vec::new();
+                for f in &e.formats {
+                    let f: FlowFormat = f.parse().map_err(|m| at("formats", m))?;
+                    if !formats.contains(&f) {
+                        formats.push(f);
+                    }
+                }
+                if formats.is_empty() {
+                    return Err(at("formats", "is empty: name at least one format".into()));
+                }
+                let cavity = match e.cavity.as_str() {
+                    "fixed" => Cavity::Fixed,
+                    "free" => Cavity::Free,
+                    other => return Err(at("cavity", format!("unknown cavity '{other}': use \"fixed\" or \"free\""))),
+                };
+                Some(SceneExport { mesh: base.join(&e.mesh), formats, cavity, permeability: e.permeability })
+            }
+        };
         let mut plies = Vec::new();
         for spanned in &file.ply {
-            let line = 1 + text[..spanned.span().start].matches('\n').count();
+            let line = line_of(spanned.span().start);
             let p = spanned.get_ref();
             let at = |field: &str, m: String| invalid(format!("ply '{}' (line {line}), field `{field}`: {m}", p.name));
             if plies.iter().any(|q: &Ply| q.settings.name == p.name) {
                 return Err(at("name", "two plies have this name; give each ply its own name".into()));
             }
-            let v = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
-            for (field, a) in [("origin", p.origin), ("warp", p.warp)] {
-                if !a.iter().all(|x| x.is_finite()) {
-                    return Err(at(field, "must be three finite numbers".into()));
-                }
+            if !p.origin.iter().all(|x| x.is_finite()) {
+                return Err(at("origin", "must be three finite numbers".into()));
             }
             if !(p.spacing.is_finite() && p.spacing > 0.0) {
                 return Err(at("spacing", format!("must be a positive length, got {}", p.spacing)));
             }
-            if v(p.warp).norm() == 0.0 {
-                return Err(at("warp", "must not be the zero vector".into()));
-            }
+            let orientation = match (p.warp, p.angle_deg) {
+                (Some(_), Some(_)) => return Err(at("warp", "give either warp or angle_deg, not both".into())),
+                (Some(w), None) => {
+                    if !w.iter().all(|x| x.is_finite()) {
+                        return Err(at("warp", "must be three finite numbers".into()));
+                    }
+                    if v(w).norm() == 0.0 {
+                        return Err(at("warp", "must not be the zero vector".into()));
+                    }
+                    Orientation::Warp(v(w))
+                }
+                (None, Some(a)) if a.is_finite() => Orientation::Angle(a.to_radians()),
+                (None, Some(a)) => return Err(at("angle_deg", format!("must be a finite angle, got {a}"))),
+                (None, None) => Orientation::Angle(0.0),
+            };
             let extent = match (p.grid, &p.outline, &p.outline_file) {
                 (Some([nu, nv]), None, None) => {
                     if nu < 2 || nv < 2 {
@@ -158,27 +333,50 @@ impl Scene {
                 _ => return Err(at("grid", "give exactly one of grid, outline or outline_file".into())),
             };
             let generators = parse_generators(&p.generators, base, scale).map_err(|m| at("generators", m))?;
+            let material = match &p.material {
+                None => None,
+                Some(m) => Some(match materials.get(m) {
+                    Some(known) => known.clone(),
+                    None => {
+                        let path = base.join(m);
+                        if !path.is_file() {
+                            let names: Vec<&str> = materials.keys().map(String::as_str).collect();
+                            return Err(at(
+                                "material",
+                                format!(
+                                    "'{m}' is neither a name in [materials] ({}) nor a card file {}",
+                                    if names.is_empty() { "none given".to_string() } else { names.join(", ") },
+                                    path.display()
+                                ),
+                            ));
+                        }
+                        let card = MaterialCard::load(&path).map_err(|e| at("material", e.to_string()))?;
+                        PlyMaterial { name: card.name.clone(), card, path }
+                    }
+                }),
+            };
+            let thickness = match p.thickness {
+                Some(t) if t.is_finite() && t > 0.0 => Some(t * scale),
+                Some(t) => return Err(at("thickness", format!("must be a positive length, got {t}"))),
+                None => material.as_ref().map(|m| m.card.thickness),
+            };
             let refinement = match p.method.as_str() {
                 "kinematic" => {
-                    for (field, given) in [("material", p.material.is_some()), ("mode", p.mode.is_some())] {
-                        if given {
-                            return Err(at(field, "only a ply with method = \"mechanical\" uses it".into()));
-                        }
+                    if p.mode.is_some() {
+                        return Err(at("mode", "only a ply with method = \"mechanical\" uses it".into()));
                     }
                     None
                 }
                 "mechanical" => {
-                    let file = p.material.as_ref().ok_or_else(|| {
-                        at("material", "a mechanical ply needs a material card: material = \"card.toml\"".into())
+                    let m = material.as_ref().ok_or_else(|| {
+                        at("material", "a mechanical ply needs a material card: material = \"card.toml\" or a name from [materials]".into())
                     })?;
-                    let material_path = base.join(file);
-                    let material = MaterialCard::load(&material_path).map_err(|e| at("material", e.to_string()))?;
                     let mode = match p.mode.as_deref().unwrap_or("pressed") {
                         "pressed" => ContactMode::Pressed,
                         "free" => ContactMode::Free,
                         other => return Err(at("mode", format!("unknown mode '{other}': use \"pressed\" or \"free\""))),
                     };
-                    Some(Refinement { material, material_path, mode })
+                    Some(Refinement { material: m.card.clone(), material_path: m.path.clone(), mode })
                 }
                 other => return Err(at("method", format!("unknown method '{other}': use \"kinematic\" or \"mechanical\""))),
             };
@@ -196,15 +394,37 @@ impl Scene {
             let settings = KinematicSettings {
                 name: p.name.clone(),
                 origin: Point::from(v(p.origin) * scale),
-                warp: v(p.warp),
+                warp: match orientation {
+                    Orientation::Warp(w) => w,
+                    Orientation::Angle(_) => reference,
+                },
                 spacing: p.spacing * scale,
                 extent,
                 pre_shear: p.pre_shear_deg.to_radians(),
                 generators,
                 max_shear: max_shear.to_radians(),
             };
-            plies.push(Ply { settings, refinement, locking_angle: locking.to_radians(), line });
+            plies.push(Ply { settings, orientation, material, thickness, refinement, locking_angle: locking.to_radians(), line });
         }
-        Ok(Scene { path: path.into(), scale, tool: base.join(&file.tool), plies })
+        // A ply above another needs the thickness of the one below to know where it lies.
+        if plies.len() > 1 {
+            if let Some(p) = plies[..plies.len() - 1].iter().find(|p| p.thickness.is_none()) {
+                return Err(invalid(format!(
+                    "ply '{}' (line {}), field `thickness`: a ply with plies above it needs a thickness: give `material` (a card with its thickness) or `thickness`",
+                    p.settings.name, p.line
+                )));
+            }
+        }
+        Ok(Scene {
+            path: path.into(),
+            scale,
+            tool: base.join(&file.tool),
+            reference,
+            stack_side,
+            roll_width,
+            nesting_gap,
+            export,
+            plies,
+        })
     }
 }

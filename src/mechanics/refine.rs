@@ -211,3 +211,25 @@ pub fn cell_changes(before: &DrapeNet, after: &DrapeNet) -> Vec<Option<(f64, f64
     }
     out
 }
+
+/// Record the solver's work and the per-cell change from the kinematic net in the net's meta.
+pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, material: &std::path::Path) {
+    let changes = cell_changes(kinematic, &refined.net);
+    let shear: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(g, _)| g.to_degrees())).collect();
+    let angle: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(_, a)| a.to_degrees())).collect();
+    out.meta.insert(
+        "change_from_kinematic".into(),
+        serde_json::json!({"shear_deg": shear, "warp_angle_deg": angle}),
+    );
+    out.meta.insert("material".into(), serde_json::json!(material.display().to_string()));
+    out.meta.insert(
+        "solver".into(),
+        serde_json::json!({
+            "outcome": refined.outcome(),
+            "energy_kinematic": refined.energy_kinematic,
+            "energy_final": refined.energy_final,
+            "load_steps": refined.steps,
+        }),
+    );
+}
+

@@ -1,0 +1,186 @@
+//! Offset surfaces: the tool moved along its normals by the thickness of the plies below, so
+//! each ply of a layup is draped where it will lie.
+//!
+//! Each vertex moves along the direction `m` that moves every adjacent facet's plane by the same
+//! distance: the least-squares solution of `n_f . m = 1` over the facets around the vertex,
+//! weighted by their corner angles. On a smooth surface `m` is the vertex normal; on a sharp
+//! edge or corner (convex or concave) it is longer and points along the bisector, so both faces
+//! move by the full thickness instead of the corner thinning the stack. The distance per vertex
+//! comes from the caller (it varies where the plies below shear and thicken, and steps down at
+//! their edges).
+use super::{ObjError, Point, ToolSurface, Vector};
+use nalgebra::{Matrix3, SymmetricEigen};
+
+/// Eigenvalues of the normal scatter below this fraction of the largest are dropped: the
+/// facets around the vertex do not constrain the offset in that direction.
+const SCATTER_CUTOFF_REL: f64 = 1e-9;
+/// Longest offset direction relative to the distance: a vertex on a 150 deg concave edge moves
+/// 1 / cos(75 deg) = 3.9 times the thickness; sharper spikes are clipped to this.
+pub const MAX_OFFSET_STRETCH: f64 = 4.0;
+
+/// What an offset did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OffsetReport {
+    /// Vertices moved (distance > 0).
+    pub moved: usize,
+    /// Largest and mean distance over the moved vertices, metres.
+    pub max_distance: f64,
+    pub mean_distance: f64,
+    /// Vertices whose direction was clipped at [`MAX_OFFSET_STRETCH`].
+    pub clipped: usize,
+    /// Triangles that turned over (offset normal against the original): a concave region whose
+    /// radius is below the offset distance folds the offset surface there.
+    pub folded: usize,
+}
+
+/// Unit-distance offset direction of every vertex (see the module doc), pointing to the side the
+/// facet normals point to.
+pub fn offset_directions(tool: &ToolSurface) -> (Vec<Vector>, usize) {
+    let vertices = tool.vertices();
+    let mut scatter = vec![Matrix3::<f64>::zeros(); vertices.len()];
+    let mut rhs = vec![Vector::zeros(); vertices.len()];
+    for (t, tri) in tool.triangles().iter().enumerate() {
+        let n = tool.normal(t as u32);
+        for k in 0..3 {
+            let (a, b, c) = (tri[k] as usize, tri[(k + 1) % 3] as usize, tri[(k + 2) % 3] as usize);
+            let (u, v) = (vertices[b] - vertices[a], vertices[c] - vertices[a]);
+            let angle = u.cross(&v).norm().atan2(u.dot(&v));
+            scatter[a] += n * n.transpose() * angle;
+            rhs[a] += n * angle;
+        }
+    }
+    let mut clipped = 0;
+    let dirs = scatter
+        .iter()
+        .zip(&rhs)
+        .map(|(s, r)| {
+            if r.norm() == 0.0 {
+                return Vector::zeros(); // a vertex no triangle uses
+            }
+            let eig = SymmetricEigen::new(*s);
+            let top = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+            let mut m = Vector::zeros();
+            for k in 0..3 {
+                let lambda = eig.eigenvalues[k];
+                if lambda > SCATTER_CUTOFF_REL * top {
+                    let e = eig.eigenvectors.column(k);
+                    m += e * (e.dot(r) / lambda);
+                }
+            }
+            let mean = r.normalize();
+            if !(m.dot(&mean) > 0.0) || !m.iter().all(|x| x.is_finite()) {
+                m = mean;
+            }
+            if m.norm() > MAX_OFFSET_STRETCH {
+                clipped += 1;
+                m *= MAX_OFFSET_STRETCH / m.norm();
+            }
+            m
+        })
+        .collect();
+    (dirs, clipped)
+}
+
+/// The tool offset by `distance[v]` metres at vertex `v` (to the side its normals point to; a
+/// negative distance moves the other way). The result is a new, checked [`ToolSurface`].
+pub fn offset_surface(tool: &ToolSurface, distance: &[f64]) -> Result<(ToolSurface, OffsetReport), ObjError> {
+    let (dirs, clipped) = offset_directions(tool);
+    offset_along(tool, &dirs, clipped, distance)
+}
+
+/// The tool offset by `distance[v]` along precomputed directions `dirs` (from
+/// [`offset_directions`], of which `clipped` were clipped): for several offsets of one tool.
+pub fn offset_along(
+    tool: &ToolSurface,
+    dirs: &[Vector],
+    clipped: usize,
+    distance: &[f64],
+) -> Result<(ToolSurface, OffsetReport), ObjError> {
+    assert_eq!(distance.len(), tool.vertices().len(), "one offset distance per tool vertex");
+    let mut report = OffsetReport { clipped, ..Default::default() };
+    let moved = offset_vertices(tool, dirs, distance);
+    for &h in distance.iter().filter(|h| **h != 0.0) {
+        report.moved += 1;
+        report.max_distance = report.max_distance.max(h.abs());
+        report.mean_distance += h.abs();
+    }
+    if report.moved > 0 {
+        report.mean_distance /= report.moved as f64;
+    }
+    for (t, tri) in tool.triangles().iter().enumerate() {
+        let [a, b, c] = tri.map(|i| moved[i as usize]);
+        if (b - a).cross(&(c - a)).dot(&tool.normal(t as u32)) <= 0.0 {
+            report.folded += 1;
+        }
+    }
+    let surface = ToolSurface::from_triangles(moved, tool.triangles().to_vec())?;
+    Ok((surface, report))
+}
+
+/// The tool's vertices moved by `distance[v]` along `dirs[v]`.
+pub fn offset_vertices(tool: &ToolSurface, dirs: &[Vector], distance: &[f64]) -> Vec<Point> {
+    tool.vertices().iter().zip(dirs).zip(distance).map(|((p, m), &h)| p + m * h).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::shapes;
+
+    /// Offsets agree with the analytic ones to this (metres), rounding only.
+    const TOL: f64 = 1e-12;
+
+    #[test]
+    fn a_sphere_offset_is_a_larger_sphere_over_the_facet_planes() {
+        let tool = shapes::hemisphere(0.1, 12).into_surface().unwrap();
+        let h = 0.002;
+        let (off, report) = offset_surface(&tool, &vec![h; tool.vertices().len()]).unwrap();
+        assert_eq!(report.folded, 0);
+        assert_eq!(report.clipped, 0);
+        // Vertex on the sphere: moves radially; each adjacent facet plane moves by ~h.
+        for (p, q) in tool.vertices().iter().zip(off.vertices()) {
+            let d = q - p;
+            let radial = p.coords.normalize();
+            assert!((d.normalize() - radial).norm() < 0.05, "offset leaves the radial direction at {p:?}");
+            assert!(d.norm() >= h - TOL && d.norm() < 1.05 * h, "offset {}", d.norm());
+        }
+    }
+
+    #[test]
+    fn a_sharp_inside_corner_moves_both_walls_by_the_thickness() {
+        // An L-shaped channel: floor z = 0 for x < 0, wall x = 0 for z > 0, normals towards (-x, +z)
+        // (the ply lies inside the corner).
+        let v = vec![
+            Point::new(-1.0, 0.0, 0.0),
+            Point::new(0.0, 0.0, 0.0),
+            Point::new(0.0, 1.0, 0.0),
+            Point::new(-1.0, 1.0, 0.0),
+            Point::new(0.0, 0.0, 1.0),
+            Point::new(0.0, 1.0, 1.0),
+        ];
+        let tris = vec![[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]];
+        let tool = ToolSurface::from_triangles(v, tris).unwrap();
+        assert!(tool.normal(0).z > 0.0 && tool.normal(2).x < 0.0, "test mesh winding");
+        let h = 0.01;
+        let (off, report) = offset_surface(&tool, &vec![h; 6]).unwrap();
+        assert_eq!(report.folded, 0);
+        for (k, p) in off.vertices().iter().enumerate() {
+            let on_floor = tool.vertices()[k].z == 0.0;
+            let on_wall = tool.vertices()[k].x == 0.0;
+            if on_floor {
+                assert!((p.z - h).abs() < TOL, "vertex {k} floor offset {}", p.z);
+            }
+            if on_wall {
+                assert!((p.x + h).abs() < TOL, "vertex {k} wall offset {}", p.x);
+            }
+        }
+    }
+
+    #[test]
+    fn a_zero_distance_leaves_the_tool_where_it_is() {
+        let tool = shapes::saddle(0.2, 0.3, 10).into_surface().unwrap();
+        let (off, report) = offset_surface(&tool, &vec![0.0; tool.vertices().len()]).unwrap();
+        assert_eq!(report.moved, 0);
+        assert_eq!(off.vertices(), tool.vertices());
+    }
+}

@@ -1,0 +1,197 @@
+//! Draping a layup: each ply in stacking order on the tool offset by the plies below it, its warp
+//! resolved from the ply angle on that surface, refined where the ply asks for it; and the
+//! numbers of the layup table.
+use super::scene::{Orientation, Ply, Scene, StackSide};
+use crate::export::map::NetSampler;
+use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
+use crate::geometry::{ObjError, Point, ToolSurface, Vector};
+use crate::kinematic::fishnet::DrapeError;
+use crate::kinematic::{drape, DrapeNet, NodeStatus};
+use crate::mechanics::refine::{annotate, refine, RefineError, RefineSettings, Refined};
+use std::time::Instant;
+
+/// A reference direction closer than this (sine of the angle) to the tool normal at a seed has
+/// no usable projection onto the tool there.
+const MIN_REFERENCE_SINE: f64 = 1e-3;
+
+/// Why a layup could not be draped. Every message names the ply and its line in the scene.
+#[derive(Debug, thiserror::Error)]
+pub enum LayupError {
+    #[error("ply '{ply}' (line {line}): {source}")]
+    Drape { ply: String, line: usize, source: DrapeError },
+    #[error("ply '{ply}' (line {line}): the offset surface of the plies below is unusable: {source}")]
+    Offset { ply: String, line: usize, source: ObjError },
+    #[error("ply '{ply}' (line {line}): refinement: {source}")]
+    Refine { ply: String, line: usize, source: RefineError },
+    #[error("ply '{ply}' (line {line}): {message}")]
+    Orientation { ply: String, line: usize, message: String },
+}
+
+/// One draped ply of a layup.
+#[derive(Debug, Clone)]
+pub struct PlyResult {
+    /// The net: refined where the ply is mechanical, else kinematic.
+    pub net: DrapeNet,
+    /// The solver's record, for a mechanical ply.
+    pub refined: Option<Refined>,
+    /// The warp direction at the seed, resolved on the ply's surface.
+    pub warp: Vector,
+    /// Unit normal of the ply's surface at the seed, on the side the plies stack to.
+    pub seed_normal: Vector,
+    /// How the tool was offset for this ply (nothing moved for the first).
+    pub offset: OffsetReport,
+    pub stats: PlyStats,
+}
+
+/// A ply's row of the layup table.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PlyStats {
+    /// Largest and mean |shear| over the complete cells, radians.
+    pub max_abs_shear: f64,
+    pub mean_abs_shear: f64,
+    /// Draped area (3D) of the cells sheared past the locking angle, m^2.
+    pub area_over_locking: f64,
+    /// Complete cells over the cells the ply asked for (its grid, or its outline).
+    pub coverage: f64,
+    /// Draped area (3D) of the complete cells, m^2.
+    pub draped_area: f64,
+    /// Fabric used: the complete cells unsheared (cells x d^2), m^2; the flat pattern's area.
+    pub fabric_area: f64,
+    /// Mass of that fabric, kg, when the ply has a material card.
+    pub fabric_mass: Option<f64>,
+    /// Complete cells.
+    pub cells: usize,
+}
+
+/// The layup-table numbers of a draped net.
+pub fn ply_stats(net: &DrapeNet, locking_angle: f64, areal_mass: Option<f64>) -> PlyStats {
+    let mut s = PlyStats::default();
+    let mut asked = 0usize;
+    let mut sum = 0.0;
+    for i in 0..net.nu.saturating_sub(1) {
+        for j in 0..net.nv.saturating_sub(1) {
+            let corners = [net.index(i, j), net.index(i + 1, j), net.index(i + 1, j + 1), net.index(i, j + 1)];
+            if corners.iter().all(|&k| net.status[k] != NodeStatus::OutsideOutline) {
+                asked += 1;
+            }
+            let (Some(c), Some(g)) = (net.cell_corners(i, j), net.cell_shear(i, j)) else { continue };
+            let area = 0.5 * ((c[1] - c[0]).cross(&(c[2] - c[0])).norm() + (c[2] - c[0]).cross(&(c[3] - c[0])).norm());
+            s.cells += 1;
+            s.draped_area += area;
+            s.max_abs_shear = s.max_abs_shear.max(g.abs());
+            sum += g.abs();
+            if g.abs() > locking_angle {
+                s.area_over_locking += area;
+            }
+        }
+    }
+    if s.cells > 0 {
+        s.mean_abs_shear = sum / s.cells as f64;
+    }
+    s.coverage = if asked > 0 { s.cells as f64 / asked as f64 } else { 0.0 };
+    s.fabric_area = s.cells as f64 * net.spacing * net.spacing;
+    s.fabric_mass = areal_mass.map(|m| m * s.fabric_area);
+    s
+}
+
+/// The warp direction of `ply` at its seed on `surface`, and the normal there on the stacking side.
+pub fn resolve_warp(ply: &Ply, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<(Vector, Vector), String> {
+    let sp = surface.closest_point(&ply.settings.origin);
+    let n = match side {
+        StackSide::Normal => sp.normal,
+        StackSide::Opposite => -sp.normal,
+    };
+    let (direction, angle) = match ply.orientation {
+        Orientation::Warp(w) => (w, 0.0),
+        Orientation::Angle(a) => (*reference, a),
+    };
+    let projected = direction - n * n.dot(&direction);
+    if projected.norm() < MIN_REFERENCE_SINE * direction.norm() {
+        let what = match ply.orientation {
+            Orientation::Warp(_) => "the warp direction",
+            Orientation::Angle(_) => "the scene's reference direction",
+        };
+        return Err(format!(
+            "{what} is normal to the tool at the seed {:?} (normal {:?}): it has no direction on the surface there; choose another direction",
+            sp.point, n
+        ));
+    }
+    let rotation = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(n), angle);
+    Ok(((rotation * projected).normalize(), n))
+}
+
+/// Drape every ply of `scene` on `tool` in stacking order. `on_ply(k, name)` is called before
+/// ply `k` starts (for progress display).
+pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usize, &str)) -> Result<Vec<PlyResult>, LayupError> {
+    let (dirs, clipped) = offset_directions(tool);
+    let sign = match scene.stack_side {
+        StackSide::Normal => 1.0,
+        StackSide::Opposite => -1.0,
+    };
+    // Thickness of the stack so far at every tool vertex, metres.
+    let mut stack = vec![0.0; tool.vertices().len()];
+    let mut results: Vec<PlyResult> = Vec::new();
+    for (k, ply) in scene.plies.iter().enumerate() {
+        on_ply(k, &ply.settings.name);
+        let name = ply.settings.name.clone();
+        let line = ply.line;
+        let (offset_tool, offset) = if k == 0 {
+            (None, OffsetReport::default())
+        } else {
+            let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
+            let (s, r) = offset_along(tool, &dirs, clipped, &signed)
+                .map_err(|source| LayupError::Offset { ply: name.clone(), line, source })?;
+            (Some(s), r)
+        };
+        let surface = offset_tool.as_ref().unwrap_or(tool);
+        let (warp, seed_normal) = resolve_warp(ply, &scene.reference, surface, scene.stack_side)
+            .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
+        let mut settings = ply.settings.clone();
+        settings.warp = warp;
+        let mut net = drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
+        net.meta.insert("stack_offset_max_m".into(), serde_json::json!(offset.max_distance));
+        if let Some(a) = ply.angle_deg() {
+            net.meta.insert("angle_deg".into(), serde_json::json!(a));
+        }
+        let mut refined = None;
+        if let Some(r) = &ply.refinement {
+            let t = Instant::now();
+            let settings = RefineSettings { mode: r.mode, ..RefineSettings::default() };
+            let result = refine(&net, surface, &r.material, &settings)
+                .map_err(|source| LayupError::Refine { ply: name.clone(), line, source })?;
+            let mut out = result.net.clone();
+            annotate(&mut out, &net, &result, &r.material_path);
+            out.timing.load_ms = net.timing.load_ms;
+            out.timing.generators_ms = 0.0;
+            out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
+            net = out;
+            refined = Some(result);
+        }
+        if let Some(t0) = ply.thickness {
+            if k + 1 < scene.plies.len() {
+                add_ply_thickness(&mut stack, sign, tool, &dirs, &net, t0);
+            }
+        }
+        let areal_mass = ply.material.as_ref().map(|m| m.card.areal_mass);
+        let stats = ply_stats(&net, ply.locking_angle, areal_mass);
+        results.push(PlyResult { net, refined, warp, seed_normal, offset, stats });
+    }
+    Ok(results)
+}
+
+/// Add a draped ply's thickness t0 / cos(gamma) (sheared cells keep their fibre lengths, so their
+/// area shrinks by cos(gamma) and the ply thickens) to the stack at every tool vertex it covers.
+fn add_ply_thickness(stack: &mut [f64], sign: f64, tool: &ToolSurface, dirs: &[Vector], net: &DrapeNet, t0: f64) {
+    let Some(sampler) = NetSampler::new(net) else { return };
+    // Where the ply was draped: the tool offset by the stack below it.
+    let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
+    let under: Vec<Point> = offset_vertices(tool, dirs, &signed);
+    // The net follows its surface up to the chord sagitta and, for a refined ply, what the
+    // mechanics moved it: accept it within a ply thickness or a cell of the surface.
+    let reach = t0.max(net.spacing);
+    for (v, p) in under.iter().enumerate() {
+        if let Some(hit) = sampler.cover(p, reach) {
+            stack[v] += t0 / hit.shear().cos().max(f64::MIN_POSITIVE);
+        }
+    }
+}
