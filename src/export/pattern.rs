@@ -72,7 +72,7 @@ fn piece(p: &FlatPattern, at: &Placement) -> Piece {
     let label_height = (LABEL_FRACTION * sx.min(sy)).clamp(LABEL_MIN_M, LABEL_MAX_M);
     // Below the arrow (across it), so the two do not overlap.
     let n = [-w[1], w[0]];
-    let label_at = [a[0] - 1.5 * label_height * n[0], a[1] - 1.5 * label_height * n[1]];
+    let label_at = [a[0] - 2.0 * label_height * n[0], a[1] - 2.0 * label_height * n[1]];
     let label = format!(
         "{}  area {:.6} m2  bbox {:.1} x {:.1} mm  warp ->",
         p.ply,
@@ -116,9 +116,15 @@ fn check_finite(pc: &Piece, path: &Path) -> Result<(), PatternError> {
     Ok(())
 }
 
-/// A length in metres as millimetres, shortest exact decimal (no `-0`).
+/// Decimals written for millimetres: a nanometre, far below any cutter's resolution, and enough
+/// to print the grid's decimal lengths exactly instead of their binary rounding (950.0000000000001).
+const MM_DECIMALS: usize = 6;
+
+/// A length in metres as millimetres, to [`MM_DECIMALS`] places, trailing zeros dropped, no `-0`.
 fn mm(v: f64) -> String {
-    format!("{}", v * MM + 0.0)
+    let s = format!("{:.*}", MM_DECIMALS, v * MM);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".to_string() } else { s.to_string() }
 }
 
 /// DXF layer names of the plies, in order: each name with characters other than ASCII letters,
@@ -235,6 +241,11 @@ pub fn write_dxf(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Re
             g(30, "0")?;
             g(40, &mm(pc.label_height))?;
             g(1, &dxf_text(&pc.label))?;
+            // Centred on the alignment point (72 = 1), like the SVG's text-anchor middle.
+            g(72, "1")?;
+            g(11, &mm(pc.label_at[0]))?;
+            g(21, &mm(pc.label_at[1]))?;
+            g(31, "0")?;
         }
         g(0, "ENDSEC")?;
         g(0, "EOF")
@@ -295,13 +306,14 @@ fn write_svg_pieces(path: &Path, pcs: &[Piece], ids: &[String], lo: [f64; 2], hi
     let (width, height) = ((hi[0] - lo[0]) * MM + 2.0 * SVG_MARGIN_MM, (hi[1] - lo[1]) * MM + 2.0 * SVG_MARGIN_MM);
     write_atomic(path, |f| {
         writeln!(f, r#"<?xml version="1.0" encoding="UTF-8"?>"#)?;
+        let u = |v: f64| mm(v / MM);
         writeln!(
             f,
             r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}mm" height="{h}mm" viewBox="{x0} {y0} {w} {h}">"#,
-            w = width + 0.0,
-            h = height + 0.0,
-            x0 = x0 + 0.0,
-            y0 = y0 + 0.0
+            w = u(width),
+            h = u(height),
+            x0 = u(x0),
+            y0 = u(y0)
         )?;
         writeln!(f, "<title>{}</title>", xml(title))?;
         writeln!(f, "<desc>Units: millimetres; y up on the roll is up on the page. Warp arrows show the warp of each piece.</desc>")?;
