@@ -8,7 +8,7 @@
 use drape::export::pattern::{dxf_layer_names, svg_ids, write_dxf, write_pattern_svg, write_svg, PatternError};
 use drape::geometry::{shapes, Point, ToolSurface, Vector};
 use drape::kinematic::{drape, DrapeNet, Extent, KinematicSettings, NodeStatus};
-use drape::layup::flat::{flat_pattern, shoelace_area, FlatError, FlatPattern};
+use drape::layup::flat::{flat_pattern, flat_pattern_with_margin, shoelace_area, FlatError, FlatPattern};
 use drape::layup::nest::{nest, Nesting, Rotation};
 use serde_json::Value;
 use std::path::Path;
@@ -216,6 +216,80 @@ fn pinch() -> FlatPattern {
     shape("pinch", 0.01, 21, 21, |i, j| (i < 10) == (j < 10))
 }
 
+/// A flat net of `cells`, as a net (see [`shape`]).
+fn shape_net(name: &str, d: f64, nu: usize, nv: usize, cells: impl Fn(usize, usize) -> bool) -> DrapeNet {
+    let mut net = DrapeNet::new(name, d, nu, nv, (nu / 2, nv / 2));
+    for i in 0..nu - 1 {
+        for j in 0..nv - 1 {
+            if cells(i, j) {
+                for (a, b) in [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)] {
+                    let k = net.index(a, b);
+                    net.positions[k] = Point::new(a as f64 * d, b as f64 * d, 0.0);
+                    net.status[k] = NodeStatus::Placed;
+                }
+            }
+        }
+    }
+    net
+}
+
+/// Loops of a pattern with a margin: outer counter-clockwise first, holes clockwise, region
+/// areas are their shoelace sums, and the box is the plain pattern's grown by the margin.
+fn check_margin(p: &FlatPattern, plain: &FlatPattern, margin: f64) {
+    let mut total = 0.0;
+    for r in &p.regions {
+        let areas: Vec<f64> = r.loops.iter().map(|l| shoelace_area(l)).collect();
+        assert!(areas[0] > 0.0 && areas[1..].iter().all(|&a| a < 0.0), "{}: {areas:?}", p.ply);
+        assert!((areas.iter().sum::<f64>() - r.area).abs() <= AREA_REL * r.area);
+        total += r.area;
+    }
+    assert!((total - p.area).abs() <= AREA_REL * p.area);
+    assert_eq!(p.cells, plain.cells);
+    assert_eq!(p.regions.iter().map(|r| r.cells).sum::<usize>(), p.cells);
+    for k in 0..2 {
+        assert!((p.min[k] - (plain.min[k] - margin)).abs() < LEN_EPS && (p.max[k] - (plain.max[k] + margin)).abs() < LEN_EPS);
+    }
+    assert!(p.area > plain.area);
+}
+
+#[test]
+fn cutting_margin_grows_the_outline_with_square_corners() {
+    let d = 0.01;
+    // A 0.2 x 0.1 rectangle grown by m: (0.2 + 2m) x (0.1 + 2m).
+    let rect = shape_net("rect", d, 21, 11, |_, _| true);
+    let m = 0.003;
+    let p = flat_pattern_with_margin(&rect, m).unwrap();
+    check_margin(&p, &flat_pattern(&rect).unwrap(), m);
+    assert_eq!((p.regions.len(), p.regions[0].loops.len(), p.regions[0].loops[0].len()), (1, 1, 4));
+    assert!((p.area - (0.2 + 2.0 * m) * (0.1 + 2.0 * m)).abs() < 1e-15, "{}", p.area);
+    // Two squares touching at a corner merge into one piece: the grown squares overlap by (2m)^2.
+    let pinch = shape_net("pinch", d, 21, 21, |i, j| (i < 10) == (j < 10));
+    let p = flat_pattern_with_margin(&pinch, m).unwrap();
+    check_margin(&p, &flat_pattern(&pinch).unwrap(), m);
+    assert_eq!((p.regions.len(), p.regions[0].cells), (1, 200));
+    let want = 2.0 * (0.1 + 2.0 * m) * (0.1 + 2.0 * m) - 4.0 * m * m;
+    assert!((p.area - want).abs() < 1e-15, "{} vs {want}", p.area);
+    // A ring keeps a smaller hole, until the margin closes it (hole 0.1 wide).
+    let ring = shape_net("ring", d, 21, 21, |i, j| !(5..15).contains(&i) || !(5..15).contains(&j));
+    let plain = flat_pattern(&ring).unwrap();
+    for (m, holes) in [(0.004, 1), (0.03, 1), (0.05, 0), (0.07, 0)] {
+        let p = flat_pattern_with_margin(&ring, m).unwrap();
+        check_margin(&p, &plain, m);
+        assert_eq!(p.regions[0].loops.len() - 1, holes, "margin {m}");
+        let hole = (0.1 - 2.0 * m).max(0.0);
+        let want = (0.2 + 2.0 * m).powi(2) - hole * hole;
+        assert!((p.area - want).abs() < 1e-14, "margin {m}: {} vs {want}", p.area);
+    }
+    // A margin that is not a whole number of spacings, on a hemisphere drape (pinches, stairs).
+    let net = drape(hemisphere(), &KinematicSettings::grid("hm", Point::new(0.1, 0.0, 1.0), Vector::new(1.0, 0.3, 0.0), 0.05, 61, 61)).unwrap();
+    let plain = flat_pattern(&net).unwrap();
+    for m in [0.0123, 0.025, 0.075] {
+        check_margin(&flat_pattern_with_margin(&net, m).unwrap(), &plain, m);
+    }
+    assert_eq!(flat_pattern_with_margin(&net, 0.0).unwrap(), plain);
+    assert!(matches!(flat_pattern_with_margin(&net, -0.01), Err(FlatError::BadMargin { .. })));
+}
+
 fn check_nesting(patterns: &[FlatPattern], n: &Nesting) {
     assert_eq!(n.placements.len(), patterns.len());
     for (p, q) in patterns.iter().zip(&n.placements) {
@@ -326,6 +400,7 @@ fn drawings_read_back_independently() {
     let mut patterns = some_patterns();
     patterns.truncate(5);
     patterns[4].ply = "odd name/<&>".into(); // must become a valid layer name and id
+    patterns.push(flat_pattern_with_margin(&shape_net("ring-margin", 0.01, 21, 21, |i, j| i < 5 || j < 5 || i >= 15), 0.0037).unwrap());
     let n = nest(&patterns, 1.6, 0.01, Rotation::AllowQuarterTurn).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let (dxf, svg, one) = (dir.path().join("nest.dxf"), dir.path().join("nest.svg"), dir.path().join("ring.svg"));

@@ -10,7 +10,8 @@
 //! already refused (`outside_outline`), so the union of complete cells *is* the ply trimmed to its
 //! outline, at the resolution of the net (a staircase within one spacing d of the true outline).
 //! Nodes lost for other reasons (off the tool, shear limit, folds) are trimmed the same way: the
-//! pattern is the fabric that actually lies on the tool.
+//! pattern is the fabric that actually lies on the tool. A cutting allowance can be added all
+//! round with [`flat_pattern_with_margin`].
 use crate::kinematic::DrapeNet;
 use std::collections::HashMap;
 
@@ -20,6 +21,9 @@ pub enum FlatError {
     /// The net has no cell with four placed corners.
     #[error("ply '{ply}' has no complete cell (no cell with all four corners placed), so it has no flat pattern. Check the drape of this ply: its seed, size and the node statuses in its .drape.json.")]
     NoCells { ply: String },
+    /// A cutting allowance that is not a length.
+    #[error("ply '{ply}': the cutting margin {margin} is not zero or a positive length in metres. Fix it in the scene file.")]
+    BadMargin { ply: String, margin: f64 },
     /// The net's spacing cannot scale a pattern.
     #[error("ply '{ply}': the net spacing {spacing} is not a positive finite length, so the pattern cannot be unfolded. Re-create the net with `drape run`.")]
     BadSpacing { ply: String, spacing: f64 },
@@ -40,9 +44,10 @@ pub struct Region {
     /// point twice; loops of one pattern may touch at a corner (a pinch point) but never cross.
     /// Collinear vertices are merged, so every vertex is a corner.
     pub loops: Vec<Vec<[f64; 2]>>,
-    /// Number of cells in the region.
+    /// Number of the ply's cells in the region.
     pub cells: usize,
-    /// Area (m^2): `cells * d^2`, equal to the signed shoelace area of the loops.
+    /// Area inside the loops (m^2), their signed shoelace area: `cells * d^2` exactly when there
+    /// is no cutting margin.
     pub area: f64,
 }
 
@@ -58,9 +63,9 @@ pub struct FlatPattern {
     pub origin_node: (usize, usize),
     /// The connected pieces, largest first (ties in grid order).
     pub regions: Vec<Region>,
-    /// Total number of complete cells.
+    /// Total number of complete cells; `cells * d^2` is the ply's area.
     pub cells: usize,
-    /// Total area (m^2), `cells * d^2`.
+    /// Area to cut (m^2), inside the loops: `cells * d^2` exactly when there is no margin.
     pub area: f64,
     /// Lower-left corner of the bounding box (m).
     pub min: [f64; 2],
@@ -87,9 +92,26 @@ impl FlatPattern {
 /// outline of their union (see the module comment for the frame and the trimming).
 /// Error when the net has no complete cell, or a spacing that is not a positive length.
 pub fn flat_pattern(net: &DrapeNet) -> Result<FlatPattern, FlatError> {
+    flat_pattern_with_margin(net, 0.0)
+}
+
+/// Grid coordinates closer than this (in spacings) are one coordinate when cells are grown by a
+/// margin: `i - u` and `k + 1 + u` can meet up to rounding.
+const SNAP: f64 = 1e-9;
+
+/// The flat pattern with a cutting allowance: the outline of the union of the complete cells,
+/// each grown by `margin` (m) on every side. Corners stay square (the allowance of a staircase
+/// is a staircase); pieces closer than `2 margin` merge into one piece and narrower holes close.
+/// Then `area` is the area to cut (inside the grown outline), while `cells` still counts the
+/// ply's cells; each region's `cells` counts the cells it contains. `margin = 0` is
+/// [`flat_pattern`]. Errors as [`flat_pattern`], and for a negative or non-finite margin.
+pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPattern, FlatError> {
     let d = net.spacing;
     if !(d.is_finite() && d > 0.0) {
         return Err(FlatError::BadSpacing { ply: net.name.clone(), spacing: d });
+    }
+    if !(margin.is_finite() && margin >= 0.0) {
+        return Err(FlatError::BadMargin { ply: net.name.clone(), margin });
     }
     let (ncx, ncy) = (net.nu.saturating_sub(1), net.nv.saturating_sub(1));
     let mut mask = CellMask::new(ncx, ncy);
@@ -105,35 +127,112 @@ pub fn flat_pattern(net: &DrapeNet) -> Result<FlatPattern, FlatError> {
         return Err(FlatError::NoCells { ply: net.name.clone() });
     }
     let (i0, j0) = (net.origin_node.0 as f64, net.origin_node.1 as f64);
-    let to_flat = |[i, j]: [i64; 2]| [(i as f64 - i0) * d, (j as f64 - j0) * d];
-    let mut regions = Vec::with_capacity(traced.len());
+    let to_flat = |[x, y]: [f64; 2]| [(x - i0) * d, (y - j0) * d];
+    let regions: Vec<Region> = if margin == 0.0 {
+        traced
+            .iter()
+            .map(|r| Region {
+                loops: r.loops.iter().map(|l| l.iter().map(|&[i, j]| to_flat([i as f64, j as f64])).collect()).collect(),
+                cells: r.cells,
+                area: r.cells as f64 * d * d,
+            })
+            .collect()
+    } else {
+        grown(&mask, margin / d)
+            .into_iter()
+            .map(|(loops, cells)| {
+                let loops: Vec<Vec<[f64; 2]>> = loops.iter().map(|l| l.iter().map(|&p| to_flat(p)).collect()).collect();
+                let area = loops.iter().map(|l| shoelace_area(l)).sum();
+                Region { loops, cells, area }
+            })
+            .collect()
+    };
     let mut min = [f64::INFINITY; 2];
     let mut max = [f64::NEG_INFINITY; 2];
-    for r in &traced {
-        let loops: Vec<Vec<[f64; 2]>> = r.loops.iter().map(|l| l.iter().map(|&p| to_flat(p)).collect()).collect();
-        for p in loops.iter().flatten() {
-            for k in 0..2 {
-                min[k] = min[k].min(p[k]);
-                max[k] = max[k].max(p[k]);
-            }
+    for p in regions.iter().flat_map(|r| r.loops.iter()).flatten() {
+        for k in 0..2 {
+            min[k] = min[k].min(p[k]);
+            max[k] = max[k].max(p[k]);
         }
-        regions.push(Region { loops, cells: r.cells, area: r.cells as f64 * d * d });
     }
     let cells: usize = traced.iter().map(|r| r.cells).sum();
-    let big = &traced[0];
-    let anchor = to_flat([0, 0]);
-    let anchor = [anchor[0] + (big.anchor[0] as f64 + 0.5) * d, anchor[1] + (big.anchor[1] as f64 + 0.5) * d];
-    Ok(FlatPattern {
-        ply: net.name.clone(),
-        spacing: d,
-        origin_node: net.origin_node,
-        regions,
-        cells,
-        area: cells as f64 * d * d,
-        min,
-        max,
-        anchor,
-    })
+    // The arrow hangs on a cell of the ply itself, not on the allowance.
+    let a = traced[0].anchor;
+    let anchor = to_flat([a[0] as f64 + 0.5, a[1] as f64 + 0.5]);
+    let area = if margin == 0.0 { cells as f64 * d * d } else { regions.iter().map(|r| r.area).sum() };
+    Ok(FlatPattern { ply: net.name.clone(), spacing: d, origin_node: net.origin_node, regions, cells, area, min, max, anchor })
+}
+
+/// Sorted distinct coordinates, those within [`SNAP`] of a kept one dropped.
+fn snapped(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    let mut out: Vec<f64> = Vec::with_capacity(v.len());
+    for x in v {
+        if out.last().is_none_or(|&l| x - l >= SNAP) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// Index in `axis` (from [`snapped`]) of a coordinate that was snapped into it.
+fn snap_index(axis: &[f64], x: f64) -> usize {
+    axis.partition_point(|&a| a < x - SNAP)
+}
+
+/// Loops (grid units) and cell counts of the union of the filled cells each grown by `u` on
+/// every side: the rectangles' edges make a compressed grid, whose covered cells (by a 2-D
+/// difference array) are traced like the cells of the net.
+fn grown(mask: &CellMask, u: f64) -> Vec<(Vec<Vec<[f64; 2]>>, usize)> {
+    let filled: Vec<[usize; 2]> = (0..mask.nx).flat_map(|i| (0..mask.ny).map(move |j| [i, j])).filter(|&[i, j]| mask.get(i as i64, j as i64)).collect();
+    let grow = |k: usize| [k as f64 - u, k as f64 + 1.0 + u];
+    let xs = snapped(filled.iter().flat_map(|c| grow(c[0])).collect());
+    let ys = snapped(filled.iter().flat_map(|c| grow(c[1])).collect());
+    let (nx, ny) = (xs.len(), ys.len());
+    let mut cover = vec![0i64; nx * ny];
+    for &[i, j] in &filled {
+        let ([x0, x1], [y0, y1]) = (grow(i), grow(j));
+        let (a0, a1, b0, b1) = (snap_index(&xs, x0), snap_index(&xs, x1), snap_index(&ys, y0), snap_index(&ys, y1));
+        cover[a0 * ny + b0] += 1;
+        cover[a1 * ny + b0] -= 1;
+        cover[a0 * ny + b1] -= 1;
+        cover[a1 * ny + b1] += 1;
+    }
+    for a in 0..nx {
+        for b in 0..ny {
+            let left = if a > 0 { cover[(a - 1) * ny + b] } else { 0 };
+            let below = if b > 0 { cover[a * ny + b - 1] } else { 0 };
+            let diag = if a > 0 && b > 0 { cover[(a - 1) * ny + b - 1] } else { 0 };
+            cover[a * ny + b] += left + below - diag;
+        }
+    }
+    let mut big = CellMask::new(nx - 1, ny - 1);
+    for a in 0..nx - 1 {
+        for b in 0..ny - 1 {
+            if cover[a * ny + b] > 0 {
+                big.set(a, b);
+            }
+        }
+    }
+    let regions = trace(&big);
+    // Which grown region holds each cell: look up the compressed cell under the cell's centre.
+    let mut region_of = vec![usize::MAX; (nx - 1) * (ny - 1)];
+    for (k, r) in regions.iter().enumerate() {
+        for c in &r.members {
+            region_of[c[0] as usize * (ny - 1) + c[1] as usize] = k;
+        }
+    }
+    let mut counts = vec![0usize; regions.len()];
+    for &[i, j] in &filled {
+        let a = xs.partition_point(|&x| x <= i as f64 + 0.5) - 1;
+        let b = ys.partition_point(|&y| y <= j as f64 + 0.5) - 1;
+        counts[region_of[a * (ny - 1) + b]] += 1;
+    }
+    regions
+        .into_iter()
+        .zip(counts)
+        .map(|(r, n)| (r.loops.iter().map(|l| l.iter().map(|&[a, b]| [xs[a as usize], ys[b as usize]]).collect()).collect(), n))
+        .collect()
 }
 
 /// Signed shoelace area of a closed loop (positive when counter-clockwise).
@@ -180,6 +279,8 @@ pub struct GridRegion {
     pub cells: usize,
     /// The cell of the region nearest to its centroid (lowest grid order on ties).
     pub anchor: [i64; 2],
+    /// The region's cells.
+    pub members: Vec<[i64; 2]>,
 }
 
 /// Directions of boundary edges, counter-clockwise order: +x, +y, -x, -y.
@@ -286,7 +387,7 @@ pub fn trace(mask: &CellMask) -> Vec<GridRegion> {
             let (cx, cy) = (sx / n, sy / n);
             let dist = |c: &[i64; 2]| (c[0] as f64 - cx).powi(2) + (c[1] as f64 - cy).powi(2);
             let anchor = *cells.iter().min_by(|a, b| dist(a).total_cmp(&dist(b)).then(a.cmp(b))).expect("regions are not empty");
-            GridRegion { loops, cells: cells.len(), anchor }
+            GridRegion { loops, cells: cells.len(), anchor, members: cells }
         })
         .collect();
     // Stable: equal sizes keep grid order.
