@@ -5,10 +5,11 @@
 //! exactly the number of complete cells times d^2. The DXF and SVG are read back by
 //! tools/pattern_readback.py (ezdxf and xml.etree; `python3 -m pip install -r
 //! tools/requirements.txt`); DRAPE_SKIP_PYTHON=1 skips that part.
-use drape::export::pattern::{dxf_layer_names, svg_ids, write_dxf, write_pattern_svg, write_svg, PatternError};
+use drape::export::pattern::{dxf_layer_names, svg_ids, write_cutting_plan, write_dxf, write_pattern_svg, write_svg, PatternError};
 use drape::geometry::{shapes, Point, ToolSurface, Vector};
 use drape::kinematic::{drape, DrapeNet, Extent, KinematicSettings, NodeStatus};
-use drape::layup::flat::{flat_pattern, flat_pattern_with_margin, shoelace_area, FlatError, FlatPattern};
+use drape::layup::flat::{flat_pattern, flat_pattern_with_margin, shoelace_area, FlatError, FlatPattern, Region};
+use proptest::prelude::*;
 use drape::layup::nest::{nest, Nesting, Rotation};
 use serde_json::Value;
 use std::path::Path;
@@ -344,6 +345,38 @@ fn nesting_places_every_piece_inside_the_roll_without_overlap() {
     }
 }
 
+/// A rectangular pattern `a x b` (m) with its lower-left corner at `at`, built field by field.
+fn rect_pattern(name: &str, a: f64, b: f64, at: [f64; 2]) -> FlatPattern {
+    let (x0, y0, x1, y1) = (at[0], at[1], at[0] + a, at[1] + b);
+    FlatPattern {
+        ply: name.into(),
+        spacing: a.min(b),
+        origin_node: (0, 0),
+        regions: vec![Region { loops: vec![vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]], cells: 1, area: a * b }],
+        cells: 1,
+        area: a * b,
+        min: [x0, y0],
+        max: [x1, y1],
+        anchor: [x0 + a / 2.0, y0 + b / 2.0],
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// Random boxes on random rolls: inside the roll, apart by the gap, areas add up.
+    #[test]
+    fn nesting_random_boxes(sizes in proptest::collection::vec((0.01f64..0.9, 0.01f64..0.9, -1.0f64..1.0, -1.0f64..1.0), 1..25),
+                            width in 0.9f64..2.5, gap in 0.0f64..0.05, turn in any::<bool>()) {
+        let patterns: Vec<FlatPattern> = sizes.iter().enumerate().map(|(k, &(a, b, x, y))| rect_pattern(&format!("p{k}"), a, b, [x, y])).collect();
+        let rot = if turn { Rotation::AllowQuarterTurn } else { Rotation::WarpAlongRoll };
+        let n = nest(&patterns, width, gap, rot).unwrap();
+        check_nesting(&patterns, &n);
+        // No piece reaches past the roll length and the roll is not longer than laying them end to end.
+        let end_to_end: f64 = patterns.iter().map(|p| p.size()[0].max(if turn { p.size()[1] } else { 0.0 }) + gap).sum();
+        prop_assert!(n.length <= end_to_end + LEN_EPS);
+    }
+}
+
 #[test]
 fn nesting_refuses_a_piece_wider_than_the_roll() {
     let wide = shape("wide", 0.1, 4, 13, |_, _| true); // 0.3 along x, 1.2 across
@@ -473,4 +506,17 @@ fn drawings_read_back_independently() {
     }
     assert!(close(num(&g["signed_area_mm2"]) * 1e-6, p.area, FILE_AREA_REL));
     assert!(s["groups"].get("roll").is_none());
+
+    // The whole plan: nesting drawings and one SVG per ply, all readable.
+    let plan = dir.path().join("plan");
+    let paths = write_cutting_plan(&patterns, &n, &plan, "nest").unwrap();
+    let names: Vec<String> = paths.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert_eq!(names[..3], ["nest.dxf", "nest.svg", "ply-hemi.svg"]);
+    assert_eq!(names.len(), 2 + patterns.len());
+    assert_eq!(std::fs::read(&paths[0]).unwrap(), std::fs::read(&dxf).unwrap(), "deterministic");
+    let r = readback(&paths.iter().map(|p| p.as_path()).collect::<Vec<_>>());
+    for (p, (path, id)) in patterns.iter().zip(paths[2..].iter().zip(&ids)) {
+        let g = &r[path.to_str().unwrap()]["groups"][id.as_str()];
+        assert!(close(num(&g["signed_area_mm2"]) * 1e-6, p.area, FILE_AREA_REL), "{id}");
+    }
 }

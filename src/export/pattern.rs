@@ -15,7 +15,7 @@ use super::{write_atomic, ExportError};
 use crate::layup::flat::FlatPattern;
 use crate::layup::nest::{Nesting, Placement};
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Why a pattern drawing could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -369,4 +369,24 @@ pub fn write_pattern_svg(pattern: &FlatPattern, path: &Path) -> Result<(), Patte
     check_finite(&pc, path)?;
     let title = format!("ply {}: flat pattern, area {:.6} m2", pattern.ply, pattern.area);
     write_svg_pieces(path, &[pc], &svg_ids(std::slice::from_ref(pattern)), pattern.min, pattern.max, None, &title)
+}
+
+/// Write a whole cutting plan into `dir` (created if missing): the nesting as `<stem>.dxf` and
+/// `<stem>.svg`, and each pattern on its own as `<id>.svg` with `id` from [`svg_ids`]
+/// (`ply-NAME`, file-name safe). Returns the paths written, in that order. Everything is checked
+/// before the first file is written.
+pub fn write_cutting_plan(patterns: &[FlatPattern], nesting: &Nesting, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PatternError> {
+    let dxf = dir.join(format!("{stem}.dxf"));
+    pieces(patterns, nesting, &dxf)?;
+    std::fs::create_dir_all(dir).map_err(|source| ExportError::CreateDir { path: dir.to_path_buf(), source })?;
+    let svg = dir.join(format!("{stem}.svg"));
+    write_dxf(patterns, nesting, &dxf)?;
+    write_svg(patterns, nesting, &svg)?;
+    let mut out = vec![dxf, svg];
+    for (p, id) in patterns.iter().zip(svg_ids(patterns)) {
+        let path = dir.join(format!("{id}.svg"));
+        write_pattern_svg(p, &path)?;
+        out.push(path);
+    }
+    Ok(out)
 }
