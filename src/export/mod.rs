@@ -9,6 +9,7 @@ pub mod flow;
 pub mod flowmesh;
 pub mod json;
 pub mod map;
+pub mod pattern;
 pub mod vtu;
 
 pub use atomic::write_atomic;

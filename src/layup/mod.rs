@@ -1,4 +1,6 @@
 //! Scenes: the tool and the plies to drape on it, read from TOML.
+pub mod flat;
+pub mod nest;
 pub mod scene;
 pub mod stack;
 
