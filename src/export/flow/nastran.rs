@@ -8,7 +8,8 @@
 //! the deck is `out`; for a layup each ply gets its own deck `STEM_<ply>.<ext>` beside `out`
 //! (same GRIDs and element ids in all of them). This is a mesh + orientation deck to INCLUDE:
 //! elements covered by the ply have PID 1, the others PID 2 and no THETA (the field is left
-//! blank, and a comment lists them); define PSHELL/PCOMP 1 and 2 yourself.
+//! blank, and a comment lists them); define PSHELL/PCOMP 1 and 2 yourself. The executive and
+//! case control sections are empty (`CEND`, `BEGIN BULK`, ..., `ENDDATA`).
 use super::{deg, file_tag, fit_real, sibling, write_atomic, ExportError, FlowMesh, LayupMap};
 use crate::export::flowmesh::ElementShape;
 use crate::export::map::PlyMap;
@@ -52,6 +53,9 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<
             writeln!(w, "$   {}", ids.join(" "))?;
         }
     }
+    // Empty executive and case control sections: a deck pyNastran and meshio read whole; add
+    // SOL and case control above CEND to run it, or INCLUDE the bulk lines in your own deck.
+    writeln!(w, "CEND")?;
     writeln!(w, "BEGIN BULK")?;
     write_grids(mesh, w)?;
     for (el, f) in mesh.elements.iter().zip(&ply.elements) {
