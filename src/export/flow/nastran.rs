@@ -1,6 +1,7 @@
 //! Nastran bulk data (MSC / NX / pyNastran) with the material orientation angle THETA of each
-//! element: GRID, CTRIA3 and CQUAD4 in large-field fixed format (16-character fields, so THETA
-//! and coordinates keep 11 or more significant digits).
+//! element: GRID, CTRIA3 and CQUAD4 in large-field fixed format (16-character fields; reals
+//! take at most 15 characters so a blank always separates neighbours, which keeps 10 or more
+//! significant digits: THETA to better than 1e-8 degree).
 //!
 //! THETA is field 7 of CTRIA3 (EID PID G1 G2 G3 THETA) and field 8 of CQUAD4 (EID PID G1 G2 G3
 //! G4 THETA), a real in degrees measured from the element's G1 -> G2 edge about its normal: the
@@ -93,7 +94,8 @@ pub(super) fn write_element<W: Write>(
 
 /// A real in a large field (checked finite before writing).
 pub(super) fn real(x: f64) -> String {
-    fit_real(x, LARGE).expect("values are checked finite before writing")
+    // One character short of the field: a blank always separates neighbouring numbers.
+    fit_real(x, LARGE - 1).expect("values are checked finite before writing")
 }
 
 /// One entry in large-field fixed format: `fields` are the entry's fields 2, 3, ... in
