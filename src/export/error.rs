@@ -20,4 +20,8 @@ pub enum ExportError {
     BadNet { ply: String, reason: String },
     #[error("ply name '{ply}' cannot be used as an output file name ({reason}). Rename the ply in the scene file.")]
     BadName { ply: String, reason: String },
+    #[error("cannot write the {format} flow export: ply '{ply}', element {element}: {field} is {value} (must be finite). This is a bug in the mapping stage (nothing was written); please report it together with the scene and flow mesh.")]
+    FlowNonFinite { format: &'static str, ply: String, element: u64, field: &'static str, value: f64 },
+    #[error("cannot write the {format} flow export: {reason}. Nothing was written.")]
+    FlowInvalid { format: &'static str, reason: String },
 }

@@ -1,0 +1,629 @@
+//! Flow-mesh writers read back by independent code (tools/flow_readback.py: meshio, pyNastran,
+//! Python's csv and parsers written from the Abaqus, OptiStruct and RTMsim documentation).
+//!
+//! A small curved mesh with triangles, warped and oblique quads and non-consecutive node and
+//! element ids; fibres built in the test from a known angle THETA (from edge G1 -> G2), shear
+//! and thinning, for one net and for a 3-ply layup in which some plies miss some elements.
+//!
+//! Needs `python3` with meshio, numpy and pyNastran (tools/requirements.txt). Set
+//! DRAPE_SKIP_PYTHON=1 to skip the Python part (the Rust-side checks still run).
+use drape::export::flow::{write_flow, write_rtmsim, FlowFormat, FLOW_CSV_HEADER, MAX_RTMSIM_SETS};
+use drape::export::flowmesh::{ElementShape, FlowElement, FlowMesh};
+use drape::export::map::{ElementFibres, LayupMap, PlyMap};
+use drape::export::ExportError;
+use drape::geometry::{Point, Vector};
+use nalgebra::Matrix3;
+use serde_json::Value;
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Directions read back from text written with `{:?}` (exact) and recomputed geometry.
+const EXACT_TOL: f64 = 1e-12;
+/// Angles (degrees) read back from 16-character Nastran fields.
+const LARGE_FIELD_DEG_TOL: f64 = 1e-8;
+/// Directions rebuilt from a THETA in a 16-character field.
+const LARGE_FIELD_DIR_TOL: f64 = 1e-9;
+/// Coordinates in RTMsim's 8-character fields (metres, part of size 0.3 m).
+const SHORT_FIELD_TOL: f64 = 1e-6;
+
+const NOMINAL_T: f64 = 3.0e-4;
+const VF0: f64 = 0.5;
+
+fn rotate(v: Vector, n: Vector, angle: f64) -> Vector {
+    let (s, c) = angle.sin_cos();
+    v * c + n.cross(&v) * s + n * n.dot(&v) * (1.0 - c)
+}
+
+/// Signed angle from `a` to `b` about `n`.
+fn angle_about(a: Vector, b: Vector, n: Vector) -> f64 {
+    n.dot(&a.cross(&b)).atan2(a.dot(&b))
+}
+
+fn wrap_deg(d: f64) -> f64 {
+    let r = d.rem_euclid(360.0);
+    if r > 180.0 {
+        r - 360.0
+    } else {
+        r
+    }
+}
+
+/// Curved, warped mesh: nodes (i, j) at (0.1 i, 0.1 j, 0.02 i j) with ids 10 i + j + 11, and an
+/// extra node 40 off the surface for an oblique triangle.
+fn mesh() -> FlowMesh {
+    let mut nodes = Vec::new();
+    let mut node_ids = Vec::new();
+    for i in 0..3 {
+        for j in 0..3 {
+            nodes.push(Point::new(0.1 * i as f64, 0.1 * j as f64, 0.02 * (i * j) as f64));
+            node_ids.push(10 * i as u64 + j as u64 + 11);
+        }
+    }
+    nodes.push(Point::new(0.25, 0.1, 0.05));
+    node_ids.push(40);
+    let idx = |id: u64| node_ids.iter().position(|&x| x == id).unwrap();
+    let el = |id: u64, ns: &[u64]| FlowElement {
+        id,
+        shape: if ns.len() == 3 { ElementShape::Tria3 } else { ElementShape::Quad4 },
+        nodes: ns.iter().map(|&n| idx(n)).collect(),
+        property: 1,
+    };
+    let elements = vec![
+        el(7, &[11, 21, 22, 12]),
+        el(3, &[12, 22, 23, 13]),
+        el(42, &[21, 31, 32]),
+        el(1000, &[21, 32, 22]),
+        el(15, &[22, 32, 33, 23]),
+        el(16, &[31, 40, 32]),
+    ];
+    FlowMesh { path: PathBuf::from("test-mesh.bdf"), nodes, node_ids, elements }
+}
+
+/// Ply angles (rad) and which elements (by index) each ply misses.
+const PLIES: [(&str, f64, &[usize]); 3] = [("base", 0.0, &[5]), ("p45", PI / 4.0, &[1]), ("p-45", -PI / 4.0, &[4, 5])];
+
+fn shear_of(e: usize, k: usize) -> f64 {
+    0.05 + 0.07 * e as f64 + 0.02 * k as f64
+}
+
+fn change_of(e: usize, k: usize) -> f64 {
+    0.03 * (e as f64 + 1.0) * if k % 2 == 0 { 1.0 } else { -1.0 }
+}
+
+fn fibres(mesh: &FlowMesh, e: usize, k: usize, ply_angle: f64) -> ElementFibres {
+    let n = mesh.normal(e).unwrap();
+    let u = mesh.first_edge(e).unwrap();
+    let r = Vector::new(1.0, 0.2, 0.0).normalize();
+    let nominal = angle_about(u, r - n * n.dot(&r), n) + ply_angle;
+    let change = change_of(e, k);
+    let theta = nominal + change;
+    let shear = shear_of(e, k);
+    let warp = rotate(u, n, theta);
+    let weft = rotate(warp, n, FRAC_PI_2 - shear);
+    let b1 = (warp + weft).normalize();
+    let b2 = n.cross(&b1);
+    let (k1, k2, k3) = (2.0e-10 * (1.0 - shear), 0.5e-10, 1.0e-12);
+    let perm = b1 * b1.transpose() * k1 + b2 * b2.transpose() * k2 + n * n.transpose() * k3;
+    let wrap = |a: f64| (a + PI).rem_euclid(2.0 * PI) - PI;
+    ElementFibres {
+        warp,
+        weft,
+        normal: n,
+        shear,
+        theta: wrap(theta),
+        angle_change: change,
+        thickness: NOMINAL_T / shear.cos(),
+        nominal_thickness: NOMINAL_T,
+        vf: VF0,
+        permeability: Some(perm),
+    }
+}
+
+fn layup_map(mesh: &FlowMesh, layup: bool) -> LayupMap {
+    let n = mesh.elements.len();
+    let plies: Vec<PlyMap> = PLIES
+        .iter()
+        .take(if layup { 3 } else { 1 })
+        .enumerate()
+        .map(|(k, (name, angle, missing))| PlyMap {
+            ply: name.to_string(),
+            elements: (0..n).map(|e| (!missing.contains(&e)).then(|| fibres(mesh, e, k, *angle))).collect(),
+        })
+        .collect();
+    let mut thickness = vec![0.0; n];
+    let mut mean_vf = vec![None; n];
+    let mut permeability = vec![None; n];
+    for e in 0..n {
+        let cov: Vec<&ElementFibres> = plies.iter().filter_map(|p| p.elements[e].as_ref()).collect();
+        if cov.is_empty() {
+            continue;
+        }
+        let t: f64 = cov.iter().map(|f| f.thickness).sum();
+        thickness[e] = t;
+        mean_vf[e] = Some(cov.iter().map(|f| f.vf * f.thickness).sum::<f64>() / t);
+        permeability[e] =
+            Some(cov.iter().fold(Matrix3::zeros(), |s, f| s + f.permeability.unwrap() * f.thickness) / t);
+    }
+    LayupMap { plies, layup, thickness, mean_vf, permeability }
+}
+
+fn python_ready() -> bool {
+    if std::env::var("DRAPE_SKIP_PYTHON").is_ok_and(|v| v == "1") {
+        eprintln!("flow_writers: DRAPE_SKIP_PYTHON=1: skipped the independent Python read-back");
+        return false;
+    }
+    let probe = Command::new("python3").args(["-c", "import meshio, numpy, pyNastran"]).output();
+    match probe {
+        Ok(o) if o.status.success() => true,
+        Ok(o) => panic!(
+            "python3 cannot import meshio/numpy/pyNastran ({}). Run `python3 -m pip install -r tools/requirements.txt`, \
+             or set DRAPE_SKIP_PYTHON=1 to skip this check.",
+            String::from_utf8_lossy(&o.stderr).trim()
+        ),
+        Err(e) => panic!("cannot run python3 ({e}); install it or set DRAPE_SKIP_PYTHON=1"),
+    }
+}
+
+fn readback(format: &str, files: &[PathBuf]) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/flow_readback.py");
+    let out = Command::new("python3").arg(&script).arg(format).args(files).output().unwrap();
+    assert!(out.status.success(), "{} {format} failed:\n{}", script.display(), String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("readback output is not JSON ({e})"))
+}
+
+fn f64s(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap_or_else(|| panic!("not an array: {v}")).iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+fn vec3(v: &[f64]) -> Vector {
+    Vector::new(v[0], v[1], v[2])
+}
+
+/// Unit, in the element plane, at 90 deg - shear from each other.
+fn assert_frame(mesh: &FlowMesh, e: usize, warp: Vector, weft: Vector, shear_deg: f64, tol: f64, what: &str) {
+    let n = mesh.normal(e).unwrap();
+    assert!((warp.norm() - 1.0).abs() < tol && (weft.norm() - 1.0).abs() < tol, "{what}: not unit");
+    assert!(warp.dot(&n).abs() < tol && weft.dot(&n).abs() < tol, "{what}: not in the element plane");
+    let between = warp.dot(&weft).clamp(-1.0, 1.0).acos().to_degrees();
+    assert!((between - (90.0 - shear_deg)).abs() < 1e-9, "{what}: warp-weft {between} vs 90 - {shear_deg}");
+}
+
+fn write(mesh: &FlowMesh, map: &LayupMap, format: FlowFormat, out: &Path) -> Vec<PathBuf> {
+    let files = write_flow(mesh, map, format, out).unwrap();
+    for f in &files {
+        assert!(f.is_file(), "{} missing", f.display());
+    }
+    files
+}
+
+#[test]
+fn vtu_fields_and_frames() {
+    let mesh = mesh();
+    for layup in [false, true] {
+        let map = layup_map(&mesh, layup);
+        let dir = tempfile::tempdir().unwrap();
+        let files = write(&mesh, &map, FlowFormat::Vtu, &dir.path().join("flow.vtu"));
+        let text = std::fs::read_to_string(&files[0]).unwrap();
+        assert!(!text.contains("NaN") && !text.contains("inf"));
+        if !python_ready() {
+            continue;
+        }
+        let s = readback("vtu", &files);
+        let data = s["cell_data"].as_object().unwrap();
+        let mut names: Vec<&str> = data.keys().map(String::as_str).collect();
+        names.sort();
+        let per_ply = ["covered", "warp", "weft", "shear_deg", "thickness", "vf", "permeability"];
+        let mut expected: Vec<String> = vec!["element_id".into()];
+        for p in &map.plies {
+            let prefix = if layup { format!("{}_", p.ply) } else { String::new() };
+            expected.extend(per_ply.iter().map(|f| format!("{prefix}{f}")));
+        }
+        if layup {
+            expected.extend(["laminate_thickness", "mean_vf", "laminate_permeability"].map(String::from));
+        }
+        expected.sort();
+        assert_eq!(names, expected, "field names");
+        let cells = s["cells"].as_array().unwrap();
+        assert_eq!(cells.len(), mesh.elements.len());
+        for (e, el) in mesh.elements.iter().enumerate() {
+            let ty = if el.shape == ElementShape::Tria3 { "triangle" } else { "quad" };
+            assert_eq!(cells[e]["type"], ty);
+            let nodes: Vec<usize> = cells[e]["nodes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
+            assert_eq!(nodes, el.nodes);
+            assert_eq!(data["element_id"][e][0].as_f64().unwrap(), el.id as f64);
+            for p in &map.plies {
+                let prefix = if layup { format!("{}_", p.ply) } else { String::new() };
+                let get = |f: &str| f64s(&data[&format!("{prefix}{f}")][e]);
+                let covered = get("covered")[0];
+                match &p.elements[e] {
+                    None => {
+                        assert_eq!(covered, 0.0);
+                        for f in ["warp", "weft", "shear_deg", "thickness", "vf", "permeability"] {
+                            assert!(get(f).iter().all(|&v| v == 0.0), "{f} of uncovered element {}", el.id);
+                        }
+                    }
+                    Some(fib) => {
+                        assert_eq!(covered, 1.0);
+                        let (warp, weft) = (vec3(&get("warp")), vec3(&get("weft")));
+                        assert_eq!(warp, fib.warp);
+                        assert_frame(&mesh, e, warp, weft, get("shear_deg")[0], EXACT_TOL, "vtu");
+                        let theta = angle_about(mesh.first_edge(e).unwrap(), warp, mesh.normal(e).unwrap());
+                        assert!((theta - fib.theta).abs() < 1e-12);
+                        let k = get("permeability");
+                        let want = fib.permeability.unwrap();
+                        for r in 0..3 {
+                            for c in 0..3 {
+                                assert_eq!(k[3 * r + c], want[(r, c)], "row-major permeability");
+                            }
+                        }
+                    }
+                }
+            }
+            if layup {
+                assert_eq!(data["laminate_thickness"][e][0].as_f64().unwrap(), map.thickness[e]);
+                assert_eq!(data["mean_vf"][e][0].as_f64().unwrap(), map.mean_vf[e].unwrap_or(0.0));
+            }
+        }
+    }
+}
+
+#[test]
+fn nastran_theta_reproduces_warp() {
+    let mesh = mesh();
+    for layup in [false, true] {
+        let map = layup_map(&mesh, layup);
+        let dir = tempfile::tempdir().unwrap();
+        let files = write(&mesh, &map, FlowFormat::Nastran, &dir.path().join("flow.bdf"));
+        let names: Vec<String> = files.iter().map(|f| f.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        if layup {
+            assert_eq!(names, ["flow_base.bdf", "flow_p45.bdf", "flow_p-45.bdf"]);
+        } else {
+            assert_eq!(names, ["flow.bdf"]);
+        }
+        if !python_ready() {
+            continue;
+        }
+        let s = readback("nastran", &files);
+        for (deck, ply) in s["decks"].as_array().unwrap().iter().zip(&map.plies) {
+            // Grids: same ids, coordinates to 16-character precision; meshio agrees.
+            let grids = deck["grids"].as_object().unwrap();
+            assert_eq!(grids.len(), mesh.nodes.len());
+            let mio = deck["meshio_points"].as_array().unwrap();
+            assert_eq!(mio.len(), mesh.nodes.len());
+            let mut read_nodes = Vec::new();
+            for (k, id) in mesh.node_ids.iter().enumerate() {
+                let p = vec3(&f64s(&grids[&id.to_string()]));
+                assert!((p - mesh.nodes[k].coords).norm() < 1e-13, "grid {id}");
+                assert!((vec3(&f64s(&mio[k])) - mesh.nodes[k].coords).norm() < 1e-13, "meshio grid {id}");
+                read_nodes.push(Point::from(p));
+            }
+            let back = FlowMesh { nodes: read_nodes, ..mesh.clone() };
+            let els = deck["elements"].as_object().unwrap();
+            assert_eq!(els.len(), mesh.elements.len());
+            for (e, el) in mesh.elements.iter().enumerate() {
+                let r = &els[&el.id.to_string()];
+                assert_eq!(r["type"], if el.shape == ElementShape::Tria3 { "CTRIA3" } else { "CQUAD4" });
+                let nodes: Vec<u64> = r["nodes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+                assert_eq!(nodes, el.nodes.iter().map(|&k| mesh.node_ids[k]).collect::<Vec<_>>());
+                assert!(r["mcid"].is_null(), "THETA must be read as a real angle, not a coordinate system");
+                match &ply.elements[e] {
+                    None => assert_eq!(r["pid"], 2, "uncovered element {} must have its own PID", el.id),
+                    Some(fib) => {
+                        assert_eq!(r["pid"], 1);
+                        let theta = r["theta"].as_f64().unwrap();
+                        assert!((theta - fib.theta.to_degrees()).abs() < LARGE_FIELD_DEG_TOL, "{theta}");
+                        let n = back.normal(e).unwrap();
+                        let warp = rotate(back.first_edge(e).unwrap(), n, theta.to_radians());
+                        assert!((warp - fib.warp).norm() < LARGE_FIELD_DIR_TOL, "element {}: THETA does not give the warp", el.id);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn abaqus_distributions() {
+    let mesh = mesh();
+    let map = layup_map(&mesh, true);
+    let dir = tempfile::tempdir().unwrap();
+    let files = write(&mesh, &map, FlowFormat::Abaqus, &dir.path().join("flow.inp"));
+    if !python_ready() {
+        return;
+    }
+    let s = readback("abaqus", &files);
+    assert_eq!(s["meshio_points"].as_array().unwrap().len(), mesh.nodes.len());
+    assert_eq!(s["meshio_cells"].as_array().unwrap().len(), mesh.elements.len());
+    let ids: Vec<u64> = s["node_ids"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+    assert_eq!(ids, mesh.node_ids);
+    let mut eids: Vec<u64> = s["element_ids"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+    let mut want: Vec<u64> = mesh.elements.iter().map(|e| e.id).collect();
+    eids.sort();
+    want.sort();
+    assert_eq!(eids, want);
+    assert_eq!(s["tables"]["DRAPE_DIRECTIONS"], serde_json::json!(["COORD3D", "COORD3D"]));
+    for (k, ply) in map.plies.iter().enumerate() {
+        let tag = drape::export::flow::abaqus_ply_tag(k, &ply.ply);
+        let d = &s["distributions"][&format!("{tag}_DIR")];
+        assert_eq!(d["location"], "ELEMENT");
+        assert_eq!(d["table"], "DRAPE_DIRECTIONS");
+        assert_eq!(f64s(&d["default"]).len(), 6);
+        let ori = &s["orientations"][&format!("{tag}_ORI")];
+        assert_eq!(ori["lines"][0][0], format!("{tag}_DIR"));
+        let covered: Vec<u64> = s["elsets"][&tag].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+        let rows = d["rows"].as_object().unwrap();
+        for (e, el) in mesh.elements.iter().enumerate() {
+            match &ply.elements[e] {
+                None => {
+                    assert!(!rows.contains_key(&el.id.to_string()) && !covered.contains(&el.id));
+                    let unc = s["elsets"][&format!("{tag}_UNCOVERED")].as_array().unwrap();
+                    assert!(unc.iter().any(|v| v.as_u64() == Some(el.id)));
+                }
+                Some(fib) => {
+                    assert!(covered.contains(&el.id));
+                    let r = f64s(&rows[&el.id.to_string()]);
+                    let (a, b) = (vec3(&r[0..3]), vec3(&r[3..6]));
+                    assert_frame(&mesh, e, a, b, fib.shear.to_degrees(), EXACT_TOL, "abaqus");
+                    let theta = angle_about(mesh.first_edge(e).unwrap(), a, mesh.normal(e).unwrap());
+                    assert!((theta - fib.theta).abs() < 1e-12);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn optistruct_ply_drape() {
+    let mesh = mesh();
+    let map = layup_map(&mesh, true);
+    let dir = tempfile::tempdir().unwrap();
+    let files = write(&mesh, &map, FlowFormat::OptiStruct, &dir.path().join("flow.fem"));
+    if !python_ready() {
+        return;
+    }
+    let s = readback("optistruct", &files);
+    let els = &s["elements"];
+    for (k, ply) in map.plies.iter().enumerate() {
+        let id = (k + 1).to_string();
+        let p = &s["plies"][&id];
+        assert_eq!(p["did"].as_u64().unwrap(), (k + 1) as u64);
+        assert_eq!(p["esids"], serde_json::json!([k + 1]));
+        assert!((p["t"].as_f64().unwrap() - NOMINAL_T).abs() < 1e-15);
+        let set: Vec<u64> = s["sets"][&id].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+        let covered: Vec<u64> =
+            mesh.elements.iter().zip(&ply.elements).filter(|(_, f)| f.is_some()).map(|(e, _)| e.id).collect();
+        assert_eq!(set, covered);
+        let drape = s["drapes"][&id].as_object().unwrap();
+        assert_eq!(drape.len(), covered.len());
+        for (e, el) in mesh.elements.iter().enumerate() {
+            let Some(fib) = &ply.elements[e] else { continue };
+            let row = f64s(&drape[&el.id.to_string()]);
+            assert!((row[0] - fib.thickness / fib.nominal_thickness).abs() < 1e-12, "thinning");
+            // Nominal angles are consistent across plies here, so DRAPE THETA = angle change.
+            assert!((row[1] - fib.angle_change.to_degrees()).abs() < LARGE_FIELD_DEG_TOL, "drape angle {}", row[1]);
+            let el_theta = els[&el.id.to_string()]["theta"].as_f64().unwrap();
+            let total = el_theta + p["theta"].as_f64().unwrap() + row[1];
+            let warp = rotate(mesh.first_edge(e).unwrap(), mesh.normal(e).unwrap(), total.to_radians());
+            assert!((warp - fib.warp).norm() < LARGE_FIELD_DIR_TOL, "element {}: angles do not give the warp", el.id);
+        }
+        assert!((wrap_deg(p["theta"].as_f64().unwrap()) - wrap_deg((PLIES[k].1 - PLIES[0].1).to_degrees())).abs() < 1e-8);
+    }
+    // Element 16 is covered by the base ply only in the single-net map; here p45 covers it.
+    assert_eq!(els["16"]["pid"], 1);
+}
+
+#[test]
+fn rtmsim_mesh_sets_and_parameters() {
+    let mesh = mesh();
+    for layup in [false, true] {
+        let map = layup_map(&mesh, layup);
+        let dir = tempfile::tempdir().unwrap();
+        let report = write_rtmsim(&mesh, &map, &dir.path().join("flow.bdf")).unwrap();
+        let names: Vec<String> = report.files.iter().map(|f| f.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, ["flow.bdf", "flow_input.txt"]);
+        eprintln!(
+            "rtmsim layup={layup}: {} group(s) found, {} region(s), {} merged, max direction error {:.3} deg",
+            report.groups_found,
+            report.regions.len(),
+            report.merged_elements,
+            report.max_direction_error_deg
+        );
+        assert!(report.regions.len() <= MAX_RTMSIM_SETS + 1 && report.regions.len() <= report.groups_found);
+        let uncovered: Vec<u64> = if layup { vec![] } else { vec![16] };
+        assert_eq!(report.uncovered, uncovered);
+        if !python_ready() {
+            continue;
+        }
+        let s = readback("rtmsim", &report.files);
+        assert_eq!(s["meshfilename"], "flow.bdf");
+        let ids_of = |v: &Value| -> Vec<u64> { v.as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect() };
+        assert_eq!(ids_of(&s["uncovered"]), uncovered);
+        // Triangles: each covered tri by its id, each covered quad as two (SPLIT lines).
+        let tris = s["tris"].as_object().unwrap();
+        let splits: Vec<Vec<u64>> = s["splits"].as_array().unwrap().iter().map(ids_of).collect();
+        let mut tri_of = std::collections::BTreeMap::new(); // tri id -> element index
+        for (e, el) in mesh.elements.iter().enumerate() {
+            if uncovered.contains(&el.id) {
+                assert!(!tris.contains_key(&el.id.to_string()));
+                continue;
+            }
+            let mine: Vec<u64> = match el.shape {
+                ElementShape::Tria3 => vec![el.id],
+                ElementShape::Quad4 => {
+                    let sp = splits.iter().find(|s| s[0] == el.id).expect("quad split recorded");
+                    vec![sp[1], sp[2]]
+                }
+            };
+            let mut corners = std::collections::BTreeSet::new();
+            for t in &mine {
+                for n in ids_of(&tris[&t.to_string()]) {
+                    corners.insert(n);
+                }
+                tri_of.insert(*t, e);
+            }
+            let want: std::collections::BTreeSet<u64> = el.nodes.iter().map(|&k| mesh.node_ids[k]).collect();
+            assert_eq!(corners, want, "element {} triangles", el.id);
+        }
+        assert_eq!(tris.len(), tri_of.len());
+        assert_eq!(s["meshio_triangles"].as_u64().unwrap() as usize, tri_of.len());
+        for (id, p) in s["grids"].as_object().unwrap() {
+            let k = mesh.node_ids.iter().position(|n| n.to_string() == *id).unwrap();
+            assert!((vec3(&f64s(p)) - mesh.nodes[k].coords).norm() < SHORT_FIELD_TOL, "grid {id}");
+        }
+        // Regions: main = cells in no set; set s = region s; values as reported.
+        let params: Vec<Vec<f64>> = s["params"].as_array().unwrap().iter().map(f64s).collect();
+        let sets: Vec<Vec<u64>> = s["sets"].as_array().unwrap().iter().map(ids_of).collect();
+        let types: Vec<u64> = ids_of(&s["patchtypes"]);
+        let mut region_of_tri = std::collections::BTreeMap::new();
+        for (r, reg) in report.regions.iter().enumerate() {
+            let p = &params[r];
+            let want = [reg.thickness, reg.porosity, reg.permeability, reg.ratio, reg.refdir.x, reg.refdir.y, reg.refdir.z];
+            assert_eq!(p[..], want[..], "region {r} parameters");
+            if r > 0 {
+                assert_eq!(types[r - 1], 2);
+                for t in &sets[r - 1] {
+                    region_of_tri.insert(*t, r);
+                }
+            }
+        }
+        for s_unused in report.regions.len()..=MAX_RTMSIM_SETS {
+            assert_eq!(types[s_unused - 1], 0);
+            assert!(sets[s_unused - 1].is_empty());
+        }
+        assert_eq!(s["i_interactive"].as_u64().unwrap(), if report.regions.len() > 1 { 2 } else { 1 });
+        let mut max_err: f64 = 0.0;
+        for (t, &e) in &tri_of {
+            let r = *region_of_tri.get(t).unwrap_or(&0);
+            assert!(report.regions[r].elements.contains(&mesh.elements[e].id), "tri {t} in the wrong region");
+            // The reference direction projected onto the element vs the element's own K1 axis.
+            let n = mesh.normal(e).unwrap();
+            let k = map.permeability[e].unwrap();
+            let eig = k.symmetric_eigen();
+            let (mut best, mut dir) = (f64::MIN, Vector::zeros());
+            for c in 0..3 {
+                let v: Vector = eig.eigenvectors.column(c).into();
+                if v.dot(&n).abs() < 0.5 && eig.eigenvalues[c] > best {
+                    best = eig.eigenvalues[c];
+                    dir = v;
+                }
+            }
+            let rd = vec3(&params[r][4..7]);
+            let p = (rd - n * n.dot(&rd)).normalize();
+            max_err = max_err.max(p.dot(&dir).abs().min(1.0).acos().to_degrees());
+            // Porosity of the element within the region's bin unless its group was merged.
+            if report.merged_elements == 0 {
+                let por = 1.0 - map.mean_vf[e].unwrap();
+                assert!((por - params[r][1]).abs() <= drape::export::flow::POROSITY_BIN, "porosity");
+            }
+        }
+        assert!((max_err - report.max_direction_error_deg).abs() < 1e-6, "{max_err} vs {}", report.max_direction_error_deg);
+    }
+}
+
+#[test]
+fn csv_rows() {
+    let mesh = mesh();
+    let map = layup_map(&mesh, true);
+    let dir = tempfile::tempdir().unwrap();
+    let files = write(&mesh, &map, FlowFormat::Csv, &dir.path().join("flow.csv"));
+    let text = std::fs::read_to_string(&files[0]).unwrap();
+    assert_eq!(text.lines().next(), Some(FLOW_CSV_HEADER));
+    if !python_ready() {
+        return;
+    }
+    let s = readback("csv", &files);
+    assert_eq!(s["widths"], serde_json::json!([23]));
+    let rows = s["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), mesh.elements.len() * map.plies.len());
+    let num = |r: &Value, c: &str| r[c].as_str().unwrap().parse::<f64>().unwrap();
+    for (e, el) in mesh.elements.iter().enumerate() {
+        for (k, ply) in map.plies.iter().enumerate() {
+            let r = &rows[e * map.plies.len() + k];
+            assert_eq!(r["element_id"], el.id.to_string());
+            assert_eq!(r["ply"], ply.ply.as_str());
+            match &ply.elements[e] {
+                None => {
+                    assert_eq!(r["covered"], "0");
+                    assert_eq!(r["warp_x"], "");
+                    assert_eq!(r["k33"], "");
+                }
+                Some(fib) => {
+                    assert_eq!(r["covered"], "1");
+                    let warp = Vector::new(num(r, "warp_x"), num(r, "warp_y"), num(r, "warp_z"));
+                    let weft = Vector::new(num(r, "weft_x"), num(r, "weft_y"), num(r, "weft_z"));
+                    assert_frame(&mesh, e, warp, weft, num(r, "shear_deg"), EXACT_TOL, "csv");
+                    let theta = num(r, "theta_deg").to_radians();
+                    let from_theta = rotate(mesh.first_edge(e).unwrap(), mesh.normal(e).unwrap(), theta);
+                    assert!((from_theta - warp).norm() < 1e-12);
+                    assert!((num(r, "angle_change_deg") - fib.angle_change.to_degrees()).abs() < 1e-12);
+                    assert_eq!(num(r, "k12"), fib.permeability.unwrap()[(0, 1)]);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn non_finite_is_refused_and_nothing_written() {
+    let mesh = mesh();
+    let mut map = layup_map(&mesh, true);
+    map.plies[1].elements[2].as_mut().unwrap().theta = f64::NAN;
+    let dir = tempfile::tempdir().unwrap();
+    for format in FlowFormat::ALL {
+        let out = dir.path().join(format!("flow.{}", format.name()));
+        let e = write_flow(&mesh, &map, format, &out).unwrap_err();
+        assert!(matches!(e, ExportError::FlowNonFinite { .. }), "{e}");
+        let msg = e.to_string();
+        assert!(msg.contains("'p45'") && msg.contains("element 42") && msg.contains("theta"), "{msg}");
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // A map that does not fit the mesh is refused too.
+    let mut short = layup_map(&mesh, false);
+    short.plies[0].elements.pop();
+    let e = write_flow(&mesh, &short, FlowFormat::Csv, &dir.path().join("x.csv")).unwrap_err().to_string();
+    assert!(e.contains("5 entries for 6 flow elements"), "{e}");
+    // RTMsim needs permeability.
+    let mut noperm = layup_map(&mesh, false);
+    noperm.permeability.iter_mut().for_each(|k| *k = None);
+    let e = write_flow(&mesh, &noperm, FlowFormat::Rtmsim, &dir.path().join("r.bdf")).unwrap_err().to_string();
+    assert!(e.contains("permeability"), "{e}");
+}
+
+/// More groups than RTMsim's 1 + 4 regions: the smallest groups are merged into the nearest
+/// written region, every covered element still lands in exactly one region.
+#[test]
+fn rtmsim_merges_excess_groups() {
+    let mesh = mesh();
+    let mut map = layup_map(&mesh, false);
+    // Element 16 covered too, and every element in its own thickness bin (x 1.3 each).
+    map.plies[0].elements[5] = Some(fibres(&mesh, 5, 0, 0.0));
+    for e in 0..mesh.elements.len() {
+        let f = map.plies[0].elements[e].as_mut().unwrap();
+        f.thickness = NOMINAL_T * 1.3f64.powi(e as i32);
+        map.thickness[e] = f.thickness;
+        map.mean_vf[e] = Some(f.vf);
+        map.permeability[e] = f.permeability;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let report = write_rtmsim(&mesh, &map, &dir.path().join("merged.bdf")).unwrap();
+    let input = std::fs::read_to_string(&report.files[1]).unwrap();
+    eprintln!("{input}");
+    assert_eq!(report.groups_found, 6);
+    assert_eq!(report.regions.len(), MAX_RTMSIM_SETS + 1);
+    assert_eq!(report.merged_elements, 1);
+    let mut all: Vec<u64> = report.regions.iter().flat_map(|r| r.elements.clone()).collect();
+    all.sort();
+    let mut want: Vec<u64> = mesh.elements.iter().map(|e| e.id).collect();
+    want.sort();
+    assert_eq!(all, want);
+    assert_eq!(report.regions[0].set, None);
+    assert_eq!(report.regions.iter().skip(1).map(|r| r.set.unwrap()).collect::<Vec<_>>(), [1, 2, 3, 4]);
+    if !python_ready() {
+        return;
+    }
+    let s = readback("rtmsim", &report.files);
+    let sets = s["sets"].as_array().unwrap();
+    assert!(sets.iter().all(|v| !v.as_array().unwrap().is_empty()), "all four sets used");
+    assert_eq!(s["patchtypes"], serde_json::json!([2, 2, 2, 2]));
+}

@@ -1,0 +1,354 @@
+#!/usr/bin/env python3
+"""Independent read-back of drape's flow-mesh exports (not drape's code).
+
+Usage: python3 tools/flow_readback.py FORMAT FILE [FILE...]
+
+  vtu FILE            meshio: points, cells in file order, cell data by name
+  nastran FILE...     pyNastran (BDF, xref off) per deck: grids, elements with PID and THETA;
+                      meshio on the same deck: its GRID points (meshio skips elements that carry
+                      a THETA field, so only the points are compared)
+  abaqus FILE         meshio for nodes and elements; our parser of *ELSET, *DISTRIBUTION TABLE,
+                      *DISTRIBUTION and *ORIENTATION as the Abaqus Keywords Reference lays them out
+  optistruct FILE     our parser of large-field fixed format (GRID*, CTRIA3*, CQUAD4*, SET*,
+                      DRAPE*, PLY*) per the OptiStruct Reference Guide
+  rtmsim MESH INPUT   our parser following RTMsim's read_nastran_mesh (8-character columns,
+                      SETs numbered by order) and its 14-line input file; meshio on the mesh
+  csv FILE            Python's csv module
+
+Prints one JSON object to stdout. Exit status 2 on bad arguments.
+"""
+import csv
+import json
+import math
+import sys
+
+# ---------------------------------------------------------------- helpers
+
+
+def nastran_real(text):
+    """A Nastran real: 1.5, .5, 1.5E-3, 1.5-3 (implicit exponent), -.5+2."""
+    t = text.strip().lower().replace("d", "e")
+    try:
+        return float(t)
+    except ValueError:
+        pass
+    for k in range(len(t) - 1, 0, -1):
+        if t[k] in "+-" and t[k - 1] != "e":
+            return float(t[:k] + "e" + t[k:])
+    raise ValueError("not a Nastran real: %r" % text)
+
+
+def large_entries(path):
+    """Large-field fixed-format entries of a bulk section: [(name, [fields 2..])]."""
+    entries = []
+    in_bulk = False
+    with open(path) as f:
+        for raw in f:
+            line = raw.rstrip("\n")
+            if line.startswith("$") or not line.strip():
+                continue
+            if line.strip().upper() == "BEGIN BULK":
+                in_bulk = True
+                continue
+            if not in_bulk:
+                continue
+            if line.strip().upper() == "ENDDATA":
+                break
+            head = line[:8]
+            fields = [line[8 + 16 * i: 24 + 16 * i].strip() for i in range(4)]
+            if head.startswith("*"):
+                if not entries:
+                    raise SystemExit("%s: continuation before any entry" % path)
+                entries[-1][1].extend(fields)
+            else:
+                name = head.strip()
+                if not name.endswith("*"):
+                    raise SystemExit("%s: not a large-field entry: %r" % (path, line))
+                entries.append((name[:-1], fields))
+    return entries
+
+
+# ---------------------------------------------------------------- formats
+
+
+def read_vtu(path):
+    import meshio
+    import numpy as np
+
+    m = meshio.read(path)
+    cells = []
+    for block in m.cells:
+        for c in np.asarray(block.data):
+            cells.append({"type": block.type, "nodes": [int(x) for x in c]})
+    data = {}
+    for name, arrays in m.cell_data.items():
+        values = []
+        for a in arrays:
+            a = np.asarray(a, dtype=float)
+            values.extend(a.reshape(len(a), -1).tolist())
+        data[name] = values
+    return {"points": np.asarray(m.points, dtype=float).tolist(), "cells": cells, "cell_data": data}
+
+
+def read_nastran(paths):
+    import meshio
+    from pyNastran.bdf.bdf import BDF
+
+    decks = []
+    for path in paths:
+        model = BDF(debug=None, log=None, mode="msc")
+        model.read_bdf(path, xref=False, punch=False)
+        grids = {int(nid): [float(x) for x in n.xyz] for nid, n in model.nodes.items()}
+        elements = {}
+        for eid, e in model.elements.items():
+            theta = e.theta_mcid
+            elements[int(eid)] = {
+                "type": e.type,
+                "pid": int(e.pid),
+                "nodes": [int(n) for n in e.node_ids],
+                "theta": float(theta) if isinstance(theta, float) else None,
+                "mcid": int(theta) if isinstance(theta, int) else None,
+            }
+        m = meshio.read(path, file_format="nastran")
+        decks.append(
+            {
+                "path": path,
+                "grids": grids,
+                "elements": elements,
+                "meshio_points": [[float(x) for x in p] for p in m.points],
+            }
+        )
+    return {"decks": decks}
+
+
+def read_abaqus(path):
+    import meshio
+    import numpy as np
+
+    m = meshio.read(path, file_format="abaqus")
+    cells = []
+    for block in m.cells:
+        for c in np.asarray(block.data):
+            cells.append({"type": block.type, "nodes": [int(x) for x in c]})
+
+    # Our parser: keyword lines start with '*', '**' are comments, parameters NAME=VALUE.
+    elsets, tables, dists, oris = {}, {}, {}, {}
+    node_ids, element_ids = [], []
+    current = None
+    with open(path) as f:
+        for raw in f:
+            line = raw.strip()
+            if not line or line.startswith("**"):
+                continue
+            if line.startswith("*"):
+                parts = [p.strip() for p in line[1:].split(",")]
+                kw = parts[0].upper()
+                params = {}
+                for p in parts[1:]:
+                    if "=" in p:
+                        k, v = p.split("=", 1)
+                        params[k.strip().upper()] = v.strip()
+                    elif p:
+                        params[p.upper()] = True
+                current = (kw, params)
+                if kw == "ELSET":
+                    elsets[params["ELSET"]] = []
+                elif kw == "DISTRIBUTION TABLE":
+                    tables[params["NAME"]] = None
+                elif kw == "DISTRIBUTION":
+                    dists[params["NAME"]] = {
+                        "location": params.get("LOCATION"),
+                        "table": params.get("TABLE"),
+                        "default": None,
+                        "rows": {},
+                    }
+                elif kw == "ORIENTATION":
+                    oris[params["NAME"]] = {"params": params, "lines": []}
+                continue
+            if current is None:
+                continue
+            kw, params = current
+            fields = [x.strip() for x in line.split(",")]
+            if kw == "NODE":
+                node_ids.append(int(fields[0]))
+            elif kw == "ELEMENT":
+                element_ids.append(int(fields[0]))
+            elif kw == "ELSET":
+                elsets[params["ELSET"]].extend(int(x) for x in fields if x)
+            elif kw == "DISTRIBUTION TABLE":
+                tables[params["NAME"]] = [x.upper() for x in fields if x]
+            elif kw == "DISTRIBUTION":
+                d = dists[params["NAME"]]
+                if fields[0] == "":
+                    if d["default"] is not None or d["rows"]:
+                        raise SystemExit("%s: default line of %s is not first" % (path, params["NAME"]))
+                    d["default"] = [float(x) for x in fields[1:]]
+                else:
+                    if d["default"] is None:
+                        raise SystemExit("%s: distribution %s has no default line first" % (path, params["NAME"]))
+                    d["rows"][int(fields[0])] = [float(x) for x in fields[1:]]
+            elif kw == "ORIENTATION":
+                oris[params["NAME"]]["lines"].append(fields)
+    return {
+        "meshio_points": np.asarray(m.points, dtype=float).tolist(),
+        "meshio_cells": cells,
+        "node_ids": node_ids,
+        "element_ids": element_ids,
+        "elsets": elsets,
+        "tables": tables,
+        "distributions": {k: dict(v, rows={str(e): r for e, r in v["rows"].items()}) for k, v in dists.items()},
+        "orientations": oris,
+    }
+
+
+def read_optistruct(path):
+    grids, elements, sets, drapes, plies = {}, {}, {}, {}, {}
+    for name, fields in large_entries(path):
+        if name == "GRID":
+            grids[int(fields[0])] = [nastran_real(x) for x in fields[2:5]]
+        elif name in ("CTRIA3", "CQUAD4"):
+            nn = 3 if name == "CTRIA3" else 4
+            theta = fields[2 + nn] if len(fields) > 2 + nn else ""
+            elements[int(fields[0])] = {
+                "type": name,
+                "pid": int(fields[1]),
+                "nodes": [int(x) for x in fields[2: 2 + nn]],
+                "theta": nastran_real(theta) if theta else None,
+            }
+        elif name == "SET":
+            if fields[1] != "ELEM" or fields[2] != "LIST":
+                raise SystemExit("%s: SET %s is not ELEM LIST" % (path, fields[0]))
+            sets[int(fields[0])] = [int(x) for x in fields[8:] if x]
+        elif name == "DRAPE":
+            rows = {}
+            for k in range(8, len(fields), 8):
+                line = fields[k: k + 4]
+                if not any(line):
+                    continue
+                if line[0] != "ELEM":
+                    raise SystemExit("%s: DRAPE %s: entity type %r" % (path, fields[0], line[0]))
+                rows[line[1]] = [nastran_real(line[2]), nastran_real(line[3])]
+            drapes[int(fields[0])] = rows
+        elif name == "PLY":
+            plies[int(fields[0])] = {
+                "mid": int(fields[1]),
+                "t": nastran_real(fields[2]),
+                "theta": nastran_real(fields[3]) if fields[3] else 0.0,
+                "did": int(fields[6]),
+                "esids": [int(x) for x in fields[8:] if x],
+            }
+    return {
+        "grids": {str(k): v for k, v in grids.items()},
+        "elements": {str(k): v for k, v in elements.items()},
+        "sets": {str(k): v for k, v in sets.items()},
+        "drapes": {str(k): v for k, v in drapes.items()},
+        "plies": {str(k): v for k, v in plies.items()},
+    }
+
+
+def rtmsim_number(text):
+    """RTMsim's own conversion of a GRID coordinate field (pre.jl)."""
+    t = text.replace(" ", "").replace("E", "").replace("e", "")
+    t = t.replace("-", "e-").replace("+", "e+")
+    if t.startswith("e"):
+        t = t[1:]
+    return float(t)
+
+
+def read_rtmsim(mesh_path, input_path):
+    import meshio
+
+    grids, tris, sets, splits, uncovered = {}, {}, [[], [], [], []], [], []
+    set_index = 0
+    in_set = False
+    with open(mesh_path) as f:
+        for raw in f:
+            line = raw.rstrip("\n")
+            if line.startswith("$$ SPLIT"):
+                splits.append([int(x) for x in line.split()[2:]])
+            if line.startswith("$$ UNCOVERED"):
+                uncovered.extend(int(x) for x in line.split()[2:])
+            if len(line) < 8:
+                continue
+            if in_set and line[:8] != " " * 8:
+                in_set = False
+                set_index += 1
+            card = line[:8]
+            if card == "GRID    ":
+                grids[int(line[8:16])] = [rtmsim_number(line[24 + 8 * i: 32 + 8 * i]) for i in range(3)]
+            elif card == "CTRIA3  ":
+                tris[int(line[8:16])] = [int(line[24 + 8 * i: 32 + 8 * i]) for i in range(3)]
+            elif card[:3] == "SET" or in_set:
+                in_set = True
+                for x in line[8:].replace(" ", "").split(","):
+                    if x:
+                        if set_index >= 4:
+                            raise SystemExit("%s: more than four SETs" % mesh_path)
+                        sets[set_index].append(int(x))
+    with open(input_path) as f:
+        rows = [line.rstrip("\n").split(" ") for line in f]
+    if len(rows) < 14:
+        raise SystemExit("%s: %d lines, RTMsim reads 14" % (input_path, len(rows)))
+    params = [[float(x) for x in rows[5 + k][:7]] for k in range(5)]
+    m = meshio.read(mesh_path, file_format="nastran")
+    n_tri = sum(len(b.data) for b in m.cells if b.type == "triangle")
+    return {
+        "grids": {str(k): v for k, v in grids.items()},
+        "tris": {str(k): v for k, v in tris.items()},
+        "sets": sets,
+        "splits": splits,
+        "uncovered": uncovered,
+        "meshfilename": rows[1][0],
+        "params": params,
+        "patchtypes": [int(x) for x in rows[10][:4]],
+        "i_interactive": int(rows[12][0]),
+        "meshio_points": len(m.points),
+        "meshio_triangles": n_tri,
+    }
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        r = csv.reader(f)
+        header = next(r)
+        rows = [dict(zip(header, row)) for row in r]
+        widths = sorted({len(row) for row in rows})
+    return {"header": header, "rows": rows, "widths": widths}
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    fmt, files = argv[0], argv[1:]
+    if fmt == "vtu" and len(files) == 1:
+        out = read_vtu(files[0])
+    elif fmt == "nastran":
+        out = read_nastran(files)
+    elif fmt == "abaqus" and len(files) == 1:
+        out = read_abaqus(files[0])
+    elif fmt == "optistruct" and len(files) == 1:
+        out = read_optistruct(files[0])
+    elif fmt == "rtmsim" and len(files) == 2:
+        out = read_rtmsim(files[0], files[1])
+    elif fmt == "csv" and len(files) == 1:
+        out = read_csv(files[0])
+    else:
+        print(__doc__, file=sys.stderr)
+        return 2
+
+    def clean(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return str(v)
+        if isinstance(v, dict):
+            return {str(k): clean(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [clean(x) for x in v]
+        return v
+
+    json.dump(clean(out), sys.stdout)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
