@@ -1,6 +1,7 @@
 //! The `drape` command line: argument parsing and subcommands; nothing numerical lives here.
 mod bench;
 mod calibrate;
+mod export;
 mod kinematic;
 mod progress;
 mod refine;
@@ -66,6 +67,8 @@ pub enum Command {
     Run(scene::RunArgs),
     /// Refine a kinematic net mechanically (tension, shear, bending, gravity, tool contact).
     Refine(refine::RefineArgs),
+    /// Map a draped net onto a resin-flow mesh and write fibre directions, shear, thickness and Vf.
+    Export(export::ExportArgs),
     /// Fit a material card's shear or knit tension law to test data.
     Calibrate(calibrate::CalibrateArgs),
     /// Virtual material tests on the mechanical model.
@@ -83,6 +86,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Bench(a) => bench::run(a),
         Command::Test(a) => virtual_test::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Export(a) => export::run(a),
     }
 }
 

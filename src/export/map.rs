@@ -119,6 +119,12 @@ impl PermeabilityModel {
     }
 }
 
+/// Fibre volume fraction assumed when a ply has no material card with a `[flow]` section (the
+/// commands say so when they use it).
+pub const DEFAULT_FIBRE_VOLUME_FRACTION: f64 = 0.5;
+/// Ply thickness assumed when a ply has neither a material card nor a thickness, metres.
+pub const DEFAULT_PLY_THICKNESS: f64 = 5.0e-4;
+
 /// What a ply is made of and how it is mapped.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlyMapSettings {
@@ -136,6 +142,48 @@ pub struct PlyMapSettings {
     /// element to count as covered (the flow mesh may be the tool, the part's mid-surface or its
     /// outer surface, so the net may sit up to a laminate thickness away).
     pub max_distance: f64,
+}
+
+impl PlyMapSettings {
+    /// Settings for `net` made of `card` (or the defaults when `None`; the returned notes say
+    /// which were assumed), `thickness` overriding the card's. The nominal warp is the net's
+    /// warp at its seed (meta `warp_direction`); the search reaches a cell plus the net's stack
+    /// offset plus its thickness off the net, which takes a flow mesh of the tool surface, the
+    /// part's mid-surface or the outer surface.
+    pub fn for_net(
+        net: &DrapeNet,
+        card: Option<&crate::material::MaterialCard>,
+        thickness: Option<f64>,
+        cavity: Cavity,
+        permeability: Option<PermeabilityModel>,
+    ) -> (PlyMapSettings, Vec<String>) {
+        let mut notes = Vec::new();
+        let thickness = thickness.or(card.map(|c| c.thickness)).unwrap_or_else(|| {
+            notes.push(format!(
+                "ply '{}': no material card or thickness: assumed t0 = {} mm",
+                net.name,
+                DEFAULT_PLY_THICKNESS * 1e3
+            ));
+            DEFAULT_PLY_THICKNESS
+        });
+        let vf = card.and_then(|c| c.flow).map(|f| f.fibre_volume_fraction).unwrap_or_else(|| {
+            notes.push(format!(
+                "ply '{}': no [flow] fibre_volume_fraction in a material card: assumed Vf0 = {DEFAULT_FIBRE_VOLUME_FRACTION}",
+                net.name
+            ));
+            DEFAULT_FIBRE_VOLUME_FRACTION
+        });
+        let nominal_warp = net
+            .meta
+            .get("warp_direction")
+            .and_then(|v| serde_json::from_value::<[f64; 3]>(v.clone()).ok())
+            .map(|w| Vector::new(w[0], w[1], w[2]))
+            .filter(|w| w.norm() > 0.0 && w.iter().all(|x| x.is_finite()))
+            .unwrap_or_else(Vector::zeros);
+        let stack = net.meta.get("stack_offset_max_m").and_then(|v| v.as_f64()).unwrap_or(0.0);
+        let max_distance = net.spacing + stack + thickness;
+        (PlyMapSettings { thickness, vf, cavity, permeability, nominal_warp, max_distance }, notes)
+    }
 }
 
 /// Why a net could not be mapped.

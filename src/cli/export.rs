@@ -1,0 +1,131 @@
+//! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
+//! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
+use super::{compute, input, Failure};
+use crate::export::flow::{write_flow, FlowFormat};
+use crate::export::flowmesh::read_flow_mesh;
+use crate::export::map::{map_net, Cavity, LayupMap, PermeabilityModel, PlyMapSettings};
+use crate::export::read_net;
+use crate::layup::unit_scale;
+use crate::material::MaterialCard;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Cavity on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum CavityArg {
+    /// Closed mould: thickness fixed, Vf = Vf0 / cos(shear).
+    Fixed,
+    /// Free thickness: t = t0 / cos(shear), Vf = Vf0.
+    Free,
+}
+
+/// Arguments of `drape export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Draped net (`<ply>.drape.json` from `drape run`, `drape kinematic` or `drape refine`).
+    #[arg(long)]
+    pub net: PathBuf,
+    /// Resin-flow shell mesh: Nastran (.bdf .nas .dat .fem), Abaqus (.inp), OBJ or Gmsh 4 (.msh).
+    #[arg(long)]
+    pub mesh: PathBuf,
+    /// Output format: vtu, nastran, abaqus, optistruct, rtmsim or csv.
+    #[arg(long)]
+    pub format: String,
+    /// Output file (formats that need two files put the second beside it).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Units of the flow mesh: m or mm.
+    #[arg(long, default_value = "m")]
+    pub mesh_units: String,
+    /// Material card for the ply's thickness, Vf and fibre radius (default: the card the net
+    /// records, if any).
+    #[arg(long)]
+    pub material: Option<PathBuf>,
+    /// Ply thickness as laid flat, m (overrides the card's).
+    #[arg(long)]
+    pub thickness: Option<f64>,
+    /// What shear does to thickness and fibre volume fraction.
+    #[arg(long, value_enum, default_value = "fixed")]
+    pub cavity: CavityArg,
+    /// Also write permeability tensors (Gebart's model on the fibre directions; needs a fibre
+    /// radius from the card's [flow] section or --fibre-radius).
+    #[arg(long)]
+    pub permeability: bool,
+    /// Fibre radius, m, for --permeability.
+    #[arg(long)]
+    pub fibre_radius: Option<f64>,
+}
+
+pub fn run(a: ExportArgs) -> Result<(), Failure> {
+    let format: FlowFormat = a.format.parse().map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
+    let scale = unit_scale(&a.mesh_units).map_err(|m| input(anyhow::anyhow!("--mesh-units: {m}")))?;
+    if let Some(t) = a.thickness {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(input(anyhow::anyhow!("--thickness must be a positive length in metres, got {t}")));
+        }
+    }
+    let net = read_net(&a.net).map_err(input)?;
+    let card_path = a.material.clone().or_else(|| net.meta.get("material").and_then(|m| m.as_str()).map(PathBuf::from));
+    let card = match &card_path {
+        Some(p) => Some(MaterialCard::load(p).map_err(|e| {
+            input(anyhow::anyhow!("{e}{}", if a.material.is_none() { " (the card the net records; give --material)" } else { "" }))
+        })?),
+        None => None,
+    };
+    let permeability = if a.permeability {
+        let radius = a.fibre_radius.or(card.as_ref().and_then(|c| c.flow).map(|f| f.fibre_radius)).ok_or_else(|| {
+            input(anyhow::anyhow!(
+                "--permeability needs a fibre radius: give --fibre-radius R (m) or a --material card with a [flow] section"
+            ))
+        })?;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(input(anyhow::anyhow!("--fibre-radius must be a positive length in metres, got {radius}")));
+        }
+        Some(PermeabilityModel { fibre_radius: radius })
+    } else {
+        None
+    };
+    let cavity = match a.cavity {
+        CavityArg::Fixed => Cavity::Fixed,
+        CavityArg::Free => Cavity::Free,
+    };
+    let t = Instant::now();
+    let mesh = read_flow_mesh(&a.mesh, scale).map_err(input)?;
+    let read_ms = t.elapsed().as_secs_f64() * 1e3;
+    let (settings, notes) = PlyMapSettings::for_net(&net, card.as_ref(), a.thickness, cavity, permeability);
+    for n in &notes {
+        eprintln!("note: {n}");
+    }
+    let t = Instant::now();
+    let ply = map_net(&net, &mesh, &settings).map_err(input)?;
+    let map_ms = t.elapsed().as_secs_f64() * 1e3;
+    let map = LayupMap::new(vec![ply], false, mesh.elements.len());
+    println!(
+        "flow mesh {}: {} nodes, {} elements (read in {read_ms:.1} ms)",
+        a.mesh.display(),
+        mesh.nodes.len(),
+        mesh.elements.len()
+    );
+    println!("{}", coverage_line(&map, 0));
+    println!("  mapped in {map_ms:.1} ms");
+    let written = write_flow(&mesh, &map, format, &a.out).map_err(compute)?;
+    for p in written {
+        println!("  wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// One line on ply `k` of a map: elements covered and their shear.
+pub(crate) fn coverage_line(map: &LayupMap, k: usize) -> String {
+    let ply = &map.plies[k];
+    let covered: Vec<f64> = ply.elements.iter().flatten().map(|f| f.shear.abs().to_degrees()).collect();
+    let max = covered.iter().cloned().fold(0.0, f64::max);
+    let mean = if covered.is_empty() { 0.0 } else { covered.iter().sum::<f64>() / covered.len() as f64 };
+    format!(
+        "  ply {}: covers {} of {} elements; |shear| max {max:.2} deg, mean {mean:.2} deg",
+        ply.ply,
+        covered.len(),
+        ply.elements.len()
+    )
+}
