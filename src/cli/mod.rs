@@ -3,6 +3,7 @@ mod bench;
 mod calibrate;
 mod kinematic;
 mod refine;
+mod report;
 mod scene;
 mod summary;
 mod virtual_test;
@@ -71,6 +72,8 @@ pub enum Command {
     Test(virtual_test::TestArgs),
     /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
     Bench(bench::BenchArgs),
+    /// Draw every ply of a run folder (shear maps, histograms, changes) and write an HTML page.
+    Report(report::ReportArgs),
 }
 
 /// Run a parsed command line.
@@ -82,6 +85,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Bench(a) => bench::run(a),
         Command::Test(a) => virtual_test::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Report(a) => report::run(a),
     }
 }
 
