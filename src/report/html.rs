@@ -69,7 +69,7 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
 const STYLE: &str = "body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:2em auto;max-width:1100px;color:#222;padding:0 1em}\
 h1{font-size:1.6em}h2{margin-top:2em;border-bottom:1px solid #ccc;padding-bottom:.2em}\
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:.3em .6em;text-align:right}\
-th{background:#f3f3f3}td.t,th.t{text-align:left}img{max-width:100%;border:1px solid #ddd;margin:.5em 0}\
+th{background:#f3f3f3}td.t,th.t{text-align:left}img{max-width:100%;height:auto;border:1px solid #ddd;margin:.5em 0}\
 .notes{background:#fff6e0;border-left:4px solid #e0a000;padding:.5em 1em}.small{color:#666;font-size:.9em}\
 dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dt{color:#666}dd{margin:0}\
 .pattern svg{max-width:100%;height:auto;border:1px solid #ddd}";

@@ -226,25 +226,30 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
     Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi })
 }
 
-/// The scale (metres per OBJ unit) under which most of the net's nodes lie inside the tool's
-/// bounding box (grown by 5% of its diagonal): the run may have read the OBJ in mm.
+/// The scale (metres per OBJ unit) the run read the tool with, which the net does not record:
+/// among [`TOOL_SCALES`], those under which the most nodes lie inside the scaled tool's bounding
+/// box (grown by 5% of its diagonal), the one whose box size is closest to the net's.
 fn guess_scale(tool: &RawTool, net: &DrapeNet) -> f64 {
     let placed: Vec<&Point> = net.positions.iter().zip(&net.status).filter(|(_, s)| **s == crate::kinematic::NodeStatus::Placed).map(|(p, _)| p).collect();
+    let tool_diag = (tool.hi - tool.lo).norm();
+    let net_diag = crate::geometry::surface::bounding_diagonal(&placed.iter().map(|p| **p).collect::<Vec<_>>());
     let inside = |s: f64| {
-        let grow = 0.05 * s * (tool.hi - tool.lo).norm();
+        let grow = 0.05 * s * tool_diag;
         placed
             .iter()
             .filter(|p| (0..3).all(|k| p[k] >= s * tool.lo[k] - grow && p[k] <= s * tool.hi[k] + grow))
             .count()
     };
-    let mut best = (TOOL_SCALES[0], inside(TOOL_SCALES[0]));
-    for &s in &TOOL_SCALES[1..] {
-        let n = inside(s);
-        if n > best.1 {
-            best = (s, n);
-        }
-    }
-    best.0
+    let counts: Vec<usize> = TOOL_SCALES.iter().map(|&s| inside(s)).collect();
+    let most = counts.iter().copied().max().unwrap_or(0);
+    let misfit = |s: f64| if net_diag > 0.0 && tool_diag > 0.0 { (s * tool_diag / net_diag).ln().abs() } else { 0.0 };
+    TOOL_SCALES
+        .iter()
+        .zip(&counts)
+        .filter(|(_, &c)| c == most)
+        .map(|(&s, _)| s)
+        .min_by(|a, b| misfit(*a).total_cmp(&misfit(*b)))
+        .unwrap_or(1.0)
 }
 
 /// One ply's inputs.
@@ -422,6 +427,23 @@ fn link_to(file: &Path, dir: &Path, out: &Path) -> String {
         format!("../{name}")
     } else {
         std::fs::canonicalize(file).unwrap_or(file.to_path_buf()).display().to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tool_scale_is_the_one_that_fits_the_net() {
+        let tool = |k: f64| RawTool { vertices: vec![], triangles: vec![], lo: Point::new(-k, -k, 0.0), hi: Point::new(k, k, k) };
+        let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
+        for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
+            net.positions[k] = Point::new(p.0, p.1, 0.09);
+            net.status[k] = crate::kinematic::NodeStatus::Placed;
+        }
+        assert_eq!(guess_scale(&tool(0.1), &net), 1.0, "metres");
+        assert_eq!(guess_scale(&tool(100.0), &net), 1e-3, "millimetres: both boxes hold the net, the mm one fits");
     }
 }
 

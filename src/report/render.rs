@@ -86,6 +86,8 @@ pub struct MapPicture {
     pub limit: f64,
     pub bar_label: String,
     pub marks: Vec<Mark>,
+    /// The map's pixel rectangle [x0, y0, x1, y1]: anything drawn outside it is painted over.
+    pub frame: [i32; 4],
 }
 
 /// What the tool layer of a map is made from.
@@ -110,14 +112,15 @@ pub fn layout_map(net: &DrapeNet, values: &[Option<f64>], tool: Option<&ToolLaye
         let depth = p.iter().map(|q| q.2).sum::<f64>() / 4.0;
         cells3.push((depth, p, v));
     });
-    let mut pic = MapPicture { limit, ..Default::default() };
+    let (left, top) = (10.0, TITLE_PX as f64);
+    let (w, h) = ((WIDTH - BAR_COLUMN_PX) as f64 - 20.0, HEIGHT as f64 - top - 40.0);
+    let frame = [left as i32, top as i32, (left + w) as i32, (top + h) as i32];
+    let mut pic = MapPicture { limit, frame, ..Default::default() };
     if cells3.is_empty() {
         return pic;
     }
     let pad = MAP_PAD * (b[1] - b[0]).max(b[3] - b[2]);
     let bounds = [b[0] - pad, b[1] + pad, b[2] - pad, b[3] + pad];
-    let (left, top) = (10.0, TITLE_PX as f64);
-    let (w, h) = ((WIDTH - BAR_COLUMN_PX) as f64 - 20.0, HEIGHT as f64 - top - 40.0);
     let fit = Fit::new(bounds, left, top, w, h);
     let px = |x: f64, y: f64| {
         let (a, b) = fit.pixel(x, y);
@@ -264,11 +267,9 @@ fn bold(size: f64) -> FontDesc<'static> {
 pub fn draw_map<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pic: &MapPicture) -> DrawResult {
     register_fonts();
     root.fill(&WHITE).map_err(de)?;
-    root.draw(&Text::new(pic.title.clone(), (20, 14), bold(24.0).color(&BLACK))).map_err(de)?;
-    root.draw(&Text::new(pic.subtitle.clone(), (20, 44), font(14.0).color(&RGBColor(90, 90, 90)))).map_err(de)?;
     for (r, g) in &pic.tool_runs {
         let c = RGBColor(*g, *g, *g);
-        root.draw(&Rectangle::new([(r[0], r[1]), (r[2] - 1, r[3] - 1)], c.filled())).map_err(de)?;
+        root.draw(&Rectangle::new([(r[0], r[1]), (r[2], r[3])], c.filled())).map_err(de)?;
     }
     for (p, g) in &pic.tool_triangles {
         let c = RGBColor(*g, *g, *g);
@@ -282,6 +283,14 @@ pub fn draw_map<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pic: &MapPict
             root.draw(&PathElement::new(ring, OUTLINE.stroke_width(1))).map_err(de)?;
         }
     }
+    // Tool triangles and cells may reach past the map: paint the margins white again.
+    let [x0, y0, x1, y1] = pic.frame;
+    let (w, h) = (WIDTH as i32, HEIGHT as i32);
+    for r in [[0, 0, w, y0], [0, y1, w, h], [0, 0, x0, h], [x1, 0, w, h]] {
+        root.draw(&Rectangle::new([(r[0], r[1]), (r[2], r[3])], WHITE.filled())).map_err(de)?;
+    }
+    root.draw(&Text::new(pic.title.clone(), (20, 14), bold(24.0).color(&BLACK))).map_err(de)?;
+    root.draw(&Text::new(pic.subtitle.clone(), (20, 44), font(14.0).color(&RGBColor(90, 90, 90)))).map_err(de)?;
     if pic.cells.is_empty() {
         let style = font(20.0).color(&BLACK).pos(Pos::new(HPos::Center, VPos::Center));
         root.draw(&Text::new("no complete cells to draw", (((WIDTH - BAR_COLUMN_PX) / 2) as i32, (HEIGHT / 2) as i32), style))
