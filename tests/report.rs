@@ -14,7 +14,7 @@ const R: f64 = 0.1;
 const N: usize = 31;
 const D: f64 = 0.007;
 /// Share of the distinct expected colours that must appear in a picture.
-const MIN_COLOURS_FOUND: f64 = 0.6;
+const MIN_COLOURS_FOUND: f64 = 0.85;
 const WHITE: [u8; 3] = [255, 255, 255];
 /// Pixels in the tool's greys when the tool is drawn (the visible rim of the hemisphere).
 const MIN_TOOL_PIXELS: usize = 5000;
@@ -77,6 +77,7 @@ fn check_picture(path: &Path) -> HashMap<[u8; 3], usize> {
 fn assert_colours(hist: &HashMap<[u8; 3], usize>, expected: &HashSet<[u8; 3]>, what: &str) {
     assert!(expected.len() > 5, "{what}: too few expected colours ({})", expected.len());
     let found = expected.iter().filter(|c| hist.contains_key(*c)).count();
+    eprintln!("{what}: {found} of {} expected colours found", expected.len());
     assert!(
         found as f64 >= MIN_COLOURS_FOUND * expected.len() as f64,
         "{what}: only {found} of {} expected colours are in the picture",
