@@ -270,6 +270,12 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
     assert!(html.contains("id=\"pattern-marker\"") && !html.contains("<?xml"), "patterns.svg is shown inline");
     assert!(html.contains("25.0%"), "nesting waste shown");
     assert!(html.contains("missing.obj"), "the page says the tool could not be drawn");
+
+    // A report written into the run folder itself, twice: its own SVGs are not flat patterns.
+    write_report(dir, dir, false).unwrap();
+    write_report(dir, dir, false).unwrap();
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    assert_eq!(html.matches("<div class=\"pattern\">").count(), 1, "only patterns.svg is a pattern");
 }
 
 #[test]

@@ -145,6 +145,8 @@ pub const LAYUP_FILE: &str = "layup.json";
 const NET_SUFFIX: &str = ".drape.json";
 /// Flat-pattern SVGs larger than this are linked from the page instead of inlined.
 const PATTERN_INLINE_LIMIT: u64 = 8 << 20;
+/// The kinds of picture, as file-name suffixes after `<ply>-`.
+const PICTURES: [&str; 3] = ["shear", "histogram", "change"];
 /// Candidate scales (metres per OBJ unit) tried when the tool's units are not recorded.
 const TOOL_SCALES: [f64; 2] = [1.0, 1e-3];
 
@@ -363,7 +365,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     } else {
         ProgressBar::hidden()
     };
-    if let Ok(style) = ProgressStyle::with_template("{msg:>24} [{bar:40}] {pos}/{len} pictures ({elapsed})") {
+    if let Ok(style) = ProgressStyle::with_template("{msg:>20} [{bar:40}] {pos}/{len} ({elapsed})") {
         bar.set_style(style.progress_chars("=> "));
     }
     bar.set_message("drawing");
@@ -381,8 +383,15 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
 
     // Flat patterns: every *.svg of the run folder.
     let mut patterns = Vec::new();
+    // A report written into DIR itself leaves its own pictures there: those are not patterns.
+    let own_picture = |name: &str| {
+        PICTURES.iter().any(|kind| inputs.iter().any(|i| name == format!("{}-{kind}.svg", i.stem)))
+    };
     for p in entries.iter().filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg")) && p.is_file()) {
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        if own_picture(&name) {
+            continue;
+        }
         let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
         let body = if size > PATTERN_INLINE_LIMIT {
             Err(link_to(p, dir, out))
