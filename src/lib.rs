@@ -11,6 +11,7 @@ pub mod layup;
 pub mod material;
 pub mod mechanics;
 pub mod numeric;
+pub mod report;
 
 pub use geometry::ToolSurface;
 pub use kinematic::{drape, DrapeNet, KinematicSettings};

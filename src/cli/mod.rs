@@ -5,6 +5,7 @@ mod export;
 mod kinematic;
 mod progress;
 mod refine;
+mod report;
 mod scene;
 mod summary;
 mod virtual_test;
@@ -75,6 +76,8 @@ pub enum Command {
     Test(virtual_test::TestArgs),
     /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
     Bench(bench::BenchArgs),
+    /// Draw every ply of a run folder (shear maps, histograms, changes) and write an HTML page.
+    Report(report::ReportArgs),
 }
 
 /// Run a parsed command line.
@@ -87,6 +90,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Test(a) => virtual_test::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Export(a) => export::run(a),
+        Command::Report(a) => report::run(a),
     }
 }
 

@@ -1,0 +1,203 @@
+//! The report page: one self-contained HTML file (inline CSS; pictures linked by file name from
+//! the same folder, flat patterns inlined).
+use super::{method_name, LayupRow, Page, PlyReport};
+use crate::kinematic::DrapeNet;
+use std::fmt::Write;
+
+/// Escape text for HTML element content and attribute values.
+pub fn escape(s: &str) -> String {
+    let mut o = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => o.push_str("&amp;"),
+            '<' => o.push_str("&lt;"),
+            '>' => o.push_str("&gt;"),
+            '"' => o.push_str("&quot;"),
+            '\'' => o.push_str("&#39;"),
+            _ => o.push(c),
+        }
+    }
+    o
+}
+
+/// An SVG document without its XML declaration and DOCTYPE, ready to inline in HTML.
+pub fn strip_prolog(svg: &str) -> &str {
+    svg.find("<svg").map_or(svg, |k| &svg[k..])
+}
+
+/// A number with `digits` decimals, or a dash when missing or not finite (never "NaN").
+fn num(x: Option<f64>, digits: usize) -> String {
+    match x {
+        Some(v) if v.is_finite() => format!("{v:.digits$}"),
+        _ => "—".into(),
+    }
+}
+
+/// Facts about a net worth showing next to its pictures.
+pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
+    let mut f = vec![
+        ("grid".to_string(), format!("{} × {} nodes, origin node ({}, {})", net.nu, net.nv, net.origin_node.0, net.origin_node.1)),
+        ("fibre spacing".to_string(), format!("{:.2} mm", net.spacing * 1e3)),
+    ];
+    let placed = net.status.iter().filter(|s| **s == crate::kinematic::NodeStatus::Placed).count();
+    let failed: Vec<String> = net.status_counts().into_iter().filter(|(s, _)| s.name() != "placed").map(|(s, n)| format!("{n} {}", s.name())).collect();
+    let mut nodes = format!("{placed} of {} placed", net.status.len());
+    if !failed.is_empty() {
+        nodes += &format!(" ({})", failed.join(", "));
+    }
+    f.push(("nodes".to_string(), nodes));
+    for key in ["generators", "tool", "material"] {
+        if let Some(v) = net.meta.get(key).and_then(|v| v.as_str()) {
+            f.push((key.to_string(), v.to_string()));
+        }
+    }
+    if let Some(s) = net.meta.get("solver") {
+        if let Some(o) = s.get("outcome") {
+            let o = o.as_str().map(str::to_string).unwrap_or_else(|| o.to_string());
+            f.push(("solver outcome".to_string(), o));
+        }
+    }
+    if let Some(a) = net.meta.get("change_from_kinematic").and_then(|c| c.get("warp_angle_deg")).and_then(|a| a.as_array()) {
+        let max = a.iter().filter_map(|v| v.as_f64()).filter(|v| v.is_finite()).fold(None, |m: Option<f64>, v| Some(m.map_or(v.abs(), |m| m.max(v.abs()))));
+        if let Some(m) = max {
+            f.push(("largest warp direction change".to_string(), format!("{m:.2}°")));
+        }
+    }
+    f
+}
+
+const STYLE: &str = "body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:2em auto;max-width:1100px;color:#222;padding:0 1em}\
+h1{font-size:1.6em}h2{margin-top:2em;border-bottom:1px solid #ccc;padding-bottom:.2em}\
+table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:.3em .6em;text-align:right}\
+th{background:#f3f3f3}td.t,th.t{text-align:left}img{max-width:100%;height:auto;border:1px solid #ddd;margin:.5em 0}\
+.notes{background:#fff6e0;border-left:4px solid #e0a000;padding:.5em 1em}.small{color:#666;font-size:.9em}\
+dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dt{color:#666}dd{margin:0}\
+.pattern svg{max-width:100%;height:auto;border:1px solid #ddd}";
+
+/// The whole page.
+pub(crate) fn page(p: &Page) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
+        escape(&p.title),
+        escape(&p.title)
+    );
+    if let Some(t) = p.layup.as_ref().and_then(|l| l.tool.as_ref()) {
+        let _ = writeln!(h, "<p class=\"small\">Tool: {}</p>", escape(t));
+    }
+    let source = if p.layup.is_some() { "from layup.json" } else { "computed from the nets (no layup.json)" };
+    let _ = writeln!(h, "<h2 id=\"layup\">Layup</h2>\n<p class=\"small\">Table {source}. Shear angles in degrees; the locking angle is where the fabric stops shearing freely.</p>");
+    layup_table(&mut h, &p.rows);
+    if let Some(n) = p.layup.as_ref().and_then(|l| l.nesting.as_ref()) {
+        let _ = writeln!(
+            h,
+            "<h3>Nesting</h3>\n<table id=\"nesting\"><tr><th>roll width (m)</th><th>length (m)</th><th>used area (m²)</th><th>pattern area (m²)</th><th>waste</th></tr>\n<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr></table>",
+            num(n.roll_width_m, 3),
+            num(n.length_m, 3),
+            num(n.used_area_m2, 4),
+            num(n.pattern_area_m2, 4),
+            n.waste_fraction.filter(|w| w.is_finite()).map_or("—".into(), |w| format!("{:.1}%", 100.0 * w))
+        );
+    }
+    if !p.notes.is_empty() {
+        let _ = writeln!(h, "<div class=\"notes\"><strong>Not everything could be drawn:</strong><ul>");
+        for n in &p.notes {
+            let _ = writeln!(h, "<li>{}</li>", escape(n));
+        }
+        let _ = writeln!(h, "</ul></div>");
+    }
+    for ply in &p.plies {
+        ply_section(&mut h, ply, p.extra.get(&ply.name).map(Vec::as_slice).unwrap_or(&[]));
+    }
+    if !p.patterns.is_empty() {
+        let _ = writeln!(h, "<h2 id=\"patterns\">Flat patterns</h2>");
+        for (name, body) in &p.patterns {
+            match body {
+                Ok(svg) => {
+                    let _ = writeln!(h, "<h3>{}</h3>\n<div class=\"pattern\">{svg}</div>", escape(name));
+                }
+                Err(link) => {
+                    let _ = writeln!(h, "<h3>{0}</h3>\n<p><a href=\"{1}\">{0}</a> (too large to show inline)</p>", escape(name), escape(link));
+                }
+            }
+        }
+    }
+    let _ = writeln!(h, "<p class=\"small\">Written by drape {}.</p>\n</body>\n</html>", env!("CARGO_PKG_VERSION"));
+    h
+}
+
+fn layup_table(h: &mut String, rows: &[LayupRow]) {
+    let _ = writeln!(
+        h,
+        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
+    );
+    for r in rows {
+        let material = r.material.as_deref().map(|m| std::path::Path::new(m).file_stem().map_or(m.to_string(), |s| s.to_string_lossy().into_owned()));
+        let _ = writeln!(
+            h,
+            "<tr class=\"ply\"><td class=\"t\"><a href=\"#ply-{0}\">{0}</a></td><td class=\"t\">{1}</td><td>{2}</td><td class=\"t\">{3}</td><td>{4}</td><td>{5}</td><td>{6}</td><td>{7}</td><td>{8}</td><td>{9}</td><td>{10}</td></tr>",
+            escape(&r.name),
+            escape(material.as_deref().unwrap_or("—")),
+            num(r.angle_deg, 1),
+            escape(r.method.as_deref().unwrap_or("—")),
+            num(r.locking_angle_deg, 1),
+            num(r.max_abs_shear_deg, 1),
+            num(r.mean_abs_shear_deg, 1),
+            num(r.area_over_locking_m2, 4),
+            r.coverage.filter(|c| c.is_finite()).map_or("—".into(), |c| format!("{:.1}%", 100.0 * c)),
+            num(r.draped_area_m2, 4),
+            num(r.offset_m.map(|o| o * 1e3), 2),
+        );
+    }
+    let _ = writeln!(h, "</table>");
+}
+
+fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
+    let name = escape(&ply.name);
+    let _ = writeln!(h, "<h2 id=\"ply-{name}\">Ply {name} <span class=\"small\">({})</span></h2>", method_name(ply.method));
+    let _ = writeln!(h, "<dl>");
+    let summary = [
+        ("complete cells".to_string(), ply.cells.to_string()),
+        ("max |shear|".to_string(), format!("{}°", num(Some(ply.max_abs_shear_deg), 1))),
+        ("mean |shear|".to_string(), format!("{}°", num(Some(ply.mean_abs_shear_deg), 1))),
+        ("locking angle".to_string(), format!("{}°", num(Some(ply.locking_angle_deg), 1))),
+        ("colour scale".to_string(), format!("±{}°", num(Some(ply.colour_limit_deg), 0))),
+    ];
+    for (k, v) in summary.iter().chain(facts) {
+        let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
+    }
+    let _ = writeln!(h, "</dl>");
+    if !ply.notes.is_empty() {
+        let _ = writeln!(h, "<div class=\"notes\"><ul>");
+        for n in &ply.notes {
+            let _ = writeln!(h, "<li>{}</li>", escape(n));
+        }
+        let _ = writeln!(h, "</ul></div>");
+    }
+    for f in ply.files.iter().filter(|f| f.extension().is_some_and(|e| e == "png")) {
+        let png = f.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let svg = png.trim_end_matches(".png").to_string() + ".svg";
+        let _ = writeln!(
+            h,
+            "<figure><img src=\"{0}\" alt=\"{0}\" width=\"{2}\" height=\"{3}\"><figcaption class=\"small\"><a href=\"{0}\">PNG</a> · <a href=\"{1}\">SVG</a></figcaption></figure>",
+            escape(&png),
+            escape(&svg),
+            super::WIDTH,
+            super::HEIGHT
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_and_strips() {
+        assert_eq!(escape("<a & \"b\">"), "&lt;a &amp; &quot;b&quot;&gt;");
+        assert_eq!(strip_prolog("<?xml version=\"1.0\"?>\n<svg x=\"1\"/>"), "<svg x=\"1\"/>");
+        assert_eq!(num(Some(f64::NAN), 2), "—");
+        assert_eq!(num(Some(1.234), 1), "1.2");
+    }
+}

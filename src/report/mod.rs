@@ -1,0 +1,589 @@
+//! `drape report DIR`: pictures of every ply in a run's output folder and one HTML page that
+//! shows them with the layup table.
+//!
+//! For each `<ply>.drape.json` in DIR it writes, into DIR/report (or another folder):
+//! - `<ply>-shear.png/.svg`: the ply's cells seen obliquely along its mean normal, painted by
+//!   signed shear on a diverging colour map with symmetric limits, over the tool in light grey,
+//!   with a colour bar on which the locking angle +/- is marked;
+//! - `<ply>-histogram.png/.svg`: the distribution of signed shear with the locking angle marked;
+//! - `<ply>-change.png/.svg` for a mechanical ply: the change of shear from the kinematic net;
+//! - `index.html`: the layup table (from `layup.json` when present, else computed from the
+//!   nets), every picture, the summary numbers, the flat patterns (`*.svg` in DIR) and notes on
+//!   whatever could not be drawn.
+//!
+//! Text is rendered with the DejaVu Sans font compiled into the program (crate `dejavu`,
+//! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
+mod html;
+mod render;
+mod view;
+
+pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL_TRIANGLE_LIMIT, WIDTH};
+pub use view::{change_limit, colour_limit, shear_colour, View, VIEW_TILT_DEG};
+
+use crate::export::{read_net, write_atomic, ExportError};
+use crate::geometry::obj::read_obj;
+use crate::geometry::Point;
+use crate::kinematic::{DrapeNet, Method};
+use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use render::{Mark, ToolLayer};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Why a report could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("cannot list {path}: {source}. Give the folder `drape run --out` wrote.")]
+    ReadDir { path: PathBuf, source: std::io::Error },
+    #[error("{path} holds no drape net (*.drape.json). Give the folder `drape run --out` wrote, and run with the json format.")]
+    NoNets { path: PathBuf },
+    #[error(transparent)]
+    Net(#[from] ExportError),
+    #[error("{path}: {message}. Re-create it with `drape run`, or delete it to build the table from the nets.")]
+    Layup { path: PathBuf, message: String },
+    #[error("cannot create report folder {path}: {source}. Check the --out path and that its parent is writable.")]
+    CreateDir { path: PathBuf, source: std::io::Error },
+    #[error("cannot draw {path}: {message}. This is a bug; please report it with the run folder.")]
+    Draw { path: PathBuf, message: String },
+}
+
+/// What a report wrote.
+#[derive(Debug, Clone)]
+pub struct ReportSummary {
+    /// The report folder.
+    pub out: PathBuf,
+    /// Every file written, pictures in ply order then `index.html`.
+    pub files: Vec<PathBuf>,
+    /// One entry per ply drawn, in table order.
+    pub plies: Vec<PlyReport>,
+    /// What could not be drawn or read, in words (also shown on the page).
+    pub notes: Vec<String>,
+}
+
+/// What the report drew for one ply.
+#[derive(Debug, Clone)]
+pub struct PlyReport {
+    /// Ply name (the file stem of its net).
+    pub name: String,
+    pub method: Method,
+    /// Complete cells drawn.
+    pub cells: usize,
+    /// Locking angle used for the marks (degrees).
+    pub locking_angle_deg: f64,
+    pub max_abs_shear_deg: f64,
+    pub mean_abs_shear_deg: f64,
+    /// Colour limit of the shear map (degrees, symmetric).
+    pub colour_limit_deg: f64,
+    /// Whether the tool was drawn underneath.
+    pub tool_drawn: bool,
+    /// Pictures written for this ply.
+    pub files: Vec<PathBuf>,
+    /// What could not be drawn for this ply.
+    pub notes: Vec<String>,
+}
+
+/// One row of the layup table (`layup.json` "plies", or computed from a net).
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct LayupRow {
+    pub name: String,
+    #[serde(default)]
+    pub material: Option<String>,
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+    #[serde(default)]
+    pub method: Option<String>,
+    #[serde(default)]
+    pub locking_angle_deg: Option<f64>,
+    #[serde(default)]
+    pub max_abs_shear_deg: Option<f64>,
+    #[serde(default)]
+    pub mean_abs_shear_deg: Option<f64>,
+    #[serde(default)]
+    pub area_over_locking_m2: Option<f64>,
+    #[serde(default)]
+    pub coverage: Option<f64>,
+    #[serde(default)]
+    pub draped_area_m2: Option<f64>,
+    #[serde(default)]
+    pub offset_m: Option<f64>,
+}
+
+/// Nesting of the flat patterns on the roll (`layup.json` "nesting").
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct Nesting {
+    #[serde(default)]
+    pub roll_width_m: Option<f64>,
+    #[serde(default)]
+    pub length_m: Option<f64>,
+    #[serde(default)]
+    pub used_area_m2: Option<f64>,
+    #[serde(default)]
+    pub pattern_area_m2: Option<f64>,
+    #[serde(default)]
+    pub waste_fraction: Option<f64>,
+}
+
+/// `layup.json` as written by `drape run` (unknown keys are ignored).
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct Layup {
+    #[serde(default)]
+    pub scene: Option<String>,
+    #[serde(default)]
+    pub tool: Option<String>,
+    #[serde(default)]
+    pub plies: Vec<LayupRow>,
+    #[serde(default)]
+    pub nesting: Option<Nesting>,
+}
+
+/// Name of the optional layup file in a run folder.
+pub const LAYUP_FILE: &str = "layup.json";
+/// Suffix of net files.
+const NET_SUFFIX: &str = ".drape.json";
+/// Flat-pattern SVGs larger than this are linked from the page instead of inlined.
+const PATTERN_INLINE_LIMIT: u64 = 8 << 20;
+/// The kinds of picture, as file-name suffixes after `<ply>-`.
+const PICTURES: [&str; 3] = ["shear", "histogram", "change"];
+/// Candidate scales (metres per OBJ unit) tried when the tool's units are not recorded.
+const TOOL_SCALES: [f64; 2] = [1.0, 1e-3];
+
+/// Read `layup.json` from `dir` if present.
+pub fn read_layup(dir: &Path) -> Result<Option<Layup>, ReportError> {
+    let path = dir.join(LAYUP_FILE);
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(ReportError::Layup { path, message: format!("cannot read it: {e}") }),
+    };
+    serde_json::from_slice(&bytes).map(Some).map_err(|e| ReportError::Layup {
+        path,
+        message: format!("line {}, column {}: {e}", e.line(), e.column()),
+    })
+}
+
+/// Per-cell statistics of a net (degrees, m^2).
+#[derive(Debug, Clone, Copy, Default)]
+struct CellStats {
+    cells: usize,
+    max_abs: f64,
+    mean_abs: f64,
+    area: f64,
+    area_over_locking: f64,
+}
+
+/// Signed shear (degrees) per cell index `i * (nv - 1) + j`, and the statistics.
+fn shear_by_cell(net: &DrapeNet, locking_deg: f64) -> (Vec<Option<f64>>, CellStats) {
+    let mut values = vec![None; net.num_cells()];
+    let mut s = CellStats::default();
+    let mut sum = 0.0;
+    view::for_each_cell(net, |k, c| {
+        let (i, j) = (k / (net.nv - 1), k % (net.nv - 1));
+        let Some(g) = net.cell_shear(i, j).map(f64::to_degrees).filter(|g| g.is_finite()) else { return };
+        values[k] = Some(g);
+        let a = view::quad_area(&c);
+        s.cells += 1;
+        sum += g.abs();
+        s.max_abs = s.max_abs.max(g.abs());
+        s.area += a;
+        if g.abs() > locking_deg {
+            s.area_over_locking += a;
+        }
+    });
+    if s.cells > 0 {
+        s.mean_abs = sum / s.cells as f64;
+    }
+    (values, s)
+}
+
+/// A tool mesh as read from its OBJ (file units).
+struct RawTool {
+    vertices: Vec<Point>,
+    triangles: Vec<[u32; 3]>,
+    lo: Point,
+    hi: Point,
+}
+
+/// Where a net's tool OBJ is: as recorded (relative to the run's working folder), else
+/// relative to the run folder, else its file name in the run folder.
+fn locate_tool(recorded: &str, dir: &Path) -> Option<PathBuf> {
+    let p = PathBuf::from(recorded);
+    let mut candidates = vec![p.clone(), dir.join(&p)];
+    if let Some(f) = p.file_name() {
+        candidates.push(dir.join(f));
+    }
+    candidates.into_iter().find(|c| c.is_file())
+}
+
+fn load_tool(path: &Path) -> Result<RawTool, String> {
+    let (raw, _) = read_obj(path).map_err(|e| e.to_string())?;
+    let mut lo = Point::from([f64::INFINITY; 3]);
+    let mut hi = Point::from([f64::NEG_INFINITY; 3]);
+    for v in &raw.vertices {
+        lo = lo.inf(v);
+        hi = hi.sup(v);
+    }
+    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi })
+}
+
+/// The scale (metres per OBJ unit) the run read the tool with, which the net does not record:
+/// among [`TOOL_SCALES`], those under which the most nodes lie inside the scaled tool's bounding
+/// box (grown by 5% of its diagonal), the one whose box size is closest to the net's.
+fn guess_scale(tool: &RawTool, net: &DrapeNet) -> f64 {
+    let placed: Vec<&Point> = net.positions.iter().zip(&net.status).filter(|(_, s)| **s == crate::kinematic::NodeStatus::Placed).map(|(p, _)| p).collect();
+    let tool_diag = (tool.hi - tool.lo).norm();
+    let net_diag = crate::geometry::surface::bounding_diagonal(&placed.iter().map(|p| **p).collect::<Vec<_>>());
+    let inside = |s: f64| {
+        let grow = 0.05 * s * tool_diag;
+        placed
+            .iter()
+            .filter(|p| (0..3).all(|k| p[k] >= s * tool.lo[k] - grow && p[k] <= s * tool.hi[k] + grow))
+            .count()
+    };
+    let counts: Vec<usize> = TOOL_SCALES.iter().map(|&s| inside(s)).collect();
+    let most = counts.iter().copied().max().unwrap_or(0);
+    let misfit = |s: f64| if net_diag > 0.0 && tool_diag > 0.0 { (s * tool_diag / net_diag).ln().abs() } else { 0.0 };
+    TOOL_SCALES
+        .iter()
+        .zip(&counts)
+        .filter(|(_, &c)| c == most)
+        .map(|(&s, _)| s)
+        .min_by(|a, b| misfit(*a).total_cmp(&misfit(*b)))
+        .unwrap_or(1.0)
+}
+
+/// One ply's inputs.
+struct PlyInput {
+    stem: String,
+    net: DrapeNet,
+    locking_deg: f64,
+    row: LayupRow,
+    tool: Option<PathBuf>,
+    tool_note: Option<String>,
+}
+
+/// Everything the page shows, gathered by [`write_report`].
+pub(crate) struct Page {
+    pub title: String,
+    pub layup: Option<Layup>,
+    pub rows: Vec<LayupRow>,
+    pub plies: Vec<PlyReport>,
+    pub patterns: Vec<(String, Result<String, String>)>,
+    pub notes: Vec<String>,
+    pub extra: BTreeMap<String, Vec<(String, String)>>,
+}
+
+/// Draw every ply of the run folder `dir` into `out` (created if missing) and write
+/// `out/index.html`. With `progress`, a progress bar runs on stderr (hidden when stderr is not
+/// a terminal). Plies are drawn in parallel; the files do not depend on the thread count.
+pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSummary, ReportError> {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|source| ReportError::ReadDir { path: dir.to_path_buf(), source })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    entries.sort();
+    let net_files: Vec<(String, PathBuf)> = entries
+        .iter()
+        .filter_map(|p| {
+            let name = p.file_name()?.to_str()?;
+            let stem = name.strip_suffix(NET_SUFFIX)?;
+            (!stem.is_empty() && p.is_file()).then(|| (stem.to_string(), p.clone()))
+        })
+        .collect();
+    if net_files.is_empty() {
+        return Err(ReportError::NoNets { path: dir.to_path_buf() });
+    }
+    let layup = read_layup(dir)?;
+    let mut notes = Vec::new();
+
+    // Order: the layup's ply order, then nets it does not list, by name.
+    let mut nets: BTreeMap<String, DrapeNet> = BTreeMap::new();
+    for (stem, path) in &net_files {
+        nets.insert(stem.clone(), read_net(path)?);
+    }
+    let mut order: Vec<String> = Vec::new();
+    if let Some(l) = &layup {
+        for r in &l.plies {
+            if nets.contains_key(&r.name) {
+                if !order.contains(&r.name) {
+                    order.push(r.name.clone());
+                }
+            } else {
+                notes.push(format!("{LAYUP_FILE} lists ply '{}' but {} has no {}{NET_SUFFIX}: not drawn.", r.name, dir.display(), r.name));
+            }
+        }
+    }
+    for stem in nets.keys() {
+        if !order.contains(stem) {
+            order.push(stem.clone());
+        }
+    }
+
+    let mut inputs = Vec::new();
+    for stem in order {
+        let net = nets.remove(&stem).expect("ordered from the map's keys");
+        let given = layup.as_ref().and_then(|l| l.plies.iter().find(|r| r.name == stem)).cloned();
+        let locking_deg = given.as_ref().and_then(|r| r.locking_angle_deg).filter(|a| a.is_finite() && *a > 0.0).unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
+        let (_, st) = shear_by_cell(&net, locking_deg);
+        let row = given.unwrap_or_else(|| LayupRow {
+            name: stem.clone(),
+            material: net.meta.get("material").and_then(|m| m.as_str()).map(str::to_string),
+            angle_deg: None,
+            method: Some(method_name(net.method).into()),
+            locking_angle_deg: Some(locking_deg),
+            max_abs_shear_deg: Some(st.max_abs),
+            mean_abs_shear_deg: Some(st.mean_abs),
+            area_over_locking_m2: Some(st.area_over_locking),
+            coverage: (net.num_cells() > 0).then(|| st.cells as f64 / net.num_cells() as f64),
+            draped_area_m2: Some(st.area),
+            offset_m: None,
+        });
+        let recorded = net.meta.get("tool").and_then(|t| t.as_str()).map(str::to_string).or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
+        let (tool, tool_note) = match recorded {
+            None => (None, Some("the net records no tool file: drawn without the tool".to_string())),
+            Some(t) => match locate_tool(&t, dir) {
+                Some(p) => (Some(p), None),
+                None => (None, Some(format!("tool {t} not found (looked relative to the current folder and to {}): drawn without the tool", dir.display()))),
+            },
+        };
+        inputs.push(PlyInput { stem, net, locking_deg, row, tool, tool_note });
+    }
+
+    std::fs::create_dir_all(out).map_err(|source| ReportError::CreateDir { path: out.to_path_buf(), source })?;
+
+    // Each distinct tool is read once.
+    let mut tools: BTreeMap<PathBuf, Result<RawTool, String>> = BTreeMap::new();
+    for p in inputs.iter().filter_map(|i| i.tool.clone()) {
+        tools.entry(p.clone()).or_insert_with(|| load_tool(&p));
+    }
+
+    let pictures: u64 = inputs.iter().map(|i| if i.net.method == Method::Mechanical { 3 } else { 2 }).sum();
+    let bar = if progress {
+        ProgressBar::with_draw_target(Some(pictures + 1), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) = ProgressStyle::with_template("{msg:>20} [{bar:40}] {pos}/{len} ({elapsed})") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message("drawing");
+
+    let reports: Vec<Result<PlyReport, ReportError>> =
+        inputs.par_iter().map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), out, &bar)).collect();
+    let mut plies = Vec::new();
+    for r in reports {
+        plies.push(r?);
+    }
+    let mut files: Vec<PathBuf> = plies.iter().flat_map(|p| p.files.iter().cloned()).collect();
+    for p in &plies {
+        notes.extend(p.notes.iter().map(|n| format!("ply '{}': {n}", p.name)));
+    }
+
+    // Flat patterns: every *.svg of the run folder.
+    let mut patterns = Vec::new();
+    // A report written into DIR itself leaves its own pictures there: those are not patterns.
+    let own_picture = |name: &str| {
+        PICTURES.iter().any(|kind| inputs.iter().any(|i| name == format!("{}-{kind}.svg", i.stem)))
+    };
+    for p in entries.iter().filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg")) && p.is_file()) {
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        if own_picture(&name) {
+            continue;
+        }
+        let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+        let body = if size > PATTERN_INLINE_LIMIT {
+            Err(link_to(p, dir, out))
+        } else {
+            match std::fs::read_to_string(p) {
+                Ok(s) => Ok(html::strip_prolog(&s).to_string()),
+                Err(e) => {
+                    notes.push(format!("flat pattern {}: cannot read it ({e})", p.display()));
+                    continue;
+                }
+            }
+        };
+        patterns.push((name, body));
+    }
+
+    let mut extra = BTreeMap::new();
+    for i in &inputs {
+        extra.insert(i.stem.clone(), html::net_facts(&i.net));
+    }
+    let rows: Vec<LayupRow> = inputs.iter().map(|i| i.row.clone()).collect();
+    let title = layup
+        .as_ref()
+        .and_then(|l| l.scene.clone())
+        .map(|s| format!("Drape report: {s}"))
+        .unwrap_or_else(|| format!("Drape report: {}", dir.display()));
+    let page = Page { title, layup, rows, plies, patterns, notes, extra };
+    bar.set_message("writing index.html");
+    let index = out.join("index.html");
+    let text = html::page(&page);
+    write_atomic(&index, |w| w.write_all(text.as_bytes()))?;
+    bar.inc(1);
+    bar.finish_and_clear();
+    files.push(index);
+    let Page { plies, notes, .. } = page;
+    Ok(ReportSummary { out: out.to_path_buf(), files, plies, notes })
+}
+
+/// A link from the page in `out` to `file` in `dir`: relative when `out` is inside `dir`.
+fn link_to(file: &Path, dir: &Path, out: &Path) -> String {
+    let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    if out.parent() == Some(dir) {
+        format!("../{name}")
+    } else {
+        std::fs::canonicalize(file).unwrap_or(file.to_path_buf()).display().to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tool_scale_is_the_one_that_fits_the_net() {
+        let tool = |k: f64| RawTool { vertices: vec![], triangles: vec![], lo: Point::new(-k, -k, 0.0), hi: Point::new(k, k, k) };
+        let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
+        for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
+            net.positions[k] = Point::new(p.0, p.1, 0.09);
+            net.status[k] = crate::kinematic::NodeStatus::Placed;
+        }
+        assert_eq!(guess_scale(&tool(0.1), &net), 1.0, "metres");
+        assert_eq!(guess_scale(&tool(100.0), &net), 1e-3, "millimetres: both boxes hold the net, the mm one fits");
+    }
+}
+
+pub(crate) fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::Kinematic => "kinematic",
+        Method::Mechanical => "mechanical",
+    }
+}
+
+/// Draw one ply's pictures into `out`.
+fn draw_ply(input: &PlyInput, tool: Option<&Result<RawTool, String>>, out: &Path, bar: &ProgressBar) -> Result<PlyReport, ReportError> {
+    let net = &input.net;
+    let (values, st) = shear_by_cell(net, input.locking_deg);
+    let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
+    let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
+        Some(Ok(t)) => {
+            let s = guess_scale(t, net);
+            Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
+        }
+        Some(Err(e)) => {
+            notes.push(format!("tool not drawn: {e}"));
+            None
+        }
+        None => None,
+    };
+    let layer = scaled.as_ref().map(|(v, t)| ToolLayer { vertices: v, triangles: t });
+    let tool_text = match (&input.tool, &layer) {
+        (Some(p), Some(l)) => format!("grey: tool {} ({} triangles)", p.display(), l.triangles.len()),
+        _ => "tool not drawn (see the report page)".to_string(),
+    };
+    if st.cells == 0 {
+        notes.push("the net has no complete cell: the map is empty".into());
+    }
+    let kind = method_name(net.method);
+    let lock = input.locking_deg;
+    let limit = colour_limit(st.max_abs, lock);
+    let lock_marks = vec![
+        Mark { value: lock, label: format!("+{lock:.0}° locking") },
+        Mark { value: -lock, label: format!("−{lock:.0}° locking") },
+    ];
+    let mut map = render::layout_map(net, &values, layer.as_ref(), limit);
+    map.title = format!("Ply {}: shear angle ({kind})", input.stem);
+    map.subtitle = format!("{} cells, view along the mean ply normal tilted {VIEW_TILT_DEG:.0}°; {tool_text}", st.cells);
+    map.bar_label = "shear angle (deg)".into();
+    map.marks = lock_marks.clone();
+    let mut files = Vec::new();
+    let name = |suffix: &str| out.join(format!("{}-{suffix}", input.stem));
+    write_pair(&name("shear"), |r| render::draw_map(r, &map), |r| render::draw_map(r, &map), &mut files)?;
+    bar.inc(1);
+
+    let hist = render::HistogramPicture {
+        title: format!("Ply {}: shear distribution ({kind})", input.stem),
+        note: format!(
+            "{} cells · mean |γ| {:.1}° · max |γ| {:.1}° · {:.1}% of area over locking",
+            st.cells,
+            st.mean_abs,
+            st.max_abs,
+            if st.area > 0.0 { 100.0 * st.area_over_locking / st.area } else { 0.0 }
+        ),
+        values: values.iter().flatten().copied().collect(),
+        limit,
+        x_label: "shear angle γ (deg)".into(),
+        marks: lock_marks,
+    };
+    write_pair(&name("histogram"), |r| render::draw_histogram(r, &hist), |r| render::draw_histogram(r, &hist), &mut files)?;
+    bar.inc(1);
+
+    if net.method == Method::Mechanical {
+        match change_values(net) {
+            Ok(change) => {
+                let max = change.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                let limit = change_limit(max);
+                let mut map = render::layout_map(net, &change, layer.as_ref(), limit);
+                map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
+                map.subtitle = format!("largest change {max:.2}°, drawn on the mechanical net; {tool_text}");
+                map.bar_label = "shear change (deg)".into();
+                write_pair(&name("change"), |r| render::draw_map(r, &map), |r| render::draw_map(r, &map), &mut files)?;
+            }
+            Err(why) => notes.push(format!("no change picture: {why}")),
+        }
+        bar.inc(1);
+    }
+    Ok(PlyReport {
+        name: input.stem.clone(),
+        method: net.method,
+        cells: st.cells,
+        locking_angle_deg: lock,
+        max_abs_shear_deg: st.max_abs,
+        mean_abs_shear_deg: st.mean_abs,
+        colour_limit_deg: limit,
+        tool_drawn: layer.is_some(),
+        files,
+        notes,
+    })
+}
+
+/// The per-cell shear change (degrees) a mechanical net records in meta
+/// "change_from_kinematic"."shear_deg".
+fn change_values(net: &DrapeNet) -> Result<Vec<Option<f64>>, String> {
+    let arr = net
+        .meta
+        .get("change_from_kinematic")
+        .and_then(|c| c.get("shear_deg"))
+        .and_then(|s| s.as_array())
+        .ok_or("the net has no \"change_from_kinematic\".\"shear_deg\" (written by `drape refine` and `drape run`)")?;
+    if arr.len() != net.num_cells() {
+        return Err(format!("\"change_from_kinematic\".\"shear_deg\" has {} entries but the net has {} cells", arr.len(), net.num_cells()));
+    }
+    Ok(arr.iter().map(|v| v.as_f64().filter(|x| x.is_finite())).collect())
+}
+
+/// Render a picture to `<base>.png` and `<base>.svg`, atomically, and record the paths.
+fn write_pair(
+    base: &Path,
+    png: impl Fn(&plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>) -> render::DrawResult,
+    svg: impl Fn(&plotters::drawing::DrawingArea<plotters::prelude::SVGBackend, plotters::coord::Shift>) -> render::DrawResult,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), ReportError> {
+    let with_ext = |ext: &str| {
+        let mut name = base.file_name().unwrap_or_default().to_os_string();
+        name.push(ext);
+        base.with_file_name(name)
+    };
+    let p = with_ext(".png");
+    let bytes = render::to_png(png).map_err(|message| ReportError::Draw { path: p.clone(), message })?;
+    write_atomic(&p, |w| w.write_all(&bytes))?;
+    files.push(p);
+    let p = with_ext(".svg");
+    let text = render::to_svg(svg).map_err(|message| ReportError::Draw { path: p.clone(), message })?;
+    write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
+    files.push(p);
+    Ok(())
+}
