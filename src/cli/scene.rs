@@ -8,6 +8,13 @@ use crate::export::{write_atomic, write_net, Format};
 use crate::geometry::ToolSurface;
 use crate::kinematic::fishnet::check_settings;
 use crate::layup::stack::{drape_layup, PlyResult};
+use crate::export::flow::write_flow;
+use crate::export::flowmesh::read_flow_mesh;
+use crate::export::map::{map_net, LayupMap, PermeabilityModel, PlyMapSettings};
+use crate::export::pattern::write_cutting_plan;
+use crate::layup::flat::{flat_pattern_with_margin, FlatError};
+use crate::layup::nest::{nest, Nesting, Rotation};
+use crate::layup::scene::SceneExport;
 use crate::layup::Scene;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -68,8 +75,23 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
         }
     }
     println!("{}", layup_table(&scene, &results));
+    let nesting = cutting_plan(&scene, &results, &a.out)?;
+    if let Some(export) = &scene.export {
+        export_flow(&scene, export, &results, &a.out)?;
+    }
     let table = a.out.join("layup.json");
-    let json = layup_json(&scene, &results);
+    let mut json = layup_json(&scene, &results);
+    if let Some(n) = nesting {
+        json["nesting"] = serde_json::json!({
+            "roll_width_m": n.roll_width,
+            "gap_m": n.gap,
+            "length_m": n.length,
+            "used_area_m2": n.used_area,
+            "pattern_area_m2": n.pattern_area,
+            "waste_area_m2": n.waste_area,
+            "waste_fraction": n.waste_fraction,
+        });
+    }
     write_atomic(&table, |w| {
         serde_json::to_writer_pretty(&mut *w, &json)?;
         std::io::Write::write_all(w, b"\n")
@@ -81,6 +103,95 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
             "the mechanical solver stopped without equilibrium for {}; the last accepted states were written",
             unconverged.join(", ")
         )));
+    }
+    Ok(())
+}
+
+/// Flat patterns of every ply, nested on the roll: `patterns.dxf`, `patterns.svg` and one SVG a
+/// ply. Plies without a complete cell have no pattern and are named.
+fn cutting_plan(scene: &Scene, results: &[PlyResult], out: &Path) -> Result<Option<Nesting>, Failure> {
+    let mut patterns = Vec::new();
+    for r in results {
+        match flat_pattern_with_margin(&r.net, scene.cutting_margin) {
+            Ok(p) => patterns.push(p),
+            Err(FlatError::NoCells { ply }) => println!("ply {ply}: no complete cell, no flat pattern"),
+            Err(e) => return Err(input(e)),
+        }
+    }
+    if patterns.is_empty() {
+        return Ok(None);
+    }
+    let rotation = if scene.rotate_patterns { Rotation::AllowQuarterTurn } else { Rotation::WarpAlongRoll };
+    let roll_width = match scene.roll_width {
+        Some(w) => w,
+        None => {
+            // Without a roll width the pieces go on a roll as wide as the widest of them.
+            let w = patterns.iter().map(|p| p.size()[1]).fold(0.0, f64::max);
+            println!("no roll_width in the scene: nesting on a roll {w:.3} m wide (the widest piece)");
+            w
+        }
+    };
+    let nesting = nest(&patterns, roll_width, scene.nesting_gap, rotation).map_err(input)?;
+    let written = write_cutting_plan(&patterns, &nesting, out, "patterns").map_err(compute)?;
+    println!(
+        "flat patterns: {} pieces, {:.4} m^2 of fabric on {:.3} m of a {:.3} m roll ({:.4} m^2 used, {:.1}% waste)",
+        patterns.len(),
+        nesting.pattern_area,
+        nesting.length,
+        nesting.roll_width,
+        nesting.used_area,
+        100.0 * nesting.waste_fraction
+    );
+    for p in written {
+        println!("  wrote {}", p.display());
+    }
+    Ok(Some(nesting))
+}
+
+/// Map every ply onto the scene's resin-flow mesh and write the formats it asks for as
+/// `DIR/flow.<ext>` (`FlowFormat::scene_file`; field names prefixed by the ply).
+fn export_flow(scene: &Scene, export: &SceneExport, results: &[PlyResult], out: &Path) -> Result<(), Failure> {
+    let t = Instant::now();
+    let mesh = read_flow_mesh(&export.mesh, scene.scale).map_err(|e| input(anyhow::anyhow!("scene {}: [export] mesh: {e}", scene.path.display())))?;
+    let mut plies = Vec::new();
+    for (ply, r) in scene.plies.iter().zip(results) {
+        let card = ply.material.as_ref().map(|m| &m.card);
+        let permeability = if export.permeability {
+            let radius = card.and_then(|c| c.flow).map(|f| f.fibre_radius).ok_or_else(|| {
+                input(anyhow::anyhow!(
+                    "scene {}: ply '{}' (line {}): [export] permeability = true needs a material card with a [flow] section (fibre_radius)",
+                    scene.path.display(),
+                    ply.settings.name,
+                    ply.line
+                ))
+            })?;
+            Some(PermeabilityModel { fibre_radius: radius })
+        } else {
+            None
+        };
+        let (settings, notes) = PlyMapSettings::for_net(&r.net, card, ply.thickness, export.cavity, permeability);
+        for n in notes {
+            println!("note: {n}");
+        }
+        plies.push(map_net(&r.net, &mesh, &settings).map_err(compute)?);
+    }
+    let map = LayupMap::new(plies, true, mesh.elements.len());
+    println!(
+        "flow mesh {}: {} nodes, {} elements; mapped {} plies in {:.1} ms",
+        export.mesh.display(),
+        mesh.nodes.len(),
+        mesh.elements.len(),
+        map.plies.len(),
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    for k in 0..map.plies.len() {
+        println!("{}", super::export::coverage_line(&map, k));
+    }
+    for &format in &export.formats {
+        let path = out.join(format.scene_file());
+        for p in write_flow(&mesh, &map, format, &path).map_err(compute)? {
+            println!("  wrote {}", p.display());
+        }
     }
     Ok(())
 }

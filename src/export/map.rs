@@ -158,7 +158,8 @@ impl PlyMapSettings {
         permeability: Option<PermeabilityModel>,
     ) -> (PlyMapSettings, Vec<String>) {
         let mut notes = Vec::new();
-        let thickness = thickness.or(card.map(|c| c.thickness)).unwrap_or_else(|| {
+        let recorded = net.meta.get("thickness_m").and_then(|v| v.as_f64()).filter(|t| t.is_finite() && *t > 0.0);
+        let thickness = thickness.or(recorded).or(card.map(|c| c.thickness)).unwrap_or_else(|| {
             notes.push(format!(
                 "ply '{}': no material card or thickness: assumed t0 = {} mm",
                 net.name,

@@ -9,6 +9,8 @@
 //!                             # ("normal", default) or the other ("opposite")
 //! roll_width = 1.27           # optional: fabric roll width, for nesting the flat patterns
 //! nesting_gap = 0.01          # optional: gap between nested pieces (default 10 mm)
+//! cutting_margin = 0.0        # optional: allowance around each flat pattern
+//! rotate_patterns = false     # optional: pieces may turn 90 deg on the roll (warp across)
 //! [materials]                 # optional: names for material cards, relative to this file
 //! glass = "../../materials/glass-plain-weave.toml"
 //! [export]                    # optional: map every ply onto a resin-flow mesh
@@ -69,6 +71,9 @@ struct SceneFile {
     stack_side: Option<String>,
     roll_width: Option<f64>,
     nesting_gap: Option<f64>,
+    cutting_margin: Option<f64>,
+    #[serde(default)]
+    rotate_patterns: bool,
     #[serde(default)]
     materials: BTreeMap<String, String>,
     export: Option<toml::Spanned<ExportFile>>,
@@ -220,6 +225,10 @@ pub struct Scene {
     pub roll_width: Option<f64>,
     /// Gap between nested pieces, metres.
     pub nesting_gap: f64,
+    /// Allowance added around each flat pattern, metres.
+    pub cutting_margin: f64,
+    /// Whether pieces may be turned 90 degrees on the roll (warp across the roll).
+    pub rotate_patterns: bool,
     pub export: Option<SceneExport>,
     pub plies: Vec<Ply>,
 }
@@ -259,6 +268,11 @@ impl Scene {
             None => DEFAULT_NESTING_GAP,
             Some(g) if g.is_finite() && g >= 0.0 => g * scale,
             Some(g) => return Err(invalid(format!("field `nesting_gap`: must be a length >= 0, got {g}"))),
+        };
+        let cutting_margin = match file.cutting_margin {
+            None => 0.0,
+            Some(g) if g.is_finite() && g >= 0.0 => g * scale,
+            Some(g) => return Err(invalid(format!("field `cutting_margin`: must be a length >= 0, got {g}"))),
         };
         let mut materials: BTreeMap<String, PlyMaterial> = BTreeMap::new();
         for (name, file) in &file.materials {
@@ -423,6 +437,8 @@ impl Scene {
             stack_side,
             roll_width,
             nesting_gap,
+            cutting_margin,
+            rotate_patterns: file.rotate_patterns,
             export,
             plies,
         })

@@ -149,10 +149,6 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
         let mut settings = ply.settings.clone();
         settings.warp = warp;
         let mut net = drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
-        net.meta.insert("stack_offset_max_m".into(), serde_json::json!(offset.max_distance));
-        if let Some(a) = ply.angle_deg() {
-            net.meta.insert("angle_deg".into(), serde_json::json!(a));
-        }
         let mut refined = None;
         if let Some(r) = &ply.refinement {
             let t = Instant::now();
@@ -167,6 +163,18 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
             net = out;
             refined = Some(result);
         }
+        // What later stages (exports, reports) need to know about the ply.
+        net.meta.insert("stack_offset_max_m".into(), serde_json::json!(offset.max_distance));
+        if let Some(a) = ply.angle_deg() {
+            net.meta.insert("angle_deg".into(), serde_json::json!(a));
+        }
+        if let Some(m) = &ply.material {
+            net.meta.insert("material".into(), serde_json::json!(m.path.display().to_string()));
+        }
+        if let Some(t) = ply.thickness {
+            net.meta.insert("thickness_m".into(), serde_json::json!(t));
+        }
+        net.meta.insert("tool_scale".into(), serde_json::json!(scene.scale));
         if let Some(t0) = ply.thickness {
             if k + 1 < scene.plies.len() {
                 add_ply_thickness(&mut stack, sign, tool, &dirs, &net, t0);

@@ -58,6 +58,20 @@ impl FlowFormat {
     }
 }
 
+impl FlowFormat {
+    /// File a scene writes this format to, in its output directory.
+    pub fn scene_file(self) -> &'static str {
+        match self {
+            FlowFormat::Vtu => "flow.vtu",
+            FlowFormat::Nastran => "flow.bdf",
+            FlowFormat::Abaqus => "flow.inp",
+            FlowFormat::OptiStruct => "flow.fem",
+            FlowFormat::Rtmsim => "flow-rtmsim.bdf",
+            FlowFormat::Csv => "flow.csv",
+        }
+    }
+}
+
 impl std::str::FromStr for FlowFormat {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
