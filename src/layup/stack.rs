@@ -96,10 +96,16 @@ pub fn ply_stats(net: &DrapeNet, locking_angle: f64, areal_mass: Option<f64>) ->
 
 /// The warp direction of `ply` at its seed on `surface`, and the normal there on the stacking side.
 pub fn resolve_warp(ply: &Ply, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<(Vector, Vector), String> {
-    let sp = surface.closest_point(&ply.settings.origin);
+    resolve_warp_at(ply, &ply.settings.origin, reference, surface, side)
+}
+
+/// [`resolve_warp`] with the seed at `origin` instead of the ply's own.
+fn resolve_warp_at(ply: &Ply, origin: &Point, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<(Vector, Vector), String> {
+    let sp = surface.closest_point(origin);
+    let n = seed_normal(surface, &sp.point);
     let n = match side {
-        StackSide::Normal => sp.normal,
-        StackSide::Opposite => -sp.normal,
+        StackSide::Normal => n,
+        StackSide::Opposite => -n,
     };
     let (direction, angle) = match ply.orientation {
         Orientation::Warp(w) => (w, 0.0),
@@ -119,6 +125,27 @@ pub fn resolve_warp(ply: &Ply, reference: &Vector, surface: &ToolSurface, side: 
     let rotation = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(n), angle);
     Ok(((rotation * projected).normalize(), n))
 }
+
+/// Unit normal of `surface` at its point `p`: the facet's normal inside a facet, the mean of the
+/// facets' normals when `p` lies on an edge or a vertex (a seed is often placed on a vertex, and
+/// the angle of a ply should not depend on which facet the search happened to return).
+fn seed_normal(surface: &ToolSurface, p: &Point) -> Vector {
+    let eps = SEED_CONTACT_REL * surface.diagonal();
+    let mut n = Vector::zeros();
+    for t in surface.triangles_near(p, eps) {
+        if (surface.project_to_triangle(t, p) - p).norm() <= eps {
+            n += surface.normal(t);
+        }
+    }
+    if n.norm() > 0.0 {
+        n.normalize()
+    } else {
+        surface.closest_point(p).normal
+    }
+}
+
+/// Facets within this distance (times the tool's diagonal) of a seed touch it.
+const SEED_CONTACT_REL: f64 = 1e-9;
 
 /// Drape every ply of `scene` on `tool` in stacking order. `on_ply(k, name)` is called before
 /// ply `k` starts (for progress display).
@@ -144,9 +171,20 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
             (Some(s), r)
         };
         let surface = offset_tool.as_ref().unwrap_or(tool);
-        let (warp, seed_normal) = resolve_warp(ply, &scene.reference, surface, scene.stack_side)
-            .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         let mut settings = ply.settings.clone();
+        if k > 0 {
+            // The seed rides up with the stack: the point of the offset surface over its foot on
+            // the tool (not the offset surface's closest point, which is off to one side when the
+            // seed lies below it).
+            let foot = tool.closest_point(&ply.settings.origin);
+            let l = tool.barycentric(foot.triangle, &foot.point);
+            let tri = tool.triangle(foot.triangle);
+            let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
+            let moved = offset_vertices(tool, &dirs, &signed);
+            settings.origin = Point::from((0..3).fold(Vector::zeros(), |acc, c| acc + moved[tri[c] as usize].coords * l[c]));
+        }
+        let (warp, seed_normal) = resolve_warp_at(ply, &settings.origin, &scene.reference, surface, scene.stack_side)
+            .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
         let mut net = drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
         let mut refined = None;

@@ -1,0 +1,143 @@
+//! Layups from scene files: four-ply 0/45/90/-45 stacks on the bundled hemisphere and
+//! double-dome-like part, each ply on the tool offset by the plies below it; the layup table,
+//! flat patterns and nesting they write; and scene errors that name the field and line.
+use assert_cmd::Command;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn drape() -> Command {
+    Command::cargo_bin("drape").unwrap()
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn read_json(p: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
+}
+
+/// Thickness of the glass card the hemisphere scene uses, m.
+const GLASS_T: f64 = 5.5e-4;
+/// Positions on the offset facets agree with the analytic offset to this (m): the facets of the
+/// 20k-triangle hemisphere tilt by about half a degree around the pole.
+const OFFSET_TOL: f64 = 2e-6;
+
+fn origin_node(net: &Value) -> [f64; 3] {
+    let nv = net["grid"][1].as_u64().unwrap() as usize;
+    let [i, j] = [0, 1].map(|k| net["origin_node"][k].as_u64().unwrap() as usize);
+    let p = &net["nodes"][i * nv + j];
+    [0, 1, 2].map(|k| p[k].as_f64().unwrap())
+}
+
+#[test]
+fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let scene = root().join("geometries/hemisphere/scene.toml");
+    let run = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"]).assert().success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    assert!(stdout.contains("layup: 4 plies"), "{stdout}");
+    let layup = read_json(&out.join("layup.json"));
+    let plies = layup["plies"].as_array().unwrap();
+    let names: Vec<&str> = plies.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["p0", "p45", "p90", "m45"]);
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let expected_warp = [[1.0, 0.0], [s, s], [0.0, 1.0], [s, -s]];
+    for (k, p) in plies.iter().enumerate() {
+        // At the pole the tool normal is +z: the warp is the reference turned by the ply angle.
+        let w = [0, 1, 2].map(|c| p["warp"][c].as_f64().unwrap());
+        assert!((w[0] - expected_warp[k][0]).abs() < 1e-9 && (w[1] - expected_warp[k][1]).abs() < 1e-9 && w[2].abs() < 1e-9, "ply {k} warp {w:?}");
+        assert_eq!(p["material"], "glass");
+        assert!((p["thickness_m"].as_f64().unwrap() - GLASS_T).abs() < 1e-15);
+        // Each ply sits on the ones below: at the pole (no shear) k plies of t0.
+        let net = read_json(&out.join(format!("{}.drape.json", names[k])));
+        let o = origin_node(&net);
+        let height = 0.1 + k as f64 * GLASS_T;
+        assert!((o[2] - height).abs() < OFFSET_TOL, "ply {k}: seed node at z {} instead of {height}", o[2]);
+        // A sheared ply below thickens the stack: the largest offset exceeds k t0.
+        let offset = p["offset_m"].as_f64().unwrap();
+        if k > 0 {
+            assert!(offset > k as f64 * GLASS_T * 1.2, "ply {k}: largest offset {offset}");
+        }
+        // The table: sphere shear 40-60 deg at the corners of a 0.31 m net on R = 0.1 m.
+        let max = p["max_abs_shear_deg"].as_f64().unwrap();
+        assert!(max > 40.0 && max < 60.0, "ply {k}: max |shear| {max}");
+        assert!(p["area_over_locking_m2"].as_f64().unwrap() > 0.0);
+        let cov = p["coverage"].as_f64().unwrap();
+        assert!(cov > 0.5 && cov <= 1.0, "coverage {cov}");
+        let cells = p["cells"].as_f64().unwrap();
+        assert!((p["fabric_area_m2"].as_f64().unwrap() - cells * 0.004 * 0.004).abs() < 1e-12);
+        let mass = p["fabric_mass_kg"].as_f64().unwrap();
+        assert!((mass - 0.6 * cells * 0.004 * 0.004).abs() < 1e-12, "mass {mass}");
+    }
+    // Flat patterns nested on the scene's 1 m roll: their area is the fabric the plies use.
+    let nesting = &layup["nesting"];
+    assert_eq!(nesting["roll_width_m"].as_f64().unwrap(), 1.0);
+    let fabric: f64 = plies.iter().map(|p| p["fabric_area_m2"].as_f64().unwrap()).sum();
+    assert!((nesting["pattern_area_m2"].as_f64().unwrap() - fabric).abs() < 1e-9 * fabric);
+    let used = nesting["used_area_m2"].as_f64().unwrap();
+    assert!((nesting["waste_fraction"].as_f64().unwrap() - (used - fabric) / used).abs() < 1e-9);
+    for f in ["patterns.dxf", "patterns.svg", "ply-p0.svg", "ply-m45.svg"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+}
+
+#[test]
+fn a_four_ply_layup_runs_on_the_double_dome() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let scene = root().join("geometries/double-dome/scene.toml");
+    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"]).assert().success();
+    let layup = read_json(&out.join("layup.json"));
+    let plies = layup["plies"].as_array().unwrap();
+    assert_eq!(plies.len(), 4);
+    let angles: Vec<f64> = plies.iter().map(|p| p["angle_deg"].as_f64().unwrap()).collect();
+    assert_eq!(angles, [0.0, 45.0, 90.0, -45.0]);
+    // The carbon card: 0.35 mm a ply; offsets grow up the stack, never fold on this part.
+    let mut last = 0.0;
+    for (k, p) in plies.iter().enumerate() {
+        let off = p["offset_m"].as_f64().unwrap();
+        assert!(off >= last && (k == 0 || off >= k as f64 * 3.5e-4 - 1e-12), "ply {k}: offset {off}");
+        assert_eq!(p["offset_folded_triangles"].as_u64().unwrap(), 0, "ply {k}");
+        last = off;
+        let net = read_json(&out.join(format!("{}.drape.json", p["name"].as_str().unwrap())));
+        let o = origin_node(&net);
+        assert!((o[2] - (0.06 + k as f64 * 3.5e-4)).abs() < 1e-9, "ply {k}: seed on the flat top at z {}", o[2]);
+    }
+    // The 0 and 90 plies of a doubly symmetric part shear alike (within the grid's asymmetry).
+    let (m0, m90) = (plies[0]["max_abs_shear_deg"].as_f64().unwrap(), plies[2]["max_abs_shear_deg"].as_f64().unwrap());
+    assert!(m0 > 30.0 && (m0 - m90).abs() < 5.0, "0 deg {m0}, 90 deg {m90}");
+}
+
+fn scene_refused(scene: &str, needle: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = root().join("geometries/hemisphere/hemisphere-2k.obj");
+    let text = scene.replace("TOOL", tool.to_str().unwrap()).replace("CARDS", root().join("materials").to_str().unwrap());
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("out");
+    let a = drape().args(["run", path.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains(needle), "expected '{needle}' in: {err}");
+    assert!(!out.exists(), "nothing may be written for a bad scene");
+}
+
+const PLY: &str = "[[ply]]\nname = \"a\"\norigin = [0.0, 0.0, 0.1]\nspacing = 0.01\ngrid = [11, 11]\n";
+
+#[test]
+fn scene_errors_name_the_field_and_the_line() {
+    let head = "tool = \"TOOL\"\n";
+    scene_refused(&format!("{head}{PLY}angle_deg = 45.0\nwarp = [1.0, 0.0, 0.0]\n"), "(line 2), field `warp`: give either warp or angle_deg");
+    scene_refused(&format!("{head}{PLY}material = \"nylon\"\n"), "field `material`: 'nylon' is neither a name in [materials]");
+    scene_refused(
+        &format!("{head}{PLY}{}", PLY.replace("\"a\"", "\"b\"")),
+        "ply 'a' (line 2), field `thickness`: a ply with plies above it needs a thickness",
+    );
+    scene_refused(&format!("{head}stack_side = \"up\"\n{PLY}"), "field `stack_side`");
+    scene_refused(&format!("{head}reference = [0.0, 0.0, 0.0]\n{PLY}"), "field `reference`");
+    scene_refused(&format!("{head}[materials]\nglass = \"CARDS/nope.toml\"\n{PLY}"), "[materials] `glass`");
+    scene_refused(&format!("{head}[export]\nmesh = \"x.bdf\"\nformats = [\"stl\"]\n{PLY}"), "field `formats`: unknown format 'stl'");
+    // A reference along the normal at the seed (the pole) has no direction on the tool there.
+    scene_refused(&format!("{head}reference = [0.0, 0.0, 1.0]\n{PLY}"), "normal to the tool at the seed");
+}
