@@ -394,10 +394,9 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
             let Some(hit) = sampler.cover(&mesh.centroid(e), settings.max_distance) else {
                 return Ok(None);
             };
-            let (w3, f3, cell_normal) = (hit.warp, hit.weft, hit.normal);
-            // The element normal follows the element's own winding; turn it to the ply's side so
-            // angles are measured the same way on every element.
-            let normal = if normal.dot(&cell_normal) < 0.0 { -normal } else { normal };
+            let (w3, f3) = (hit.warp, hit.weft);
+            // Angles are measured about the element's own normal (right-handed over G1, G2, G3),
+            // as the solvers that read THETA measure them, whichever side the ply lies on.
             let (Some(warp), Some(weft)) = (in_plane(&w3, &normal), in_plane(&f3, &normal)) else {
                 return Ok(None); // the element stands edge-on to the ply: not covered
             };
