@@ -186,9 +186,12 @@ impl Reader {
         let mut lines: Vec<&[u8]> = bytes.split(|&c| c == b'\n').collect();
         let mut first_line = 0;
         if top {
+            // Cheap byte test first: this runs on every line of the file.
             if let Some(k) = lines.iter().position(|l| {
-                let t = String::from_utf8_lossy(trim(l)).to_ascii_uppercase();
-                t.starts_with("BEGIN") && t.contains("BULK")
+                let t = trim(l);
+                t.len() >= 5
+                    && t[..5].eq_ignore_ascii_case(b"BEGIN")
+                    && String::from_utf8_lossy(t).to_ascii_uppercase().contains("BULK")
             }) {
                 first_line = k + 1;
             }
@@ -215,12 +218,12 @@ impl Reader {
             };
             let is_cont = first.is_empty() || first[0] == b'+' || first[0] == b'*';
             if !is_cont {
-                let upper = String::from_utf8_lossy(first).to_ascii_uppercase();
-                if upper.starts_with("ENDDATA") {
+                let starts = |w: &[u8]| first.len() >= w.len() && first[..w.len()].eq_ignore_ascii_case(w);
+                if starts(b"ENDDATA") {
                     self.flush(b)?;
                     return Ok(true);
                 }
-                if upper.starts_with("INCLUDE") {
+                if starts(b"INCLUDE") {
                     self.flush(b)?;
                     if self.include(b, line, loc, depth)? {
                         return Ok(true);
@@ -228,7 +231,10 @@ impl Reader {
                     continue;
                 }
                 self.flush(b)?;
-                self.card.name = upper.trim_end_matches('*').trim().to_string();
+                // Upper-case name without the large-field '*', reusing the buffer.
+                let name = trim(first.strip_suffix(b"*").unwrap_or(first));
+                self.card.name.clear();
+                self.card.name.extend(name.iter().map(|c| c.to_ascii_uppercase() as char));
                 self.card.loc = Some(loc);
             } else if self.card.loc.is_none() {
                 return Err(b.syntax(loc, "continuation line with no card before it: start the card with its name (GRID, CQUAD4, ...)"));
@@ -333,7 +339,7 @@ impl Reader {
                 let n = if name.starts_with("CTRIA") { 3 } else { 4 };
                 let mut g = [0u64; 4];
                 for (k, gk) in g.iter_mut().enumerate().take(n) {
-                    *gk = id(2 + k, &format!("G{}", k + 1))?;
+                    *gk = id(2 + k, ["G1", "G2", "G3", "G4"][k])?;
                 }
                 b.add_element(eid, &g[..n], pid, loc)?;
             }
