@@ -2,8 +2,9 @@
 //! entity blocks (parametric coordinates skipped) and `$Elements` blocks. Triangles (type 2)
 //! and quadrangles (type 3) are kept; every other type (points, lines, volumes, second-order
 //! elements) is skipped. An element's property is the first physical tag of its entity when
-//! `$Entities` gives one, else the entity tag. Other sections are skipped. Older versions (2.x,
-//! 4.0) and binary files are refused with a message saying how to re-save.
+//! `$Entities` gives one, else the entity tag. Other sections are skipped. Binary 4.1 files
+//! (little-endian, 8-byte size_t, as Gmsh writes them on every common machine) are read the
+//! same way. Older versions (2.x, 4.0) are refused with a message saying how to re-save.
 use super::{read_bytes, Builder, FlowMesh, FlowMeshError, Loc};
 use std::collections::HashMap;
 use std::path::Path;
@@ -34,8 +35,16 @@ pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                         format!("Gmsh format version {}: only 4.1 is read; re-save as 4.1 ASCII (File > Export, Version 4 ASCII, or -format msh41)", t.first().unwrap_or(&"?")),
                     ));
                 }
+                if t.get(1) == Some(&"1") {
+                    if t.get(2) != Some(&"8") {
+                        return Err(b.syntax(loc, "binary .msh with a size_t that is not 8 bytes: re-save as ASCII"));
+                    }
+                    // The binary part starts after the format line.
+                    let start = byte_offset_of_line(&bytes, no);
+                    return read_binary(b, &bytes, start);
+                }
                 if t.get(1) != Some(&"0") {
-                    return Err(b.syntax(loc, "binary .msh: re-save as ASCII (Gmsh: File > Export, uncheck binary, or -format msh41 without -bin)"));
+                    return Err(b.syntax(loc, "the file type on the $MeshFormat line must be 0 (ASCII) or 1 (binary)"));
                 }
                 format_seen = true;
                 c.skip_to(&b, &end, loc)?;
@@ -173,5 +182,214 @@ fn ints(b: &Builder, l: &str, no: usize, min: usize) -> Result<Vec<i64>, FlowMes
     match v {
         Ok(v) if v.len() >= min => Ok(v),
         _ => Err(b.syntax(Loc { file: 0, line: no }, format!("expected {min} or more integers, found '{l}'"))),
+    }
+}
+
+/// Byte offset of the start of line `no + 1` (1-based `no`): where a binary part begins.
+fn byte_offset_of_line(bytes: &[u8], no: usize) -> usize {
+    let mut seen = 0;
+    for (k, &c) in bytes.iter().enumerate() {
+        if c == b'\n' {
+            seen += 1;
+            if seen == no {
+                return k + 1;
+            }
+        }
+    }
+    bytes.len()
+}
+
+/// Node count of the Gmsh element types, to step over the types we skip in binary files
+/// (ASCII files are skipped line by line and need no table).
+fn nodes_of_type(kind: i32) -> Option<usize> {
+    Some(match kind {
+        1 => 2,
+        2 => 3,
+        3 => 4,
+        4 => 4,
+        5 => 8,
+        6 => 6,
+        7 => 5,
+        8 => 3,
+        9 => 6,
+        10 => 9,
+        11 => 10,
+        12 => 27,
+        13 => 18,
+        14 => 14,
+        15 => 1,
+        16 => 8,
+        17 => 20,
+        18 => 15,
+        19 => 13,
+        20 => 9,
+        21 => 10,
+        22 => 12,
+        23 => 15,
+        24 => 15,
+        25 => 21,
+        26 => 4,
+        27 => 5,
+        28 => 6,
+        29 => 20,
+        30 => 35,
+        31 => 56,
+        _ => return None,
+    })
+}
+
+/// Little-endian reader of the binary sections.
+struct Bin<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Bin<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let s = self.bytes.get(self.pos..self.pos.checked_add(n)?)?;
+        self.pos += n;
+        Some(s)
+    }
+    fn i32(&mut self) -> Option<i32> {
+        Some(i32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+    fn f64(&mut self) -> Option<f64> {
+        Some(f64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+    /// A count that must fit what is left of the file (`each` bytes an item), so a corrupt
+    /// count cannot make us allocate wildly.
+    fn count(&mut self, each: usize) -> Option<usize> {
+        let n = usize::try_from(self.u64()?).ok()?;
+        (n.checked_mul(each)? <= self.bytes.len() - self.pos).then_some(n)
+    }
+    /// The next text line (a section header), skipping the newline left after binary data.
+    fn line(&mut self) -> Option<&'a str> {
+        while self.pos < self.bytes.len() && matches!(self.bytes[self.pos], b'\n' | b'\r' | b' ') {
+            self.pos += 1;
+        }
+        if self.pos >= self.bytes.len() {
+            return None;
+        }
+        let end = self.bytes[self.pos..].iter().position(|&c| c == b'\n').map_or(self.bytes.len(), |k| self.pos + k);
+        let l = std::str::from_utf8(&self.bytes[self.pos..end]).ok()?.trim();
+        // Binary data starts right after the header's newline.
+        self.pos = (end + 1).min(self.bytes.len());
+        Some(l)
+    }
+    /// Skip to just after the text `end` (e.g. `$EndNodes`).
+    fn skip_to(&mut self, end: &str) -> Option<()> {
+        let e = end.as_bytes();
+        let k = self.bytes[self.pos..].windows(e.len()).position(|w| w == e)?;
+        self.pos += k + e.len();
+        Some(())
+    }
+}
+
+/// Read the binary part of a 4.1 file, from `start` (just after the `$MeshFormat` line).
+fn read_binary(mut b: Builder, bytes: &[u8], start: usize) -> Result<FlowMesh, FlowMeshError> {
+    let path = b.files[0].clone();
+    let bad = |pos: usize, what: &str| FlowMeshError::Invalid {
+        path: path.clone(),
+        message: format!("binary .msh at byte {pos}: {what}; the file may be truncated or not little-endian: re-save as 4.1 ASCII"),
+    };
+    let mut r = Bin { bytes, pos: start };
+    if r.i32() != Some(1) {
+        return Err(bad(start, "the endianness check is not 1 (big-endian files are not read)"));
+    }
+    r.skip_to("$EndMeshFormat").ok_or_else(|| bad(r.pos, "no $EndMeshFormat"))?;
+    let mut physical: HashMap<(i64, i64), u64> = HashMap::new();
+    while let Some(l) = r.line() {
+        let pos = r.pos;
+        let Some(section) = l.strip_prefix('$') else { return Err(bad(pos, &format!("expected a section, found '{l}'"))) };
+        let end = format!("$End{section}");
+        let e = |what: &str| bad(pos, &format!("${section}: {what}"));
+        match section {
+            "Entities" => {
+                let mut counts = [0usize; 4];
+                for c in &mut counts {
+                    *c = r.count(4).ok_or_else(|| e("entity counts"))?;
+                }
+                for (dim, &n) in counts.iter().enumerate() {
+                    for _ in 0..n {
+                        let tag = r.i32().ok_or_else(|| e("entity tag"))?;
+                        r.take(if dim == 0 { 24 } else { 48 }).ok_or_else(|| e("entity box"))?;
+                        let np = r.count(4).ok_or_else(|| e("physical count"))?;
+                        let mut first = None;
+                        for _ in 0..np {
+                            let p = r.i32().ok_or_else(|| e("physical tag"))?;
+                            first.get_or_insert(p);
+                        }
+                        if let Some(p) = first {
+                            physical.insert((dim as i64, i64::from(tag)), u64::from(p.unsigned_abs()));
+                        }
+                        if dim > 0 {
+                            let nb = r.count(4).ok_or_else(|| e("bounding count"))?;
+                            r.take(4 * nb).ok_or_else(|| e("bounding tags"))?;
+                        }
+                    }
+                }
+            }
+            "Nodes" => {
+                let blocks = r.count(1).ok_or_else(|| e("counts"))?;
+                r.take(24).ok_or_else(|| e("counts"))?;
+                for _ in 0..blocks {
+                    let (dim, _tag, parametric) = (r.i32(), r.i32(), r.i32());
+                    let (Some(dim), Some(parametric)) = (dim, parametric) else { return Err(e("block header")) };
+                    let n = r.count(8).ok_or_else(|| e("block size"))?;
+                    let mut tags = Vec::with_capacity(n);
+                    for _ in 0..n {
+                        tags.push(r.u64().ok_or_else(|| e("node tags"))?);
+                    }
+                    let extra = if parametric != 0 { dim.max(0) as usize } else { 0 };
+                    for tag in tags {
+                        let mut x = [0.0; 3];
+                        for xi in &mut x {
+                            *xi = r.f64().ok_or_else(|| e("coordinates"))?;
+                        }
+                        r.take(8 * extra).ok_or_else(|| e("parametric coordinates"))?;
+                        // Binary data has no lines: report the section's line (the header's).
+                        b.add_node(tag, x, Loc { file: 0, line: 0 }).map_err(no_line)?;
+                    }
+                }
+            }
+            "Elements" => {
+                let blocks = r.count(1).ok_or_else(|| e("counts"))?;
+                r.take(24).ok_or_else(|| e("counts"))?;
+                for _ in 0..blocks {
+                    let (dim, tag, kind) = (r.i32(), r.i32(), r.i32());
+                    let (Some(dim), Some(tag), Some(kind)) = (dim, tag, kind) else { return Err(e("block header")) };
+                    let k = nodes_of_type(kind).ok_or_else(|| e(&format!("element type {kind} is not known: re-save as 4.1 ASCII")))?;
+                    let n = r.count(8 * (k + 1)).ok_or_else(|| e("block size"))?;
+                    let property = physical.get(&(i64::from(dim), i64::from(tag))).copied().unwrap_or(u64::from(tag.unsigned_abs()));
+                    let mut v = [0u64; 4];
+                    for _ in 0..n {
+                        let id = r.u64().ok_or_else(|| e("element"))?;
+                        if kind == 2 || kind == 3 {
+                            for x in v.iter_mut().take(k) {
+                                *x = r.u64().ok_or_else(|| e("element nodes"))?;
+                            }
+                            b.add_element(id, &v[..k], property, Loc { file: 0, line: 0 }).map_err(no_line)?;
+                        } else {
+                            r.take(8 * k).ok_or_else(|| e("element nodes"))?;
+                            b.skip(&format!("Gmsh type {kind}"));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+        r.skip_to(&end).ok_or_else(|| e(&format!("no {end}")))?;
+    }
+    b.finish("Gmsh types 2 (triangle) and 3 (quadrangle)").map_err(no_line)
+}
+
+/// Binary data has no line numbers (the builder's errors carry line 0): drop the line.
+fn no_line(e: FlowMeshError) -> FlowMeshError {
+    match e {
+        FlowMeshError::Syntax { path, line: 0, message } => FlowMeshError::Invalid { path, message: format!("binary data: {message}") },
+        e => e,
     }
 }

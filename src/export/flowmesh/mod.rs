@@ -1,6 +1,7 @@
 //! Resin-flow meshes: the user's own shell mesh of the part (not the drape grid), read from
 //! Nastran bulk data (GRID/CTRIA3/CQUAD4 in fixed, large and free fields), Abaqus input decks
-//! (*NODE/*ELEMENT, S3/S4/S3R/S4R/M3D3/M3D4/R3D3/R3D4), OBJ and Gmsh 4 `.msh`.
+//! (*NODE/*ELEMENT, S3/S4/S3R/S4R/M3D3/M3D4/R3D3/R3D4, parts and instances), OBJ and Gmsh 4.1
+//! `.msh` (ASCII and binary).
 //!
 //! Every reader returns a [`FlowMesh`]: nodes in metres (scaled by the caller's unit factor),
 //! the ids the file gave them, and three- and four-node shell elements with their own ids, so
