@@ -110,8 +110,8 @@ fn other_formats_give_the_same_plate() {
 fn scale_converts_to_metres() {
     let m = read_flow_mesh(&data("plate_small.bdf"), 1e-3).unwrap();
     for (k, (_, x)) in NODES.iter().enumerate() {
-        for i in 0..3 {
-            assert!((m.nodes[k][i] - x[i] * 1e-3).abs() <= 1e-15 * x[i].abs(), "node {k} axis {i}");
+        for (i, xi) in x.iter().enumerate() {
+            assert!((m.nodes[k][i] - xi * 1e-3).abs() <= 1e-15 * xi.abs(), "node {k} axis {i}");
         }
     }
     assert!((m.nodes[6].z - 1.5).abs() < 1e-15);
@@ -183,8 +183,8 @@ fn nastran_local_coordinate_systems() {
     let want = [[13.0, 21.0, 32.0], [15.0, 20.0, 32.0], [0.0, 0.0, 0.0]];
     // GRID 2: local (r=2, 90 deg, z=5) in system 6 = (0, 2, 5) in system 5 = (15, 20, 32).
     for (k, w) in want.iter().enumerate() {
-        for i in 0..3 {
-            assert!((m.nodes[k][i] - w[i]).abs() < 1e-12, "grid {} axis {i}: {}", k + 1, m.nodes[k][i]);
+        for (i, wi) in w.iter().enumerate() {
+            assert!((m.nodes[k][i] - wi).abs() < 1e-12, "grid {} axis {i}: {}", k + 1, m.nodes[k][i]);
         }
     }
     assert_eq!(m.elements[0].property, 1, "blank PID defaults to the EID");

@@ -230,7 +230,7 @@ fn parse(b: &mut Builder, lines: &[Line]) -> Result<Deck, FlowMeshError> {
         let mut text = start.text.clone();
         let kind_corners = if let Mode::Element { corners: Some(c), .. } = mode { Some(c) } else { None };
         loop {
-            let enough = kind_corners.is_some_and(|c| entries(&text).len() >= c + 1);
+            let enough = kind_corners.is_some_and(|c| entries(&text).len() > c);
             if !text.ends_with(',') || enough || k >= lines.len() || is_keyword(&lines[k].text) {
                 break;
             }

@@ -382,13 +382,13 @@ impl Reader {
             let x = if g.cp == 0 {
                 g.x
             } else {
-                if !frames.contains_key(&g.cp) {
-                    let f = self.frame(b, g.cp, 0).map_err(|why| {
-                        b.syntax(g.loc, format!("GRID {} has CP={}: {why}", g.id, g.cp))
-                    })?;
-                    frames.insert(g.cp, f);
-                }
-                let f = &frames[&g.cp];
+                let f = match frames.entry(g.cp) {
+                    std::collections::hash_map::Entry::Occupied(o) => o.into_mut(),
+                    std::collections::hash_map::Entry::Vacant(v) => v.insert(
+                        self.frame(b, g.cp, 0)
+                            .map_err(|why| b.syntax(g.loc, format!("GRID {} has CP={}: {why}", g.id, g.cp)))?,
+                    ),
+                };
                 f.to_basic(g.x)
             };
             b.add_node(g.id, x, g.loc)?;
@@ -424,7 +424,8 @@ impl Reader {
         let y = ez.cross(&(pc - a));
         // Relative tolerance: points A, B, C must span a plane at a scale set by |AB| |AC|.
         let tol = 1e-12 * ez.norm() * (pc - a).norm();
-        if ez.norm() == 0.0 || !(y.norm() > tol) {
+        // partial_cmp: a NaN span (from infinite points) is refused too.
+        if ez.norm() == 0.0 || y.norm().partial_cmp(&tol) != Some(std::cmp::Ordering::Greater) {
             return Err(format!("coordinate system {cid} ({}) has coincident or collinear points A, B, C", at(c.loc)));
         }
         let ez = ez.normalize();
