@@ -389,10 +389,11 @@ fn bladelike_abaqus_decks() {
     }
 }
 
-/// A generated Nastran deck of `n` x `n` quads (small fixed fields) reads in time linear in
-/// its size. DRAPE_FLOWMESH_BENCH_N sets n (default 300: 90,000 quads; 1000 is 1M).
+/// A generated Nastran deck of `n` x `n` quads (small fixed fields) reads whole and right.
+/// DRAPE_FLOWMESH_BENCH_N sets n (default 300: 90,000 quads; 1000 is 1M). The time is printed,
+/// not asserted (speed is measured by benchmarks, not tests).
 #[test]
-fn large_nastran_deck_reads_fast() {
+fn large_nastran_deck_reads_whole() {
     let n: usize = std::env::var("DRAPE_FLOWMESH_BENCH_N").ok().and_then(|s| s.parse().ok()).unwrap_or(300);
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("big.bdf");
@@ -419,16 +420,11 @@ fn large_nastran_deck_reads_fast() {
     }
     s.push_str("ENDDATA\n");
     std::fs::write(&p, &s).unwrap();
-    let (t0, c0) = (Instant::now(), thread_cpu_seconds());
+    let t0 = Instant::now();
     let m = read_flow_mesh(&p, 1.0).unwrap();
     let wall = t0.elapsed().as_secs_f64();
-    // On a loaded machine wall time says little: use this thread's CPU time where Linux gives it.
-    let dt = match (c0, thread_cpu_seconds()) {
-        (Some(a), Some(b)) => b - a,
-        _ => wall,
-    };
     eprintln!(
-        "{} quads, {} nodes, {:.1} MB read in {dt:.3} s CPU ({wall:.3} s wall)",
+        "{} quads, {} nodes, {:.1} MB read in {wall:.3} s wall",
         m.elements.len(),
         m.nodes.len(),
         s.len() as f64 / 1e6
@@ -438,18 +434,5 @@ fn large_nastran_deck_reads_fast() {
     let last = m.elements.len() - 1;
     assert_eq!(m.element_node_ids(last), [id(n - 1, n - 1) as u64, id(n, n - 1) as u64, id(n, n) as u64, id(n - 1, n) as u64]);
     assert!((m.nodes[m.nodes.len() - 1].x - n as f64 * 0.01).abs() < 1e-12);
-    // Generous bound for a shared machine: 1M quads in about a second means this size in well
-    // under this; a quadratic id lookup would blow far past it.
-    let bound = 2.0 + 10.0 * (n * n) as f64 / 1e6;
-    assert!(dt < bound, "{dt} s for {} quads (bound {bound} s)", n * n);
 }
 
-/// CPU time (user + system) of the calling thread from /proc (Linux; clock ticks of 10 ms).
-fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    // Fields after the ")" that ends the command name: state is field 3, utime 14, stime 15.
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
