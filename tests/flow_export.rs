@@ -1,0 +1,257 @@
+//! `drape export` end to end: a ply draped on the 20k-triangle hemisphere, exported onto the
+//! 2k-triangle hemisphere as the flow mesh in every format, read back by independent readers
+//! (tools/flow_readback.py: meshio, pyNastran, parsers of the documented formats). For every
+//! covered element the directions read back are unit, lie in the element's plane (from the
+//! reader's own geometry), and their angle equals the ply's shear at that place (sampled on the
+//! net by the test).
+use assert_cmd::Command;
+use drape::export::map::NetSampler;
+use drape::export::read_net;
+use drape::geometry::{Point, Vector};
+use drape::kinematic::DrapeNet;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// Unit length and in-plane tolerances of directions read back (text round trips).
+const UNIT_TOL: f64 = 1e-9;
+/// The shear in a flow element (its plane) against the net's own shear at the element centroid
+/// (the bilinear cell there, degrees): the 2k-triangle facets tilt by up to about 2 deg against
+/// the net's cells, which changes projected angles by a fraction of a degree.
+const SHEAR_AT_PLACE_TOL_DEG: f64 = 0.5;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn skip_python() -> bool {
+    if std::env::var("DRAPE_SKIP_PYTHON").is_ok_and(|v| v == "1") {
+        eprintln!("flow_export: DRAPE_SKIP_PYTHON=1: skipped the independent read-back");
+        return true;
+    }
+    false
+}
+
+fn readback(format: &str, files: &[&Path]) -> Value {
+    let out = std::process::Command::new("python3")
+        .arg(root().join("tools/flow_readback.py"))
+        .arg(format)
+        .args(files)
+        .output()
+        .expect("python3 runs");
+    assert!(out.status.success(), "flow_readback {format}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// A +45 ply on the hemisphere (drape kinematic) and its export in `format` onto the 2k mesh.
+struct Case {
+    _dir: tempfile::TempDir,
+    dir: PathBuf,
+    net: DrapeNet,
+}
+
+fn drape_ply() -> Case {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_path_buf();
+    let tool = root().join("geometries/hemisphere/hemisphere-20k.obj");
+    Command::cargo_bin("drape")
+        .unwrap()
+        .args(["kinematic", "--tool", tool.to_str().unwrap(), "--origin", "0,0,0.1", "--warp", "1,1,0"])
+        .args(["--spacing", "0.004", "--grid", "79,79", "--name", "p45", "--format", "json", "--out", d.to_str().unwrap()])
+        .assert()
+        .success();
+    let net = read_net(&d.join("p45.drape.json")).unwrap();
+    Case { _dir: dir, dir: d, net }
+}
+
+fn export(case: &Case, format: &str, out: &str, extra: &[&str]) -> PathBuf {
+    let mesh = root().join("geometries/hemisphere/hemisphere-2k.obj");
+    let card = root().join("materials/glass-plain-weave.toml");
+    let out = case.dir.join(out);
+    Command::cargo_bin("drape")
+        .unwrap()
+        .args(["export", "--net", case.dir.join("p45.drape.json").to_str().unwrap(), "--mesh", mesh.to_str().unwrap()])
+        .args(["--format", format, "--out", out.to_str().unwrap(), "--material", card.to_str().unwrap()])
+        .args(extra)
+        .assert()
+        .success();
+    out
+}
+
+fn v3(v: &Value) -> Vector {
+    Vector::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap(), v[2].as_f64().unwrap())
+}
+
+/// Element geometry from a reader: centroid, unit normal (right-handed over the corners), unit
+/// first edge projected into the plane.
+struct Element {
+    centroid: Point,
+    normal: Vector,
+    edge: Vector,
+}
+
+fn element(points: &[Point]) -> Element {
+    let c = Point::from(points.iter().fold(Vector::zeros(), |s, p| s + p.coords) / points.len() as f64);
+    let mut n = Vector::zeros();
+    for k in 0..points.len() {
+        n += points[k].coords.cross(&points[(k + 1) % points.len()].coords);
+    }
+    let n = n.normalize();
+    let e = points[1] - points[0];
+    Element { centroid: c, normal: n, edge: (e - n * n.dot(&e)).normalize() }
+}
+
+/// The ply's shear (degrees) and warp at an element, from the net itself; `None` off the net.
+fn net_at(sampler: &NetSampler, e: &Element, reach: f64) -> Option<(f64, Vector)> {
+    let s = sampler.cover(&e.centroid, reach)?;
+    let w = s.warp - e.normal * e.normal.dot(&s.warp);
+    Some((s.shear().to_degrees(), w.normalize()))
+}
+
+fn angle_deg(a: &Vector, b: &Vector) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b)).to_degrees()
+}
+
+/// Check a covered element's directions: unit, in plane, angle = 90 - shear, shear = the net's.
+fn check_directions(e: &Element, warp: &Vector, weft: &Vector, shear_deg: f64, expected: (f64, Vector), worst: &mut f64, what: &str) {
+    assert!((warp.norm() - 1.0).abs() < UNIT_TOL && (weft.norm() - 1.0).abs() < UNIT_TOL, "{what}: not unit");
+    assert!(warp.dot(&e.normal).abs() < UNIT_TOL && weft.dot(&e.normal).abs() < UNIT_TOL, "{what}: not in the element plane");
+    assert!((angle_deg(warp, weft) - (90.0 - shear_deg)).abs() < 1e-7, "{what}: angle(warp, weft) != 90 - shear");
+    let diff = (shear_deg - expected.0).abs();
+    *worst = worst.max(diff);
+    assert!(diff < SHEAR_AT_PLACE_TOL_DEG, "{what}: shear {shear_deg} deg, the net's {} deg", expected.0);
+    assert!(angle_deg(warp, &expected.1) < 1e-6, "{what}: warp is not the net's warp projected into the element");
+}
+
+#[test]
+fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
+    if skip_python() {
+        return;
+    }
+    let case = drape_ply();
+    let sampler = NetSampler::new(&case.net).unwrap();
+    let reach = case.net.spacing + 5.5e-4;
+
+    // VTU (meshio): the geometry of every element and its fields.
+    let vtu = readback("vtu", &[&export(&case, "vtu", "flow.vtu", &["--permeability"])]);
+    let points: Vec<Point> = vtu["points"].as_array().unwrap().iter().map(|p| Point::from(v3(p))).collect();
+    let cells = vtu["cells"].as_array().unwrap();
+    let data = &vtu["cell_data"];
+    for name in ["element_id", "covered", "warp", "weft", "shear_deg", "thickness", "vf", "permeability"] {
+        assert!(data.get(name).is_some(), "VTU has no cell data '{name}'");
+    }
+    let mut elements = std::collections::HashMap::new();
+    let (mut covered, mut worst) = (0, 0.0f64);
+    for (k, c) in cells.iter().enumerate() {
+        let corners: Vec<Point> = c["nodes"].as_array().unwrap().iter().map(|n| points[n.as_u64().unwrap() as usize]).collect();
+        let e = element(&corners);
+        let scalar = |name: &str| data[name][k][0].as_f64().unwrap();
+        let id = scalar("element_id") as u64;
+        let at = net_at(&sampler, &e, reach);
+        let is_covered = scalar("covered") == 1.0;
+        assert_eq!(is_covered, at.is_some(), "element {id}: covered flag against the net");
+        if let Some(expected) = at {
+            covered += 1;
+            let shear = scalar("shear_deg");
+            check_directions(&e, &v3(&data["warp"][k]), &v3(&data["weft"][k]), shear, expected, &mut worst, &format!("VTU element {id}"));
+            // Fixed cavity: Vf = Vf0 / cos(shear) with the card's Vf0.
+            let vf = scalar("vf");
+            assert!((vf - 0.429 / shear.to_radians().cos()).abs() < 1e-9, "element {id}: vf {vf}");
+            assert_eq!(scalar("thickness"), 5.5e-4);
+        } else {
+            assert_eq!(scalar("shear_deg"), 0.0, "uncovered element {id} carries a value");
+        }
+        elements.insert(id, (e, at));
+    }
+    eprintln!("VTU: {covered} of {} elements covered; largest |shear - net's shear| {worst:.4} deg", cells.len());
+    assert!(covered > 1800, "{covered} covered");
+
+    // CSV (python csv): one row per element; same checks.
+    let csv = readback("csv", &[&export(&case, "csv", "flow.csv", &[])]);
+    let f = |row: &Value, n: &str| row[n].as_str().unwrap().parse::<f64>().unwrap();
+    let mut worst = 0.0f64;
+    for row in csv["rows"].as_array().unwrap() {
+        let id: u64 = row["element_id"].as_str().unwrap().parse().unwrap();
+        let (e, at) = &elements[&id];
+        assert_eq!(row["covered"].as_str().unwrap() == "1", at.is_some(), "CSV element {id}");
+        if let Some(expected) = at {
+            let warp = Vector::new(f(row, "warp_x"), f(row, "warp_y"), f(row, "warp_z"));
+            let weft = Vector::new(f(row, "weft_x"), f(row, "weft_y"), f(row, "weft_z"));
+            check_directions(e, &warp, &weft, f(row, "shear_deg"), *expected, &mut worst, &format!("CSV element {id}"));
+        }
+    }
+
+    // Nastran (pyNastran): THETA from G1->G2 about the element normal gives the net's warp.
+    let bdf = readback("nastran", &[&export(&case, "nastran", "flow.bdf", &[])]);
+    let deck = &bdf["decks"][0];
+    let grids = &deck["grids"];
+    let mut thetas = 0;
+    for (id, el) in deck["elements"].as_object().unwrap() {
+        let id: u64 = id.parse().unwrap();
+        let corners: Vec<Point> =
+            el["nodes"].as_array().unwrap().iter().map(|n| Point::from(v3(&grids[n.as_u64().unwrap().to_string()]))).collect();
+        let e = element(&corners);
+        // Uncovered elements go to PID 2 with a blank THETA (which pyNastran reads as 0).
+        let pid = el["pid"].as_u64().unwrap();
+        match (&elements[&id].1, el["theta"].as_f64().filter(|_| pid == 1)) {
+            (Some((_, warp)), Some(theta)) => {
+                let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(e.normal), theta.to_radians());
+                assert!(angle_deg(&(r * e.edge), warp) < 1e-6, "Nastran element {id}: THETA {theta} does not give the warp");
+                thetas += 1;
+            }
+            (None, None) => assert_eq!(pid, 2, "Nastran element {id}: uncovered, PID {pid}"),
+            (at, theta) => panic!("Nastran element {id}: covered {} but THETA {theta:?}", at.is_some()),
+        }
+    }
+    assert_eq!(thetas, covered);
+
+    // Abaqus (meshio + the documented *DISTRIBUTION layout): a = warp, b = weft per element.
+    let inp = readback("abaqus", &[&export(&case, "abaqus", "flow.inp", &[])]);
+    let dist = inp["distributions"].as_object().unwrap().values().next().expect("one distribution");
+    let rows = dist["rows"].as_object().unwrap();
+    assert_eq!(rows.len(), covered);
+    let mut worst = 0.0f64;
+    for (id, r) in rows {
+        let id: u64 = id.parse().unwrap();
+        let (e, at) = &elements[&id];
+        let r: Vec<f64> = r.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let (a, b) = (Vector::new(r[0], r[1], r[2]), Vector::new(r[3], r[4], r[5]));
+        let expected = at.expect("only covered elements are distributed");
+        let shear = 90.0 - angle_deg(&a, &b);
+        check_directions(e, &a, &b, shear, expected, &mut worst, &format!("Abaqus element {id}"));
+    }
+
+    // OptiStruct (documented DRAPE/PLY layout), free cavity: thinning T = 1 / cos(shear) and
+    // element THETA + PLY THETA + DRAPE THETA gives the warp.
+    let fem = readback("optistruct", &[&export(&case, "optistruct", "flow.fem", &["--cavity", "free"])]);
+    let ply = fem["plies"].as_object().unwrap().values().next().unwrap();
+    let drape = &fem["drapes"][ply["did"].as_u64().unwrap().to_string()];
+    let mut checked = 0;
+    for (id, el) in fem["elements"].as_object().unwrap() {
+        let Some((shear, warp)) = elements[&id.parse::<u64>().unwrap()].1 else { continue };
+        let d = drape[id].as_array().expect("a covered element has a DRAPE row");
+        let (t, dtheta) = (d[0].as_f64().unwrap(), d[1].as_f64().unwrap());
+        assert!((t - 1.0 / shear.to_radians().cos()).abs() < 0.02 * t, "OptiStruct element {id}: thinning {t}, shear {shear}");
+        let theta = el["theta"].as_f64().unwrap_or(0.0) + ply["theta"].as_f64().unwrap() + dtheta;
+        let g = &fem["grids"];
+        let corners: Vec<Point> =
+            el["nodes"].as_array().unwrap().iter().map(|n| Point::from(v3(&g[n.as_u64().unwrap().to_string()]))).collect();
+        let e = element(&corners);
+        let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(e.normal), theta.to_radians());
+        assert!(angle_deg(&(r * e.edge), &warp) < 1e-6, "OptiStruct element {id}: angles do not give the warp");
+        checked += 1;
+    }
+    assert_eq!(checked, covered);
+
+    // RTMsim (its read_nastran_mesh layout and 14-line input file): the covered elements, sets
+    // of the laminate, porosity 1 - Vf within what the ply's shear makes of Vf0.
+    let mesh = export(&case, "rtmsim", "flow-rtmsim.bdf", &["--permeability"]);
+    let input = case.dir.join("flow-rtmsim_input.txt");
+    let rtm = readback("rtmsim", &[&mesh, &input]);
+    let uncovered = rtm["uncovered"].as_array().unwrap().len();
+    assert_eq!(uncovered, elements.len() - covered, "RTMsim leaves out exactly the uncovered elements");
+    assert_eq!(rtm["tris"].as_object().unwrap().len(), covered, "the 2k mesh is all triangles: none split");
+    for p in rtm["params"].as_array().unwrap() {
+        let porosity = p[1].as_f64().unwrap();
+        assert!(porosity > 1.0 - 0.429 / 50f64.to_radians().cos() && porosity <= 1.0 - 0.429 + 1e-9, "porosity {porosity}");
+    }
+}
