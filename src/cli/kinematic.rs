@@ -86,7 +86,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     // Cheap argument checks come before the (possibly slow) tool load.
     check_settings(&settings).map_err(input)?;
     let t_load = Instant::now();
-    let tool = ToolSurface::from_obj_scaled(&a.tool, scale).map_err(input)?;
+    let tool = crate::layup::load_tool(&a.tool, scale).map_err(|m| input(anyhow::anyhow!(m)))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
     let mut net = drape(&tool, &settings).map_err(input)?;

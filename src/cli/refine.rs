@@ -3,7 +3,7 @@ use super::kinematic::print_tool_report;
 use super::summary::summary;
 use super::{compute, input, parse_vec3, Failure};
 use crate::export::{read_net, write_net, Format};
-use crate::geometry::{ToolSurface, Vector};
+use crate::geometry::Vector;
 use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
 use crate::mechanics::refine::{annotate, refine, RefineSettings, Refined};
@@ -61,7 +61,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     let net = read_net(&a.net).map_err(input)?;
     let material = MaterialCard::load(&a.material).map_err(input)?;
     let t_load = Instant::now();
-    let tool = ToolSurface::from_obj(&a.tool).map_err(input)?;
+    let tool = crate::layup::load_tool(&a.tool, 1.0).map_err(|m| input(anyhow::anyhow!(m)))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
     let settings = RefineSettings {

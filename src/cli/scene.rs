@@ -5,7 +5,6 @@ use super::refine::print_solver;
 use super::summary::summary;
 use super::{compute, input, Failure};
 use crate::export::{write_atomic, write_net, Format};
-use crate::geometry::ToolSurface;
 use crate::kinematic::fishnet::check_settings;
 use crate::layup::stack::{drape_layup, PlyResult};
 use crate::export::flow::write_flow;
@@ -41,7 +40,7 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
             .map_err(|e| input(anyhow::anyhow!("scene {}: ply '{}' (line {}): {e}", a.scene.display(), ply.settings.name, ply.line)))?;
     }
     let t_load = Instant::now();
-    let tool = ToolSurface::from_obj_scaled(&scene.tool, scene.scale).map_err(input)?;
+    let tool = crate::layup::load_tool(&scene.tool, scene.scale).map_err(|m| input(anyhow::anyhow!(m)))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&scene.tool, &tool);
     // Drape every ply first, so a bad ply is reported before any file is written.

@@ -6,7 +6,7 @@ pub mod stack;
 
 pub use scene::{Ply, Scene, SceneError};
 
-use crate::geometry::Point;
+use crate::geometry::{ObjError, Point, ToolSurface};
 use crate::kinematic::GeneratorKind;
 use std::path::Path;
 
@@ -57,4 +57,37 @@ pub fn unit_scale(units: &str) -> Result<f64, String> {
         "mm" => Ok(1e-3),
         other => Err(format!("unknown units '{other}': use \"m\" or \"mm\"")),
     }
+}
+
+/// Read a tool surface: an OBJ, or any shell mesh the flow-mesh readers take (an Abaqus mould
+/// deck, a Nastran or Gmsh mesh), its quads split into triangles. Lengths scaled by `scale`.
+pub fn load_tool(path: &Path, scale: f64) -> Result<ToolSurface, String> {
+    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        return ToolSurface::from_obj_scaled(path, scale).map_err(|e: ObjError| e.to_string());
+    }
+    let mesh = crate::export::flowmesh::read_flow_mesh(path, scale).map_err(|e| e.to_string())?;
+    // Only the nodes the elements use: decks carry reference nodes (rigid bodies) that are not
+    // part of the surface.
+    let mut index = vec![u32::MAX; mesh.nodes.len()];
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for el in &mesh.elements {
+        let ids: Vec<u32> = el
+            .nodes
+            .iter()
+            .map(|&n| {
+                if index[n] == u32::MAX {
+                    index[n] = vertices.len() as u32;
+                    vertices.push(mesh.nodes[n]);
+                }
+                index[n]
+            })
+            .collect();
+        triangles.push([ids[0], ids[1], ids[2]]);
+        if ids.len() == 4 {
+            triangles.push([ids[0], ids[2], ids[3]]);
+        }
+    }
+    ToolSurface::from_triangles(vertices, triangles).map_err(|e| format!("tool {}: {e}", path.display()))
 }
