@@ -78,9 +78,44 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
     assert!((nesting["pattern_area_m2"].as_f64().unwrap() - fabric).abs() < 1e-9 * fabric);
     let used = nesting["used_area_m2"].as_f64().unwrap();
     assert!((nesting["waste_fraction"].as_f64().unwrap() - (used - fabric) / used).abs() < 1e-9);
-    for f in ["patterns.dxf", "patterns.svg", "ply-p0.svg", "ply-m45.svg"] {
+    for f in ["patterns.dxf", "patterns.svg", "ply-p0.svg", "ply-m45.svg", "flow.csv"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+    // The scene's [export]: every ply on the flow mesh, fields prefixed by the ply, laminate
+    // fields summed over the plies covering each element (read back with meshio).
+    if std::env::var("DRAPE_SKIP_PYTHON").is_ok_and(|v| v == "1") {
+        return;
+    }
+    let r = std::process::Command::new("python3")
+        .arg(root().join("tools/flow_readback.py"))
+        .args(["vtu", out.join("flow.vtu").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let vtu: Value = serde_json::from_slice(&r.stdout).unwrap();
+    let data = &vtu["cell_data"];
+    let n = vtu["cells"].as_array().unwrap().len();
+    assert_eq!(n, 2116);
+    for name in &names {
+        for field in ["covered", "warp", "weft", "shear_deg", "thickness", "vf", "permeability"] {
+            assert!(data.get(format!("{name}_{field}")).is_some(), "no field {name}_{field}");
+        }
+    }
+    assert!(data.get("warp").is_none(), "a layup prefixes every ply field");
+    let scalar = |f: String, k: usize| data[&f][k][0].as_f64().unwrap();
+    let mut full = 0;
+    for k in 0..n {
+        let covering: Vec<&str> = names.iter().copied().filter(|p| scalar(format!("{p}_covered"), k) == 1.0).collect();
+        let t: f64 = covering.iter().map(|p| scalar(format!("{p}_thickness"), k)).sum();
+        assert!((scalar("laminate_thickness".into(), k) - t).abs() < 1e-15, "element {k}");
+        assert!((t - covering.len() as f64 * GLASS_T).abs() < 1e-15, "fixed cavity keeps each ply at t0");
+        if !covering.is_empty() {
+            let vf: f64 = covering.iter().map(|p| scalar(format!("{p}_vf"), k)).sum::<f64>() / covering.len() as f64;
+            assert!((scalar("mean_vf".into(), k) - vf).abs() < 1e-12, "element {k}: mean Vf");
+        }
+        full += (covering.len() == 4) as usize;
+    }
+    assert!(full > 1900, "{full} elements under all four plies");
 }
 
 #[test]

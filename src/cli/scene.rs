@@ -63,6 +63,12 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
         }
     }
     for (ply, r) in scene.plies.iter().zip(&results) {
+        if r.offset.folded > 0 {
+            println!(
+                "warning: ply '{}': the offset surface of the plies below folded over in {} triangles (a concave radius smaller than the stack); the ply was draped on it regardless",
+                ply.settings.name, r.offset.folded
+            );
+        }
         let t_write = Instant::now();
         let written = write_net(&r.net, &a.out, &formats).map_err(compute)?;
         println!("{}", summary(&r.net, ply.locking_angle, load_ms, t_write.elapsed().as_secs_f64() * 1e3));
