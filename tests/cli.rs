@@ -132,7 +132,7 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
     let dir = tempfile::tempdir().unwrap();
     plate_obj(dir.path());
     let scene = dir.path().join("scene.toml");
-    let good = "units = \"mm\"\ntool = \"plate.obj\"\n\n[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.02\ngrid = [11, 11]\n\n[[ply]]\nname = \"b\"\norigin = [0, 0, 0]\nwarp = [1, 1, 0]\nspacing = 0.02\ngrid = [11, 11]\n";
+    let good = "units = \"mm\"\ntool = \"plate.obj\"\n\n[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.02\ngrid = [11, 11]\nthickness = 0.5\n\n[[ply]]\nname = \"b\"\norigin = [0, 0, 0]\nwarp = [1, 1, 0]\nspacing = 0.02\ngrid = [11, 11]\n";
     std::fs::write(&scene, good).unwrap();
     let out = dir.path().join("out");
     drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
@@ -151,8 +151,9 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
         }
         assert!(!out.exists());
     };
-    check(&good.replace("spacing = 0.02\ngrid = [11, 11]\n\n[[ply]]", "spacing = -1\ngrid = [11, 11]\n\n[[ply]]"), &["ply 'a'", "line 4", "spacing"]);
-    check(&good.replace("warp = [1, 1, 0]", "warp = [1, 1]"), &["line 14", "warp"]);
+    check(&good.replace("spacing = 0.02\ngrid = [11, 11]\nthickness", "spacing = -1\ngrid = [11, 11]\nthickness"), &["ply 'a'", "line 4", "spacing"]);
+    check(&good.replace("thickness = 0.5\n", ""), &["ply 'a'", "line 4", "thickness", "plies above it"]);
+    check(&good.replace("warp = [1, 1, 0]", "warp = [1, 1]"), &["line 15", "warp"]);
     check(&good.replace("name = \"b\"", "name = \"b\"\ncolour = \"red\""), &["colour"]);
     check(&good.replace("tool = \"plate.obj\"", "tool = \"missing.obj\""), &["missing.obj"]);
     check(&good.replace("units = \"mm\"", "units = \"inch\""), &["units"]);

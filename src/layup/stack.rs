@@ -181,7 +181,11 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
             let tri = tool.triangle(foot.triangle);
             let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
             let moved = offset_vertices(tool, &dirs, &signed);
-            settings.origin = Point::from((0..3).fold(Vector::zeros(), |acc, c| acc + moved[tri[c] as usize].coords * l[c]));
+            let riding = Point::from((0..3).fold(Vector::zeros(), |acc, c| acc + moved[tri[c] as usize].coords * l[c]));
+            // A seed given off the tool stays where it is, so the drape refuses it by name.
+            if (riding - ply.settings.origin).norm() <= ply.settings.spacing + (riding - foot.point).norm() {
+                settings.origin = riding;
+            }
         }
         let (warp, seed_normal) = resolve_warp_at(ply, &settings.origin, &scene.reference, surface, scene.stack_side)
             .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
