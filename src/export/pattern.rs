@@ -260,19 +260,7 @@ fn dxf_text(s: &str) -> String {
 
 /// Text escaped for XML content and attribute values.
 fn xml(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c if c.is_control() => out.push(' '),
-            c => out.push(c),
-        }
-    }
-    out
+    super::xml_escape(s)
 }
 
 /// SVG ids of the plies, in order: `ply-` and the name with characters other than ASCII

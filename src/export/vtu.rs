@@ -86,7 +86,7 @@ fn write_vtu_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
 
 /// One ASCII `<DataArray>` of `components` per tuple; `values` are written with `{}` (exact for
 /// f64), a whole number of `group`s per line.
-fn data_array<W: Write, T: std::fmt::Debug>(
+pub(crate) fn data_array<W: Write, T: std::fmt::Debug>(
     w: &mut W,
     ty: &str,
     name: &str,

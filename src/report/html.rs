@@ -6,18 +6,7 @@ use std::fmt::Write;
 
 /// Escape text for HTML element content and attribute values.
 pub fn escape(s: &str) -> String {
-    let mut o = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => o.push_str("&amp;"),
-            '<' => o.push_str("&lt;"),
-            '>' => o.push_str("&gt;"),
-            '"' => o.push_str("&quot;"),
-            '\'' => o.push_str("&#39;"),
-            _ => o.push(c),
-        }
-    }
-    o
+    crate::export::xml_escape(s)
 }
 
 /// An SVG document without its XML declaration and DOCTYPE, ready to inline in HTML.

@@ -15,8 +15,6 @@ use std::path::Path;
 
 const VTK_TRIANGLE: u8 = 5;
 const VTK_QUAD: u8 = 9;
-/// Values per line in the data arrays (any layout is valid VTK).
-const PER_LINE: usize = 9;
 
 pub(super) fn write(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
     write_atomic(out, |w| write_to(mesh, map, w))
@@ -90,7 +88,7 @@ fn row_major(k: Option<&nalgebra::Matrix3<f64>>) -> [f64; 9] {
     out
 }
 
-/// One ASCII `<DataArray>`; values with `{:?}` (shortest text that reads back exactly).
+/// One ASCII `<DataArray>` (the net writer's, a whole tuple a group).
 fn data_array<W: Write, T: std::fmt::Debug>(
     w: &mut W,
     ty: &str,
@@ -98,15 +96,5 @@ fn data_array<W: Write, T: std::fmt::Debug>(
     components: usize,
     values: impl Iterator<Item = T>,
 ) -> io::Result<()> {
-    write!(w, "<DataArray type=\"{ty}\" Name=\"{name}\"")?;
-    if components > 1 {
-        write!(w, " NumberOfComponents=\"{components}\"")?;
-    }
-    w.write_all(b" format=\"ascii\">")?;
-    let per_line = PER_LINE.max(components) / components * components;
-    for (k, v) in values.enumerate() {
-        let sep = if k % per_line == 0 { "\n" } else { " " };
-        write!(w, "{sep}{v:?}")?;
-    }
-    w.write_all(b"\n</DataArray>\n")
+    crate::export::vtu::data_array(w, ty, name, components, components, values)
 }
