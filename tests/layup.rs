@@ -173,6 +173,7 @@ fn scene_errors_name_the_field_and_the_line() {
     scene_refused(&format!("{head}reference = [0.0, 0.0, 0.0]\n{PLY}"), "field `reference`");
     scene_refused(&format!("{head}[materials]\nglass = \"CARDS/nope.toml\"\n{PLY}"), "[materials] `glass`");
     scene_refused(&format!("{head}[export]\nmesh = \"x.bdf\"\nformats = [\"stl\"]\n{PLY}"), "field `formats`: unknown format 'stl'");
+    scene_refused(&format!("{head}[export]\nmesh = \"x.bdf\"\n{PLY}"), "[export] (line 2), field `mesh`: no flow mesh at");
     // A reference along the normal at the seed (the pole) has no direction on the tool there.
     scene_refused(&format!("{head}reference = [0.0, 0.0, 1.0]\n{PLY}"), "normal to the tool at the seed");
 }

@@ -81,9 +81,6 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     }
     println!("{}", layup_table(&scene, &results));
     let nesting = cutting_plan(&scene, &results, &a.out)?;
-    if let Some(export) = &scene.export {
-        export_flow(&scene, export, &results, &a.out)?;
-    }
     let table = a.out.join("layup.json");
     let mut json = layup_json(&scene, &results);
     if let Some(n) = nesting {
@@ -103,6 +100,10 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     })
     .map_err(compute)?;
     println!("wrote {}", table.display());
+    // Last, so that a bad flow mesh costs nothing already computed.
+    if let Some(export) = &scene.export {
+        export_flow(&scene, export, &results, &a.out)?;
+    }
     if !unconverged.is_empty() {
         return Err(compute(anyhow::anyhow!(
             "the mechanical solver stopped without equilibrium for {}; the last accepted states were written",

@@ -301,7 +301,11 @@ impl Scene {
                     "free" => Cavity::Free,
                     other => return Err(at("cavity", format!("unknown cavity '{other}': use \"fixed\" or \"free\""))),
                 };
-                Some(SceneExport { mesh: base.join(&e.mesh), formats, cavity, permeability: e.permeability })
+                let mesh = base.join(&e.mesh);
+                if !mesh.is_file() {
+                    return Err(at("mesh", format!("no flow mesh at {}: check the path (relative to the scene file)", mesh.display())));
+                }
+                Some(SceneExport { mesh, formats, cavity, permeability: e.permeability })
             }
         };
         let mut plies = Vec::new();
