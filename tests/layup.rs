@@ -129,6 +129,11 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
     assert_eq!(plies.len(), 4);
     let angles: Vec<f64> = plies.iter().map(|p| p["angle_deg"].as_f64().unwrap()).collect();
     assert_eq!(angles, [0.0, 45.0, 90.0, -45.0]);
+    // The first ply is refined (pressed): its net records the change from the kinematic one.
+    assert_eq!(plies[0]["method"], "mechanical");
+    let p0 = read_json(&out.join("p0.drape.json"));
+    assert_eq!(p0["method"], "mechanical");
+    assert!(p0["meta"]["change_from_kinematic"]["shear_deg"].as_array().is_some_and(|a| !a.is_empty()));
     // The carbon card: 0.35 mm a ply; offsets grow up the stack, never fold on this part.
     let mut last = 0.0;
     for (k, p) in plies.iter().enumerate() {
