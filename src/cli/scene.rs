@@ -63,6 +63,12 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
         }
     }
     for (ply, r) in scene.plies.iter().zip(&results) {
+        if r.offset.relaxed > 0 {
+            println!(
+                "ply '{}': the plies below bridge concave corners tighter than their thickness ({} offset vertices moved off the normals)",
+                ply.settings.name, r.offset.relaxed
+            );
+        }
         if r.offset.folded > 0 {
             println!(
                 "warning: ply '{}': the offset surface of the plies below folded over in {} triangles (a concave radius smaller than the stack); the ply was draped on it regardless",
@@ -272,6 +278,7 @@ fn layup_json(scene: &Scene, results: &[PlyResult]) -> serde_json::Value {
                 "fabric_mass_kg": s.fabric_mass,
                 "offset_m": r.offset.max_distance,
                 "offset_folded_triangles": r.offset.folded,
+                "offset_bridged_vertices": r.offset.relaxed,
             })
         })
         .collect();

@@ -28,9 +28,11 @@ pub struct OffsetReport {
     pub mean_distance: f64,
     /// Vertices whose direction was clipped at [`MAX_OFFSET_STRETCH`].
     pub clipped: usize,
-    /// Triangles that turned over (offset normal against the original): a concave region whose
-    /// radius is below the offset distance folds the offset surface there.
+    /// Triangles still turned over (offset normal against the original) after relaxation: a
+    /// concave region whose radius is below the offset distance folds the offset surface there.
     pub folded: usize,
+    /// Vertices moved off their normal offset to unfold such a region (the plies bridge it).
+    pub relaxed: usize,
 }
 
 /// Unit-distance offset direction of every vertex (see the module doc), pointing to the side the
@@ -107,14 +109,90 @@ pub fn offset_along(
     if report.moved > 0 {
         report.mean_distance /= report.moved as f64;
     }
-    for (t, tri) in tool.triangles().iter().enumerate() {
-        let [a, b, c] = tri.map(|i| moved[i as usize]);
-        if (b - a).cross(&(c - a)).dot(&tool.normal(t as u32)) <= 0.0 {
-            report.folded += 1;
-        }
+    let mut moved = moved;
+    report.folded = folded_triangles(tool, &moved).len();
+    if report.folded > 0 {
+        report.relaxed = unfold(tool, &mut moved, distance);
+        report.folded = folded_triangles(tool, &moved).len();
     }
     let surface = ToolSurface::from_triangles(moved, tool.triangles().to_vec())?;
     Ok((surface, report))
+}
+
+/// Triangles of the offset whose normal turned against the tool's.
+fn folded_triangles(tool: &ToolSurface, moved: &[Point]) -> Vec<usize> {
+    (0..tool.triangles().len())
+        .filter(|&t| {
+            let [a, b, c] = tool.triangles()[t].map(|i| moved[i as usize]);
+            (b - a).cross(&(c - a)).dot(&tool.normal(t as u32)) <= 0.0
+        })
+        .collect()
+}
+
+/// Sweeps of fold relaxation at most.
+const MAX_UNFOLD_SWEEPS: usize = 200;
+
+/// Where the offset folds (a concave radius smaller than the stack: the offsets of the two sides
+/// cross), the plies bridge the corner instead: the corners of folded triangles are moved to the
+/// mean of their neighbours, sweep after sweep (widening to the neighbours when a sweep does not
+/// help), and pushed back out to their offset distance from the tool where the mean sank below
+/// it, until nothing is folded. Returns the number of vertices moved.
+fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> usize {
+    let n = moved.len();
+    let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for tri in tool.triangles() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            ring[a as usize].push(b);
+            ring[b as usize].push(a);
+        }
+    }
+    for r in &mut ring {
+        r.sort_unstable();
+        r.dedup();
+    }
+    let mut touched = vec![false; n];
+    let mut widen = 0;
+    let mut last = usize::MAX;
+    for _ in 0..MAX_UNFOLD_SWEEPS {
+        let folded = folded_triangles(tool, moved);
+        if folded.is_empty() {
+            break;
+        }
+        if folded.len() >= last {
+            widen += 1; // no progress: relax a wider patch
+        }
+        last = folded.len();
+        let mut active = vec![false; n];
+        for &t in &folded {
+            for v in tool.triangles()[t] {
+                active[v as usize] = true;
+            }
+        }
+        for _ in 0..widen {
+            let grown: Vec<usize> = (0..n).filter(|&v| active[v]).collect();
+            for v in grown {
+                for &w in &ring[v] {
+                    active[w as usize] = true;
+                }
+            }
+        }
+        // Jacobi sweep: every active vertex from the old positions (order-free, deterministic).
+        let updates: Vec<(usize, Point)> = (0..n)
+            .filter(|&v| active[v] && !ring[v].is_empty())
+            .map(|v| {
+                let sum = ring[v].iter().fold(Vector::zeros(), |s, &w| s + moved[w as usize].coords);
+                (v, Point::from(sum / ring[v].len() as f64))
+            })
+            .collect();
+        for (v, p) in updates {
+            let q = tool.closest_point(&p).point;
+            let (gap, clearance) = ((p - q).norm(), distance[v].abs());
+            moved[v] = if gap < clearance && gap > 0.0 { q + (p - q) * (clearance / gap) } else { p };
+            touched[v] = true;
+        }
+    }
+    touched.iter().filter(|&&t| t).count()
 }
 
 /// The tool's vertices moved by `distance[v]` along `dirs[v]`.
@@ -173,6 +251,50 @@ mod tests {
             if on_wall {
                 assert!((p.x + h).abs() < TOL, "vertex {k} wall offset {}", p.x);
             }
+        }
+    }
+
+    /// An L-shaped channel with a concave fillet of radius `r` (floor z = 0 for x < -r, wall
+    /// x = 0 for z > r), extruded along y; normals into the channel.
+    fn channel(r: f64, n_arc: usize) -> ToolSurface {
+        let mut profile = vec![Point::new(-1.0, 0.0, 0.0), Point::new(-0.5, 0.0, 0.0)];
+        for k in 0..=n_arc {
+            let a = std::f64::consts::FRAC_PI_2 * k as f64 / n_arc as f64;
+            profile.push(Point::new(-r + r * a.sin(), 0.0, r - r * a.cos()));
+        }
+        profile.extend([Point::new(0.0, 0.0, 0.5), Point::new(0.0, 0.0, 1.0)]);
+        let m = profile.len();
+        let mut v = Vec::new();
+        for y in [0.0, 0.2, 0.4] {
+            v.extend(profile.iter().map(|p| Point::new(p.x, y, p.z)));
+        }
+        let mut tris = Vec::new();
+        for row in 0..2u32 {
+            for k in 0..(m as u32 - 1) {
+                let (a, b) = (row * m as u32 + k, (row + 1) * m as u32 + k);
+                tris.push([a, a + 1, b + 1]);
+                tris.push([a, b + 1, b]);
+            }
+        }
+        let tool = ToolSurface::from_triangles(v, tris).unwrap();
+        assert!(tool.normal(0).z > 0.0, "channel winding: normals into the channel");
+        tool
+    }
+
+    #[test]
+    fn a_stack_thicker_than_a_concave_fillet_bridges_it_without_folding() {
+        let (r, h) = (0.01, 0.03);
+        let tool = channel(r, 8);
+        let (dirs, clipped) = offset_directions(&tool);
+        let plain = offset_vertices(&tool, &dirs, &vec![h; tool.vertices().len()]);
+        assert!(!folded_triangles(&tool, &plain).is_empty(), "the plain offset folds in the fillet");
+        let (off, report) = offset_along(&tool, &dirs, clipped, &vec![h; tool.vertices().len()]).unwrap();
+        assert_eq!(report.folded, 0);
+        assert!(report.relaxed > 0);
+        // The bridge keeps clear of the tool: no vertex comes closer to it than the stack.
+        for (k, p) in off.vertices().iter().enumerate() {
+            let d = tool.closest_point(p).distance;
+            assert!(d > 0.95 * h, "vertex {k} at {p:?} is {d} from the tool");
         }
     }
 
