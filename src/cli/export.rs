@@ -122,10 +122,18 @@ pub(crate) fn coverage_line(map: &LayupMap, k: usize) -> String {
     let covered: Vec<f64> = ply.elements.iter().flatten().map(|f| f.shear.abs().to_degrees()).collect();
     let max = covered.iter().cloned().fold(0.0, f64::max);
     let mean = if covered.is_empty() { 0.0 } else { covered.iter().sum::<f64>() / covered.len() as f64 };
-    format!(
+    let capped = ply.elements.iter().flatten().filter(|f| f.vf >= crate::export::map::VF_CAP).count();
+    let mut line = format!(
         "  ply {}: covers {} of {} elements; |shear| max {max:.2} deg, mean {mean:.2} deg",
         ply.ply,
         covered.len(),
         ply.elements.len()
-    )
+    );
+    if capped > 0 {
+        line += &format!(
+            "; Vf0 / cos(shear) passes the fibre packing limit in {capped} elements: Vf written as {:.4} there (the fabric locks before that)",
+            crate::export::map::VF_CAP
+        );
+    }
+    line
 }

@@ -78,8 +78,9 @@ const GEBART_C_HEX: f64 = 57.0;
 /// Largest fibre volume fraction of a hexagonal packing, pi / (2 sqrt 3): fibres touch.
 pub const VF_MAX_HEX: f64 = 0.906_899_682_117_108_9;
 /// Fibre volume fractions are capped just below the packing limit (the fabric would have locked
-/// long before; the cap keeps the permeability model finite and the number honest).
-const VF_CAP: f64 = VF_MAX_HEX - 1e-6;
+/// long before; the cap keeps the permeability model finite); the commands count the elements
+/// that reach it.
+pub const VF_CAP: f64 = VF_MAX_HEX - 1e-6;
 /// A centroid whose closest point on the net lies further than this (times the net spacing) from
 /// it along the net's tangent plane is off the net's edge: the element is not covered.
 const EDGE_TOLERANCE_REL: f64 = 1e-6;
