@@ -36,8 +36,6 @@ pub struct PlyResult {
     pub refined: Option<Refined>,
     /// The warp direction at the seed, resolved on the ply's surface.
     pub warp: Vector,
-    /// Unit normal of the ply's surface at the seed, on the side the plies stack to.
-    pub seed_normal: Vector,
     /// How the tool was offset for this ply (nothing moved for the first).
     pub offset: OffsetReport,
     pub stats: PlyStats,
@@ -94,13 +92,10 @@ pub fn ply_stats(net: &DrapeNet, locking_angle: f64, areal_mass: Option<f64>) ->
     s
 }
 
-/// The warp direction of `ply` at its seed on `surface`, and the normal there on the stacking side.
-pub fn resolve_warp(ply: &Ply, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<(Vector, Vector), String> {
-    resolve_warp_at(ply, &ply.settings.origin, reference, surface, side)
-}
-
-/// [`resolve_warp`] with the seed at `origin` instead of the ply's own.
-fn resolve_warp_at(ply: &Ply, origin: &Point, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<(Vector, Vector), String> {
+/// The warp direction of `ply` with its seed at `origin` on `surface`: its warp or the scene's
+/// reference, projected onto the tangent plane there and turned by the ply angle about the
+/// normal on the stacking side.
+pub fn resolve_warp(ply: &Ply, origin: &Point, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<Vector, String> {
     let sp = surface.closest_point(origin);
     let n = seed_normal(surface, &sp.point);
     let n = match side {
@@ -123,7 +118,7 @@ fn resolve_warp_at(ply: &Ply, origin: &Point, reference: &Vector, surface: &Tool
         ));
     }
     let rotation = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(n), angle);
-    Ok(((rotation * projected).normalize(), n))
+    Ok((rotation * projected).normalize())
 }
 
 /// Unit normal of `surface` at its point `p`: the facet's normal inside a facet, the mean of the
@@ -162,10 +157,12 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
         on_ply(k, &ply.settings.name);
         let name = ply.settings.name.clone();
         let line = ply.line;
+        // Where this ply lies: the tool offset by the stack below it (before bridging corners).
+        let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
+        let under = offset_vertices(tool, &dirs, &signed);
         let (offset_tool, offset) = if k == 0 {
             (None, OffsetReport::default())
         } else {
-            let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
             let (s, r) = offset_along(tool, &dirs, clipped, &signed)
                 .map_err(|source| LayupError::Offset { ply: name.clone(), line, source })?;
             (Some(s), r)
@@ -179,15 +176,13 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
             let foot = tool.closest_point(&ply.settings.origin);
             let l = tool.barycentric(foot.triangle, &foot.point);
             let tri = tool.triangle(foot.triangle);
-            let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
-            let moved = offset_vertices(tool, &dirs, &signed);
-            let riding = Point::from((0..3).fold(Vector::zeros(), |acc, c| acc + moved[tri[c] as usize].coords * l[c]));
+            let riding = Point::from((0..3).fold(Vector::zeros(), |acc, c| acc + under[tri[c] as usize].coords * l[c]));
             // A seed given off the tool stays where it is, so the drape refuses it by name.
             if (riding - ply.settings.origin).norm() <= ply.settings.spacing + (riding - foot.point).norm() {
                 settings.origin = riding;
             }
         }
-        let (warp, seed_normal) = resolve_warp_at(ply, &settings.origin, &scene.reference, surface, scene.stack_side)
+        let warp = resolve_warp(ply, &settings.origin, &scene.reference, surface, scene.stack_side)
             .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
         let mut net = drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
@@ -219,23 +214,21 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
         net.meta.insert("tool_scale".into(), serde_json::json!(scene.scale));
         if let Some(t0) = ply.thickness {
             if k + 1 < scene.plies.len() {
-                add_ply_thickness(&mut stack, sign, tool, &dirs, &net, t0);
+                add_ply_thickness(&mut stack, &under, &net, t0);
             }
         }
         let areal_mass = ply.material.as_ref().map(|m| m.card.areal_mass);
         let stats = ply_stats(&net, ply.locking_angle, areal_mass);
-        results.push(PlyResult { net, refined, warp, seed_normal, offset, stats });
+        results.push(PlyResult { net, refined, warp, offset, stats });
     }
     Ok(results)
 }
 
 /// Add a draped ply's thickness t0 / cos(gamma) (sheared cells keep their fibre lengths, so their
-/// area shrinks by cos(gamma) and the ply thickens) to the stack at every tool vertex it covers.
-fn add_ply_thickness(stack: &mut [f64], sign: f64, tool: &ToolSurface, dirs: &[Vector], net: &DrapeNet, t0: f64) {
+/// area shrinks by cos(gamma) and the ply thickens) to the stack at every tool vertex it covers;
+/// `under[v]` is where vertex `v` lay for this ply (the tool offset by the stack below it).
+fn add_ply_thickness(stack: &mut [f64], under: &[Point], net: &DrapeNet, t0: f64) {
     let Some(sampler) = NetSampler::new(net) else { return };
-    // Where the ply was draped: the tool offset by the stack below it.
-    let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
-    let under: Vec<Point> = offset_vertices(tool, dirs, &signed);
     // The net follows its surface up to the chord sagitta and, for a refined ply, what the
     // mechanics moved it: accept it within a ply thickness or a cell of the surface.
     let reach = t0.max(net.spacing);
