@@ -110,11 +110,7 @@ pub fn offset_along(
         report.mean_distance /= report.moved as f64;
     }
     let mut moved = moved;
-    report.folded = folded_triangles(tool, &moved).len();
-    if report.folded > 0 {
-        report.relaxed = unfold(tool, &mut moved, distance);
-        report.folded = folded_triangles(tool, &moved).len();
-    }
+    (report.relaxed, report.folded) = unfold(tool, &mut moved, distance);
     let surface = ToolSurface::from_triangles(moved, tool.triangles().to_vec())?;
     Ok((surface, report))
 }
@@ -136,8 +132,13 @@ const MAX_UNFOLD_SWEEPS: usize = 200;
 /// cross), the plies bridge the corner instead: the corners of folded triangles are moved to the
 /// mean of their neighbours, sweep after sweep (widening to the neighbours when a sweep does not
 /// help), and pushed back out to their offset distance from the tool where the mean sank below
-/// it, until nothing is folded. Returns the number of vertices moved.
-fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> usize {
+/// it, until nothing is folded. Returns the number of vertices moved and of triangles still
+/// folded.
+fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> (usize, usize) {
+    let mut folded = folded_triangles(tool, moved);
+    if folded.is_empty() {
+        return (0, 0);
+    }
     let n = moved.len();
     let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
     for tri in tool.triangles() {
@@ -155,7 +156,6 @@ fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> usize {
     let mut widen = 0;
     let mut last = usize::MAX;
     for _ in 0..MAX_UNFOLD_SWEEPS {
-        let folded = folded_triangles(tool, moved);
         if folded.is_empty() {
             break;
         }
@@ -191,8 +191,9 @@ fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> usize {
             moved[v] = if gap < clearance && gap > 0.0 { q + (p - q) * (clearance / gap) } else { p };
             touched[v] = true;
         }
+        folded = folded_triangles(tool, moved);
     }
-    touched.iter().filter(|&&t| t).count()
+    (touched.iter().filter(|&&t| t).count(), folded.len())
 }
 
 /// The tool's vertices moved by `distance[v]` along `dirs[v]`.
