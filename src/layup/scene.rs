@@ -264,16 +264,13 @@ impl Scene {
             }
         };
         let roll_width = positive_length("roll_width", file.roll_width)?;
-        let nesting_gap = match file.nesting_gap {
-            None => DEFAULT_NESTING_GAP,
-            Some(g) if g.is_finite() && g >= 0.0 => g * scale,
-            Some(g) => return Err(invalid(format!("field `nesting_gap`: must be a length >= 0, got {g}"))),
+        let length_or = |field: &str, x: Option<f64>, default: f64| match x {
+            None => Ok(default),
+            Some(g) if g.is_finite() && g >= 0.0 => Ok(g * scale),
+            Some(g) => Err(invalid(format!("field `{field}`: must be a length >= 0, got {g}"))),
         };
-        let cutting_margin = match file.cutting_margin {
-            None => 0.0,
-            Some(g) if g.is_finite() && g >= 0.0 => g * scale,
-            Some(g) => return Err(invalid(format!("field `cutting_margin`: must be a length >= 0, got {g}"))),
-        };
+        let nesting_gap = length_or("nesting_gap", file.nesting_gap, DEFAULT_NESTING_GAP)?;
+        let cutting_margin = length_or("cutting_margin", file.cutting_margin, 0.0)?;
         let mut materials: BTreeMap<String, PlyMaterial> = BTreeMap::new();
         for (name, file) in &file.materials {
             let path = base.join(file);
