@@ -143,7 +143,11 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
         last = off;
         let net = read_json(&out.join(format!("{}.drape.json", p["name"].as_str().unwrap())));
         let o = origin_node(&net);
-        assert!((o[2] - (0.06 + k as f64 * 3.5e-4)).abs() < 1e-9, "ply {k}: seed on the flat top at z {}", o[2]);
+        // The seed sits on the flat top raised by the plies below: 0.35 mm each, thickened by
+        // 1 / cos(shear) where they shear (under a degree on the top: the refined first ply
+        // spreads its shear a little over the whole top).
+        let (low, high) = (0.06 + k as f64 * 3.5e-4, 0.06 + k as f64 * 3.5e-4 / 1f64.to_radians().cos());
+        assert!(o[2] > low - 1e-12 && o[2] < high + 1e-12, "ply {k}: seed on the flat top at z {}", o[2]);
     }
     // The 0 and 90 plies of a doubly symmetric part shear alike (within the grid's asymmetry).
     let (m0, m90) = (plies[0]["max_abs_shear_deg"].as_f64().unwrap(), plies[2]["max_abs_shear_deg"].as_f64().unwrap());

@@ -1,7 +1,7 @@
 //! Mechanical refinement of kinematic nets: pressed keeps nodes on the tool and fibres at their
 //! length and never ends above the kinematic energy; free drape never leaves a node in the tool.
 use drape::geometry::shapes;
-use drape::geometry::{Point, ToolSurface, Vector};
+use drape::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, NodeStatus};
 use drape::material::MaterialCard;
 use drape::mechanics::refine::{refine, RefineSettings};
@@ -39,9 +39,20 @@ fn pressed_refinement_stays_on_the_tool_keeps_fibre_lengths_and_lowers_the_energ
     let r = refine(&net, &tool, &glass, &RefineSettings::default()).unwrap();
     assert!(r.ok(), "{:?}", r.outcome());
     assert!(r.energy_final <= r.energy_kinematic, "{} > {}", r.energy_final, r.energy_kinematic);
+    // Every node on the tool's smooth patches, and so nearer the true sphere than the facets are
+    // (the deepest facet point, its centroid, is `facet_depth` inside the sphere).
+    let smooth = SmoothSurface::new(&tool);
+    let facet_depth = (0..tool.num_triangles() as u32)
+        .map(|t| {
+            let c = tool.corners(t);
+            0.1 - ((c[0].coords + c[1].coords + c[2].coords) / 3.0).norm()
+        })
+        .fold(0.0, f64::max);
     for k in 0..r.net.positions.len() {
         if r.net.status[k] == NodeStatus::Placed {
-            assert!(tool.closest_point(&r.net.positions[k]).distance < 1e-12);
+            let p = r.net.positions[k];
+            assert!((smooth.project(&p).point - p).norm() < 1e-12, "node {k} off the tool");
+            assert!((p.coords.norm() - 0.1).abs() < facet_depth / 10.0, "node {k}: {} from the sphere", p.coords.norm() - 0.1);
         }
     }
     // Stiff fibres (8e6 N/m against a shear stiffness of 5 N/m): lengths stay within 1e-4.

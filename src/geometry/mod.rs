@@ -5,10 +5,12 @@ pub mod geodesic;
 pub mod obj;
 pub mod offset;
 pub mod shapes;
+pub mod smooth;
 pub mod surface;
 
 pub use obj::{MeshReport, ObjError};
 pub use check::NO_NEIGHBOUR;
+pub use smooth::{SmoothPoint, SmoothSurface};
 pub use surface::{SurfacePoint, ToolSurface};
 
 /// 3-D point, f64.

@@ -1,7 +1,28 @@
 //! Contact with the tool and fixed nodes, as per-node bases of allowed motion (pressed contact
 //! and fixed directions) and linearised one-sided constraints (free contact).
-use crate::geometry::{Point, ToolSurface, Vector};
+use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use nalgebra::Matrix3;
+
+/// A surface the nodes are held against (pressed) or kept out of (free).
+pub trait ContactSurface: Sync {
+    /// The surface point for `p` (its closest point, or a retraction onto the surface exact to
+    /// first order) and the surface's unit outward normal there.
+    fn foot(&self, p: &Point) -> (Point, Vector);
+}
+
+impl ContactSurface for ToolSurface {
+    fn foot(&self, p: &Point) -> (Point, Vector) {
+        let s = self.closest_point(p);
+        (s.point, s.normal)
+    }
+}
+
+impl ContactSurface for SmoothSurface<'_> {
+    fn foot(&self, p: &Point) -> (Point, Vector) {
+        let s = self.project(p);
+        (s.point, s.normal)
+    }
+}
 
 /// How the ply meets the tool.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -79,8 +100,8 @@ impl Freedom {
     }
 
     /// The basis of allowed motion at position `p` (tool normals for the on-tool kinds).
-    pub fn basis(&self, p: &Point, tool: Option<&ToolSurface>) -> NodeBasis {
-        let normal = || tool.map(|t| t.closest_point(p).normal).unwrap_or_else(Vector::z);
+    pub fn basis(&self, p: &Point, tool: Option<&dyn ContactSurface>) -> NodeBasis {
+        let normal = || tool.map(|t| t.foot(p).1).unwrap_or_else(Vector::z);
         match self {
             Freedom::Fixed => NodeBasis::FIXED,
             Freedom::Free => NodeBasis::free(),
@@ -119,20 +140,16 @@ pub struct ContactRow {
 pub const CONTACT_RANGE: f64 = 2.0;
 
 /// Linearised contact rows for the free-drape nodes near the tool.
-pub fn contact_rows(tool: &ToolSurface, x: &[Point], movable: &[bool], spacing: f64) -> Vec<ContactRow> {
-    let mut rows = Vec::new();
-    for (k, p) in x.iter().enumerate() {
-        if !movable[k] {
-            continue;
-        }
-        let sp = tool.closest_point(p);
-        if sp.distance > CONTACT_RANGE * spacing {
-            continue;
-        }
-        // On the tool or outside: the tool's outward normal; a node found inside gets a row that
-        // pushes it back out.
-        let gap = sp.normal.dot(&(p - sp.point));
-        rows.push(ContactRow { node: k, normal: sp.normal, gap });
-    }
-    rows
+pub fn contact_rows(tool: &dyn ContactSurface, x: &[Point], movable: &[bool], spacing: f64) -> Vec<ContactRow> {
+    use rayon::prelude::*;
+    x.par_iter()
+        .enumerate()
+        .filter(|(k, _)| movable[*k])
+        .filter_map(|(k, p)| {
+            let (foot, normal) = tool.foot(p);
+            // On the tool or outside: the tool's outward normal; a node found inside gets a row
+            // that pushes it back out.
+            ((p - foot).norm() <= CONTACT_RANGE * spacing).then(|| ContactRow { node: k, normal, gap: normal.dot(&(p - foot)) })
+        })
+        .collect()
 }

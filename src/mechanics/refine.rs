@@ -1,9 +1,9 @@
 //! Mechanical refinement of a draped net: the energy model on its grid, minimised from the
 //! kinematic state with the tool as contact, under load steps of gravity.
-use super::contact::{ContactMode, Freedom};
+use super::contact::{ContactMode, ContactSurface, Freedom};
 use super::energy::{Grid, HessianKind, Laws, Model};
 use super::solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Outcome, SolveReport, SolverSettings};
-use crate::geometry::{Point, ToolSurface, Vector};
+use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
 /// Which Hessian the quadratic models use.
@@ -125,9 +125,11 @@ pub enum RefineError {
     LoadSteps,
 }
 
-/// Refine a kinematic net on its tool. Pressed: every node slides on the tool, the origin node
-/// is held and its warp neighbour stays in the plane of the initial warp direction and normal.
-/// Free: nodes move freely with one-sided contact, the origin node held likewise.
+/// Refine a kinematic net on its tool. Pressed: every node slides on the tool (on its smooth
+/// patches, [`SmoothSurface`], onto which the kinematic nodes are first moved), the origin node is
+/// held and its warp neighbour stays in the plane of the initial warp direction and normal.
+/// Free: nodes move freely with one-sided contact with the facets as given, the origin node
+/// held likewise.
 pub fn refine<L: Laws + ?Sized>(
     kinematic: &DrapeNet,
     tool: &ToolSurface,
@@ -142,13 +144,25 @@ pub fn refine<L: Laws + ?Sized>(
         return Err(RefineError::Empty);
     }
     let grid = Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone());
+    // Pressed nodes slide on the smooth patches: on the facets themselves a net finer than them
+    // crawls from edge to edge (see the module doc of `geometry::smooth`). Free contact keeps the
+    // nodes out of the facets as given.
+    let smooth = SmoothSurface::new(tool);
+    let surface: &dyn ContactSurface = match settings.mode {
+        ContactMode::Pressed => &smooth,
+        _ => tool,
+    };
+    let mut x = kinematic.positions.clone();
+    if settings.mode == ContactMode::Pressed {
+        use rayon::prelude::*;
+        x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);
+    }
     let (i0, j0) = kinematic.origin_node;
     let origin = kinematic.index(i0, j0);
     let warp_neighbour = if i0 + 1 < kinematic.nu { Some(kinematic.index(i0 + 1, j0)) } else { None };
-    let n0 = tool.closest_point(&kinematic.positions[origin]).normal;
-    let plane_normal = warp_neighbour
-        .filter(|&k| active[k])
-        .and_then(|k| (kinematic.positions[k] - kinematic.positions[origin]).cross(&n0).try_normalize(1e-12));
+    let n0 = surface.foot(&x[origin]).1;
+    let plane_normal =
+        warp_neighbour.filter(|&k| active[k]).and_then(|k| (x[k] - x[origin]).cross(&n0).try_normalize(1e-12));
     let freedom: Vec<Freedom> = (0..active.len())
         .map(|k| {
             if !active[k] || k == origin {
@@ -166,13 +180,13 @@ pub fn refine<L: Laws + ?Sized>(
             }
         })
         .collect();
-    let cons = Constraints { freedom, mode: settings.mode, tool: Some(tool), spacing: kinematic.spacing };
-    let mut x = kinematic.positions.clone();
+    let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
-    // Energy of the kinematic state under the full load, for comparison with the result.
-    // The first step carries 1/S of the load, so the full load does (S - 1) times more work.
-    let energy_kinematic = objective.evaluate(&x, false).energy - (settings.load_steps - 1) as f64 * objective.work(&x);
+    // Energy of the kinematic state (as given) under the full load, for comparison with the
+    // result. The first step carries 1/S of the load, so the full load does (S - 1) times more work.
+    let start = &kinematic.positions;
+    let energy_kinematic = objective.evaluate(start, false).energy - (settings.load_steps - 1) as f64 * objective.work(start);
     for step in 1..=settings.load_steps {
         if step > 1 {
             objective.scale_loads(step as f64 / (step - 1) as f64);

@@ -1,8 +1,9 @@
 //! Sequential convex subproblems: at each iterate a quadratic model of the energy (convexified
 //! Hessian plus Levenberg-Marquardt damping) with the linearised contact constraints is solved by
 //! Clarabel; the step is accepted if the energy falls as predicted, else the damping grows.
-use super::contact::{contact_rows, ContactMode, ContactRow, Freedom, NodeBasis};
-use crate::geometry::{Point, ToolSurface, Vector};
+use super::contact::{contact_rows, ContactMode, ContactRow, ContactSurface, Freedom, NodeBasis};
+use crate::geometry::{Point, Vector};
+use rayon::prelude::*;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT,
@@ -129,7 +130,8 @@ impl SolveReport {
 pub struct Constraints<'a> {
     pub freedom: Vec<Freedom>,
     pub mode: ContactMode,
-    pub tool: Option<&'a ToolSurface>,
+    /// Pressed nodes slide on it; free nodes stay out of it.
+    pub tool: Option<&'a dyn ContactSurface>,
     /// Length scale for contact search (the net's spacing).
     pub spacing: f64,
 }
@@ -238,7 +240,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let start = std::time::Instant::now();
     let reduction = Reduction::new(&cons.freedom, &objective.coupled_pairs());
     let movable: Vec<bool> = cons.freedom.iter().map(|f| f.dofs() > 0).collect();
-    let bases_at = |x: &[Point]| -> Vec<NodeBasis> { cons.freedom.iter().zip(x).map(|(f, p)| f.basis(p, cons.tool)).collect() };
+    let bases_at = |x: &[Point]| -> Vec<NodeBasis> { cons.freedom.par_iter().zip(x).map(|(f, p)| f.basis(p, cons.tool)).collect() };
     let rows_at = |x: &[Point]| -> Vec<ContactRow> {
         match (cons.mode, cons.tool) {
             (ContactMode::Free, Some(tool)) => contact_rows(tool, x, &movable, cons.spacing),
@@ -312,11 +314,11 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             let delta = reduction.expand(&y, &bases);
             let mut trial: Vec<Point> = x.iter().zip(&delta).map(|(p, d)| p + d).collect();
             if let (ContactMode::Pressed, Some(tool)) = (cons.mode, cons.tool) {
-                for (k, p) in trial.iter_mut().enumerate() {
-                    if matches!(cons.freedom[k], Freedom::OnTool | Freedom::OnToolInPlane(_)) {
-                        *p = tool.closest_point(p).point;
+                trial.par_iter_mut().zip(&cons.freedom).for_each(|(p, f)| {
+                    if matches!(f, Freedom::OnTool | Freedom::OnToolInPlane(_)) {
+                        *p = tool.foot(p).0;
                     }
-                }
+                });
             }
             let trial_eval = objective.evaluate(&trial, true);
             let actual = eval.energy - trial_eval.energy;
@@ -548,5 +550,28 @@ mod tests {
         // The closest point of the (faceted) sphere to the target: along the target's direction.
         let expected = tool.closest_point(&target).point;
         assert!((x[0] - expected).norm() < 1e-4, "{} vs {}", x[0], expected);
+    }
+
+    #[test]
+    fn pressed_nodes_slide_on_the_smooth_patches() {
+        let tool = shapes::hemisphere(1.0, 20).into_surface().unwrap();
+        let smooth = crate::geometry::SmoothSurface::new(&tool);
+        let target = Point::new(0.6, 0.0, 1.2);
+        let obj = Springs { targets: vec![target], k: 1.0 };
+        let mut x = vec![smooth.project(&Point::new(0.0, 0.0, 1.0)).point];
+        let cons = Constraints { freedom: vec![Freedom::OnTool], mode: ContactMode::Pressed, tool: Some(&smooth), spacing: 0.1 };
+        let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
+        assert!(report.ok(), "{report:?}");
+        let s = smooth.project(&x[0]);
+        assert!((s.point - x[0]).norm() < 1e-12);
+        // At the constrained minimum the spring pulls along the surface normal...
+        // (to the energy's rounding: the solve stalls at |F - P| / |P| ~ 5e-8).
+        let misalignment = (target - x[0]).normalize().cross(&s.normal).norm();
+        assert!(misalignment < 1e-6, "{misalignment:e}");
+        // ... which, on patches following the sphere, is near the sphere's answer: closer than
+        // the facets get.
+        let sphere = Point::from(target.coords.normalize());
+        let facets = tool.closest_point(&target).point;
+        assert!((x[0] - sphere).norm() < (facets - sphere).norm() / 5.0, "{} vs {}", x[0], sphere);
     }
 }
