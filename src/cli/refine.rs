@@ -6,7 +6,7 @@ use crate::export::{read_net, write_net, Format};
 use crate::geometry::Vector;
 use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
-use crate::mechanics::refine::{annotate, refine, RefineSettings, Refined};
+use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
 use crate::mechanics::{ContactMode, SolverSettings};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -36,6 +36,10 @@ pub struct RefineArgs {
     /// Contact with the tool.
     #[arg(long, value_enum)]
     pub mode: Mode,
+    /// Pressed nodes slide on the OBJ's facets exactly as given instead of on smooth patches
+    /// through its vertices and normals (on a net finer than the facets this converges slowly).
+    #[arg(long)]
+    pub facets: bool,
     /// Gravity vector, m/s^2.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,-9.80665")]
     pub gravity: [f64; 3],
@@ -69,6 +73,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
             Mode::Pressed => ContactMode::Pressed,
             Mode::Free => ContactMode::Free,
         },
+        pressed_surface: if a.facets { PressedSurface::Facets } else { PressedSurface::Smooth },
         gravity: Vector::from(a.gravity),
         load_steps: a.load_steps,
         solver: SolverSettings::default().max_iterations(a.max_iterations),
@@ -104,12 +109,18 @@ pub(crate) fn print_solver(r: &Refined) {
     let ms: f64 = r.steps.iter().map(|s| s.time_ms).sum();
     let residual = r.steps.last().map_or(0.0, |s| s.residual);
     println!(
-        "  solver: {:?} after {iterations} iterations in {} load step(s), {:.0} ms; |F-P|/|P| {:.2e}; energy {:.6e} -> {:.6e} J",
+        "  solver: {:?} after {iterations} iterations in {} load step(s), {:.0} ms; |F-P|/|P| {:.2e}",
         r.outcome(),
         r.steps.len(),
         ms,
         residual,
-        r.energy_kinematic,
-        r.energy_final
     );
+    if r.energy_start == r.energy_kinematic {
+        println!("  energy: kinematic {:.6e} J -> refined {:.6e} J", r.energy_kinematic, r.energy_final);
+    } else {
+        println!(
+            "  energy: kinematic {:.6e} J on the facets, {:.6e} J moved onto the smooth tool -> refined {:.6e} J",
+            r.energy_kinematic, r.energy_start, r.energy_final
+        );
+    }
 }

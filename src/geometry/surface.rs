@@ -14,6 +14,12 @@ pub const WELD_TOLERANCE_REL: f64 = 1e-9;
 /// (relative) outside an edge still count, so roots on shared edges are never lost.
 pub const INSIDE_TOLERANCE: f64 = 1e-10;
 
+/// A point counts as on a facet's edge when its barycentric coordinate opposite the edge is at
+/// most this (points moved back onto the tool are clamped to exactly 0).
+pub const ON_EDGE_BARYCENTRIC: f64 = 1e-9;
+/// Walks around a vertex give up after this many facets (a non-manifold fan).
+const MAX_VALENCE: usize = 256;
+
 /// Precomputed per-triangle data for fast plane and barycentric tests.
 #[derive(Debug, Clone, Copy)]
 struct TriangleFrame {
@@ -214,6 +220,64 @@ impl ToolSurface {
         closest_point_on_triangle(p, &c[0], &c[1], &c[2])
     }
 
+    /// The tool's open (boundary) edges that the point at barycentric `l` on facet `t` lies on:
+    /// none inside the tool, one on an edge, two at a boundary corner (found by walking around
+    /// the vertex). Each as the edge's outward direction in its facet's plane.
+    pub fn open_edges_at(&self, t: u32, l: &[f64; 3]) -> [Option<Vector>; 2] {
+        let mut out = [None; 2];
+        let on: Vec<usize> = (0..3).filter(|&k| l[k] <= ON_EDGE_BARYCENTRIC).collect();
+        match on.as_slice() {
+            [k] => {
+                if self.neighbours[t as usize][*k] == NO_NEIGHBOUR {
+                    out[0] = Some(self.outward(t, *k));
+                }
+            }
+            [k1, k2] => {
+                // At the corner opposite both: walk around it both ways to the open edges.
+                let corner = 3 - k1 - k2;
+                let v = self.triangles[t as usize][corner];
+                for (slot, start) in [*k1, *k2].into_iter().enumerate() {
+                    out[slot] = self.walk_to_open_edge(t, start, v);
+                }
+            }
+            _ => {}
+        }
+        out
+    }
+
+    /// From facet `t` across its edge `k` (which has vertex `v`), around `v` until an open edge.
+    fn walk_to_open_edge(&self, t: u32, k: usize, v: u32) -> Option<Vector> {
+        let (mut cur, mut edge) = (t, k);
+        for _ in 0..MAX_VALENCE {
+            let n = self.neighbours[cur as usize][edge];
+            if n == NO_NEIGHBOUR {
+                return Some(self.outward(cur, edge));
+            }
+            if n == t {
+                return None; // all the way round: an inner vertex
+            }
+            // In n, the other edge at v: opposite the corner that is neither v nor across from cur.
+            let tri = self.triangles[n as usize];
+            let cv = tri.iter().position(|&w| w == v)?;
+            let (e1, e2) = ((cv + 1) % 3, (cv + 2) % 3);
+            edge = if self.neighbours[n as usize][e1] == cur { e2 } else { e1 };
+            cur = n;
+        }
+        None
+    }
+
+    /// Unit outward direction of edge `k` of facet `t`, in the facet's plane.
+    fn outward(&self, t: u32, k: usize) -> Vector {
+        let c = self.corners(t);
+        let (a, b, opposite) = (c[(k + 1) % 3], c[(k + 2) % 3], c[k]);
+        let m = (b - a).cross(&self.normal(t)).normalize();
+        if m.dot(&(opposite - a)) > 0.0 {
+            -m
+        } else {
+            m
+        }
+    }
+
     /// Barycentric coordinates of `p` (assumed in the plane of `t`) with respect to `t`.
     pub fn barycentric(&self, t: u32, p: &Point) -> [f64; 3] {
         let f = &self.frames[t as usize];
@@ -323,4 +387,34 @@ pub fn closest_point_on_triangle(p: &Point, a: &Point, b: &Point, c: &Point) -> 
     }
     let denom = 1.0 / (va + vb + vc);
     a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::shapes;
+
+    #[test]
+    fn open_edges_are_found_on_edges_and_at_corners_only() {
+        let tool = shapes::plate(2.0, 2.0, 4, 4).into_surface().unwrap();
+        let at = |p: Point| {
+            let s = tool.closest_point(&p);
+            let l = tool.barycentric(s.triangle, &s.point);
+            let mut e: Vec<Vector> = tool.open_edges_at(s.triangle, &l).into_iter().flatten().collect();
+            e.sort_by(|a, b| a.x.partial_cmp(&b.x).unwrap().then(a.y.partial_cmp(&b.y).unwrap()));
+            e
+        };
+        assert!(at(Point::new(0.3, 0.2, 0.0)).is_empty(), "inside");
+        assert!(at(Point::new(0.5, 0.5, 0.0)).is_empty(), "an inner vertex");
+        let edge = at(Point::new(1.3, 0.2, 0.0));
+        assert_eq!(edge.len(), 1);
+        assert!((edge[0] - Vector::x()).norm() < 1e-12, "{:?}", edge);
+        let corner = at(Point::new(1.3, -1.2, 0.0));
+        assert_eq!(corner.len(), 2, "{corner:?}");
+        assert!((corner[0] + Vector::y()).norm() < 1e-12 && (corner[1] - Vector::x()).norm() < 1e-12, "{corner:?}");
+        // A boundary vertex in the middle of a side: both open edges point the same way.
+        let side = at(Point::new(1.2, 0.0, 0.0));
+        assert_eq!(side.len(), 2);
+        assert!(side.iter().all(|m| (m - Vector::x()).norm() < 1e-12), "{side:?}");
+    }
 }

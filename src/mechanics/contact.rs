@@ -3,24 +3,36 @@
 use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use nalgebra::Matrix3;
 
+/// Where a point meets a contact surface.
+#[derive(Debug, Clone, Copy)]
+pub struct Foot {
+    /// The surface point for the query (its closest point, or a retraction onto the surface
+    /// exact to first order).
+    pub point: Point,
+    /// The surface's unit outward normal there.
+    pub normal: Vector,
+    /// Outward directions of the tool's open (boundary) edges the point lies on.
+    pub open_edges: [Option<Vector>; 2],
+}
+
 /// A surface the nodes are held against (pressed) or kept out of (free).
 pub trait ContactSurface: Sync {
-    /// The surface point for `p` (its closest point, or a retraction onto the surface exact to
-    /// first order) and the surface's unit outward normal there.
-    fn foot(&self, p: &Point) -> (Point, Vector);
+    /// Where `p` meets the surface.
+    fn locate(&self, p: &Point) -> Foot;
 }
 
 impl ContactSurface for ToolSurface {
-    fn foot(&self, p: &Point) -> (Point, Vector) {
+    fn locate(&self, p: &Point) -> Foot {
         let s = self.closest_point(p);
-        (s.point, s.normal)
+        let l = self.barycentric(s.triangle, &s.point);
+        Foot { point: s.point, normal: s.normal, open_edges: self.open_edges_at(s.triangle, &l) }
     }
 }
 
 impl ContactSurface for SmoothSurface<'_> {
-    fn foot(&self, p: &Point) -> (Point, Vector) {
+    fn locate(&self, p: &Point) -> Foot {
         let s = self.project(p);
-        (s.point, s.normal)
+        Foot { point: s.point, normal: s.normal, open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric) }
     }
 }
 
@@ -99,20 +111,42 @@ impl Freedom {
         }
     }
 
-    /// The basis of allowed motion at position `p` (tool normals for the on-tool kinds).
-    pub fn basis(&self, p: &Point, tool: Option<&dyn ContactSurface>) -> NodeBasis {
-        let normal = || tool.map(|t| t.foot(p).1).unwrap_or_else(Vector::z);
+    /// The basis of allowed motion at position `p` (tool normals for the on-tool kinds), for a
+    /// node the energy pushes along `descent`. An on-tool node on the tool's open boundary that
+    /// is pushed out over it is held there by the edge (it slides along the edge, or stays put at
+    /// a corner): the tool ends, and a pressed ply does not leave it.
+    pub fn basis(&self, p: &Point, tool: Option<&dyn ContactSurface>, descent: &Vector) -> NodeBasis {
+        let foot = || match tool {
+            Some(t) => t.locate(p),
+            None => Foot { point: *p, normal: Vector::z(), open_edges: [None; 2] },
+        };
+        // The open edges the node is pushed over, as outward directions in the tangent plane.
+        let held = |f: &Foot| -> Vec<Vector> {
+            f.open_edges
+                .iter()
+                .flatten()
+                .filter_map(|m| (m - f.normal * f.normal.dot(m)).try_normalize(1e-9))
+                .filter(|m| m.dot(descent) > 0.0)
+                .collect()
+        };
         match self {
             Freedom::Fixed => NodeBasis::FIXED,
             Freedom::Free => NodeBasis::free(),
             Freedom::Line(t) => NodeBasis::line(t),
             Freedom::InPlane(m) => NodeBasis::tangent(&m.normalize()),
-            Freedom::OnTool => NodeBasis::tangent(&normal()),
+            Freedom::OnTool => {
+                let f = foot();
+                match held(&f).as_slice() {
+                    [] => NodeBasis::tangent(&f.normal),
+                    [m] => NodeBasis::line(&f.normal.cross(m)),
+                    _ => NodeBasis::FIXED,
+                }
+            }
             Freedom::OnToolInPlane(m) => {
-                let n = normal();
-                match n.cross(m).try_normalize(1e-9) {
-                    Some(t) => NodeBasis::line(&t),
-                    None => NodeBasis::FIXED,
+                let f = foot();
+                match f.normal.cross(m).try_normalize(1e-9) {
+                    Some(t) if held(&f).is_empty() => NodeBasis::line(&t),
+                    _ => NodeBasis::FIXED,
                 }
             }
         }
@@ -146,7 +180,7 @@ pub fn contact_rows(tool: &dyn ContactSurface, x: &[Point], movable: &[bool], sp
         .enumerate()
         .filter(|(k, _)| movable[*k])
         .filter_map(|(k, p)| {
-            let (foot, normal) = tool.foot(p);
+            let Foot { point: foot, normal, .. } = tool.locate(p);
             // On the tool or outside: the tool's outward normal; a node found inside gets a row
             // that pushes it back out.
             ((p - foot).norm() <= CONTACT_RANGE * spacing).then(|| ContactRow { node: k, normal, gap: normal.dot(&(p - foot)) })

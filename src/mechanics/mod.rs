@@ -8,5 +8,5 @@ pub mod refine;
 pub mod solver;
 pub mod virtual_tests;
 
-pub use contact::{ContactMode, Freedom, NodeBasis};
+pub use contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Outcome, SolveReport, SolverSettings};

@@ -73,10 +73,23 @@ impl Objective for NetObjective<'_> {
     }
 }
 
+/// What pressed nodes slide on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PressedSurface {
+    /// Smooth patches over the facets ([`SmoothSurface`]): the part the tessellation stands for.
+    #[default]
+    Smooth,
+    /// The facets exactly as given (a net finer than them converges slowly: it crawls from edge
+    /// to edge).
+    Facets,
+}
+
 /// How to refine.
 #[derive(Debug, Clone)]
 pub struct RefineSettings {
     pub mode: ContactMode,
+    /// What pressed nodes slide on.
+    pub pressed_surface: PressedSurface,
     /// Gravity, m/s^2.
     pub gravity: Vector,
     /// Gravity is applied in this many equal steps.
@@ -88,6 +101,7 @@ impl Default for RefineSettings {
     fn default() -> Self {
         RefineSettings {
             mode: ContactMode::Pressed,
+            pressed_surface: PressedSurface::Smooth,
             gravity: Vector::new(0.0, 0.0, -STANDARD_GRAVITY),
             load_steps: 1,
             solver: SolverSettings::default(),
@@ -101,7 +115,14 @@ pub struct Refined {
     pub net: DrapeNet,
     /// One report per load step.
     pub steps: Vec<SolveReport>,
+    /// Energy (full load) of the kinematic net as given.
     pub energy_kinematic: f64,
+    /// Energy (full load) of the state the solver started from: the kinematic net moved onto the
+    /// smooth tool in pressed contact on [`PressedSurface::Smooth`], else the kinematic net. Moving
+    /// nodes from the facets onto the patches stretches the fibres, and a smooth tool can need a
+    /// little more shear than its facets, so the refined energy is bounded by this one, and by
+    /// `energy_kinematic` only on the facets.
+    pub energy_start: f64,
     pub energy_final: f64,
 }
 
@@ -125,8 +146,9 @@ pub enum RefineError {
     LoadSteps,
 }
 
-/// Refine a kinematic net on its tool. Pressed: every node slides on the tool (on its smooth
-/// patches, [`SmoothSurface`], onto which the kinematic nodes are first moved), the origin node is
+/// Refine a kinematic net on its tool. Pressed: every node slides on the tool (by default on its
+/// smooth patches, [`SmoothSurface`], onto which the kinematic nodes are first moved; see
+/// [`PressedSurface`]), the origin node is
 /// held and its warp neighbour stays in the plane of the initial warp direction and normal.
 /// Free: nodes move freely with one-sided contact with the facets as given, the origin node
 /// held likewise.
@@ -148,19 +170,17 @@ pub fn refine<L: Laws + ?Sized>(
     // crawls from edge to edge (see the module doc of `geometry::smooth`). Free contact keeps the
     // nodes out of the facets as given.
     let smooth = SmoothSurface::new(tool);
-    let surface: &dyn ContactSurface = match settings.mode {
-        ContactMode::Pressed => &smooth,
-        _ => tool,
-    };
+    let on_patches = settings.mode == ContactMode::Pressed && settings.pressed_surface == PressedSurface::Smooth;
+    let surface: &dyn ContactSurface = if on_patches { &smooth } else { tool };
     let mut x = kinematic.positions.clone();
-    if settings.mode == ContactMode::Pressed {
+    if on_patches {
         use rayon::prelude::*;
         x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);
     }
     let (i0, j0) = kinematic.origin_node;
     let origin = kinematic.index(i0, j0);
     let warp_neighbour = if i0 + 1 < kinematic.nu { Some(kinematic.index(i0 + 1, j0)) } else { None };
-    let n0 = surface.foot(&x[origin]).1;
+    let n0 = surface.locate(&x[origin]).normal;
     let plane_normal =
         warp_neighbour.filter(|&k| active[k]).and_then(|k| (x[k] - x[origin]).cross(&n0).try_normalize(1e-12));
     let freedom: Vec<Freedom> = (0..active.len())
@@ -180,18 +200,27 @@ pub fn refine<L: Laws + ?Sized>(
             }
         })
         .collect();
+    // The residual is measured against the kinematic net's forces as given (on the facets).
+    let facet_cons = Constraints { freedom: freedom.clone(), mode: settings.mode, tool: Some(tool), spacing: kinematic.spacing };
     let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
     // Energy of the kinematic state (as given) under the full load, for comparison with the
     // result. The first step carries 1/S of the load, so the full load does (S - 1) times more work.
-    let start = &kinematic.positions;
-    let energy_kinematic = objective.evaluate(start, false).energy - (settings.load_steps - 1) as f64 * objective.work(start);
+    let mut solver_settings = settings.solver.clone();
+    if solver_settings.force_scale.is_none() {
+        // At the full load: the one the last step must balance.
+        let full = NetObjective::new(objective.grid().clone(), laws, settings.gravity);
+        solver_settings.force_scale = Some(super::solver::force_scale(&full, &kinematic.positions, &facet_cons));
+    }
+    let full_load = |objective: &NetObjective, x: &[Point]| objective.evaluate(x, false).energy - (settings.load_steps - 1) as f64 * objective.work(x);
+    let energy_kinematic = full_load(&objective, &kinematic.positions);
+    let energy_start = full_load(&objective, &x);
     for step in 1..=settings.load_steps {
         if step > 1 {
             objective.scale_loads(step as f64 / (step - 1) as f64);
         }
-        let report = solve(&objective, &mut x, &cons, &settings.solver);
+        let report = solve(&objective, &mut x, &cons, &solver_settings);
         let ok = report.ok();
         steps.push(report);
         if !ok {
@@ -207,7 +236,7 @@ pub fn refine<L: Laws + ?Sized>(
             net.triangles[k] = tool.closest_point(p).triangle;
         }
     }
-    Ok(Refined { net, steps, energy_kinematic, energy_final })
+    Ok(Refined { net, steps, energy_kinematic, energy_start, energy_final })
 }
 
 /// Per-cell change from `before` to `after` (same grid): (shear difference, angle between the
@@ -241,6 +270,7 @@ pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, mat
         serde_json::json!({
             "outcome": refined.outcome(),
             "energy_kinematic": refined.energy_kinematic,
+            "energy_start": refined.energy_start,
             "energy_final": refined.energy_final,
             "load_steps": refined.steps,
         }),

@@ -52,6 +52,11 @@ pub struct SolverSettings {
     pub initial_damping: f64,
     /// Largest damping before the solver gives up (stalled line search).
     pub max_damping: f64,
+    /// The force the residual is measured against (N); default: the larger of the loads and the
+    /// internal forces at the start. Refinement passes the kinematic net's, as given, so that
+    /// moving its nodes onto a smooth tool (which stretches the fibres a little) does not
+    /// loosen the test.
+    pub force_scale: Option<f64>,
 }
 
 impl Default for SolverSettings {
@@ -63,6 +68,7 @@ impl Default for SolverSettings {
             stall_window: 3,
             initial_damping: 1e-6,
             max_damping: 1e12,
+            force_scale: None,
         }
     }
 }
@@ -231,6 +237,21 @@ impl Reduction {
     }
 }
 
+/// The larger of the internal forces and the loads over the free directions.
+fn start_forces(r: &Reduction, e: &Evaluation, bases: &[NodeBasis]) -> f64 {
+    norm(&r.reduce(&e.internal, bases)).max(norm(&r.reduce(&e.external, bases)))
+}
+
+/// The force scale [`solve`] would use at `x` by default: the larger of the internal forces and
+/// the loads over the free directions of `cons` there.
+pub fn force_scale(objective: &dyn Objective, x: &[Point], cons: &Constraints) -> f64 {
+    let reduction = Reduction::new(&cons.freedom, &[]);
+    let e = objective.evaluate(x, false);
+    let bases: Vec<NodeBasis> =
+        cons.freedom.par_iter().enumerate().map(|(k, f)| f.basis(&x[k], cons.tool, &(e.external[k] - e.internal[k]))).collect();
+    start_forces(&reduction, &e, &bases)
+}
+
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -240,16 +261,25 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let start = std::time::Instant::now();
     let reduction = Reduction::new(&cons.freedom, &objective.coupled_pairs());
     let movable: Vec<bool> = cons.freedom.iter().map(|f| f.dofs() > 0).collect();
-    let bases_at = |x: &[Point]| -> Vec<NodeBasis> { cons.freedom.par_iter().zip(x).map(|(f, p)| f.basis(p, cons.tool)).collect() };
+    // Bases at x for the pushes of the evaluation there (on-tool nodes pushed over the tool's
+    // open edge are held by it).
+    let bases_at = |x: &[Point], e: &Evaluation| -> Vec<NodeBasis> {
+        let (internal, external) = (&e.internal, &e.external);
+        cons.freedom
+            .par_iter()
+            .enumerate()
+            .map(|(k, f)| f.basis(&x[k], cons.tool, &(external[k] - internal[k])))
+            .collect()
+    };
     let rows_at = |x: &[Point]| -> Vec<ContactRow> {
         match (cons.mode, cons.tool) {
             (ContactMode::Free, Some(tool)) => contact_rows(tool, x, &movable, cons.spacing),
             _ => Vec::new(),
         }
     };
-    let mut bases = bases_at(x);
-    let mut rows = rows_at(x);
     let mut eval = objective.evaluate(x, true);
+    let mut bases = bases_at(x, &eval);
+    let mut rows = rows_at(x);
     let energy_start = eval.energy;
     let mut iterations = Vec::new();
     let mut damping = settings.initial_damping;
@@ -263,7 +293,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| h[k].abs()).sum::<f64>() / reduction.n.max(1) as f64
     };
     let noise = FORCE_NOISE * mean_stiffness * cons.spacing * (reduction.n as f64).sqrt();
-    let force_scale = norm(&reduction.reduce(&eval.internal, &bases)).max(norm(&reduction.reduce(&eval.external, &bases))).max(noise);
+    let force_scale = settings.force_scale.unwrap_or_else(|| start_forces(&reduction, &eval, &bases)).max(noise);
     let energy_noise = FORCE_NOISE * mean_stiffness * cons.spacing * cons.spacing * reduction.n as f64;
     let mut residual = residual(&reduction, &eval, &bases, &rows, cons.spacing, force_scale);
     let mut outcome = Outcome::IterationLimit;
@@ -316,7 +346,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             if let (ContactMode::Pressed, Some(tool)) = (cons.mode, cons.tool) {
                 trial.par_iter_mut().zip(&cons.freedom).for_each(|(p, f)| {
                     if matches!(f, Freedom::OnTool | Freedom::OnToolInPlane(_)) {
-                        *p = tool.foot(p).0;
+                        *p = tool.locate(p).point;
                     }
                 });
             }
@@ -326,7 +356,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 step_norm = norm(&y);
                 x.copy_from_slice(&trial);
                 eval = trial_eval;
-                bases = bases_at(x);
+                bases = bases_at(x, &eval);
                 rows = rows_at(x);
                 if actual >= 0.75 * predicted {
                     damping = (damping / 4.0).max(1e-12);
@@ -581,5 +611,21 @@ mod tests {
         let sphere = Point::from(target.coords.normalize());
         let facets = tool.closest_point(&target).point;
         assert!((x[0] - sphere).norm() < (facets - sphere).norm() / 5.0, "{} vs {}", x[0], sphere);
+    }
+
+    #[test]
+    fn pressed_nodes_pulled_over_the_tool_edge_are_held_by_it() {
+        // A 2 m x 2 m plate (|x|, |y| <= 1): springs pull one node beyond the edge x = 1 and
+        // another beyond the corner (1, 1); the edge holds the first (it slides along the edge to
+        // y = 0.3), the corner holds the second.
+        let tool = shapes::plate(2.0, 2.0, 4, 4).into_surface().unwrap();
+        let targets = vec![Point::new(1.5, 0.3, 0.0), Point::new(1.4, 1.6, 0.0)];
+        let obj = Springs { targets, k: 1.0 };
+        let mut x = vec![Point::new(0.2, 0.0, 0.0), Point::new(0.5, 0.5, 0.0)];
+        let cons = Constraints { freedom: vec![Freedom::OnTool; 2], mode: ContactMode::Pressed, tool: Some(&tool), spacing: 0.1 };
+        let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
+        assert_eq!(report.outcome, Outcome::Converged, "{report:?}");
+        assert!((x[0] - Point::new(1.0, 0.3, 0.0)).norm() < 1e-9, "{}", x[0]);
+        assert!((x[1] - Point::new(1.0, 1.0, 0.0)).norm() < 1e-9, "{}", x[1]);
     }
 }
