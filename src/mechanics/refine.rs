@@ -148,10 +148,9 @@ pub enum RefineError {
 
 /// Refine a kinematic net on its tool. Pressed: every node slides on the tool (by default on its
 /// smooth patches, [`SmoothSurface`], onto which the kinematic nodes are first moved; see
-/// [`PressedSurface`]), the origin node is
-/// held and its warp neighbour stays in the plane of the initial warp direction and normal.
-/// Free: nodes move freely with one-sided contact with the facets as given, the origin node
-/// held likewise.
+/// [`PressedSurface`]), the origin node is held and its warp neighbour stays in the plane of the
+/// initial warp direction and normal. Free: nodes move freely with one-sided contact with the
+/// facets as given, the origin node held likewise.
 pub fn refine<L: Laws + ?Sized>(
     kinematic: &DrapeNet,
     tool: &ToolSurface,
@@ -169,11 +168,14 @@ pub fn refine<L: Laws + ?Sized>(
     // Pressed nodes slide on the smooth patches: on the facets themselves a net finer than them
     // crawls from edge to edge (see the module doc of `geometry::smooth`). Free contact keeps the
     // nodes out of the facets as given.
-    let smooth = SmoothSurface::new(tool);
     let on_patches = settings.mode == ContactMode::Pressed && settings.pressed_surface == PressedSurface::Smooth;
-    let surface: &dyn ContactSurface = if on_patches { &smooth } else { tool };
+    let smooth = on_patches.then(|| SmoothSurface::new(tool));
+    let surface: &dyn ContactSurface = match &smooth {
+        Some(s) => s,
+        None => tool,
+    };
     let mut x = kinematic.positions.clone();
-    if on_patches {
+    if let Some(smooth) = &smooth {
         use rayon::prelude::*;
         x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);
     }
@@ -205,14 +207,14 @@ pub fn refine<L: Laws + ?Sized>(
     let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
-    // Energy of the kinematic state (as given) under the full load, for comparison with the
-    // result. The first step carries 1/S of the load, so the full load does (S - 1) times more work.
     let mut solver_settings = settings.solver.clone();
     if solver_settings.force_scale.is_none() {
         // At the full load: the one the last step must balance.
         let full = NetObjective::new(objective.grid().clone(), laws, settings.gravity);
         solver_settings.force_scale = Some(super::solver::force_scale(&full, &kinematic.positions, &facet_cons));
     }
+    // Energies under the full load, for comparison with the result. The first step carries 1/S
+    // of the load, so the full load does (S - 1) times more work.
     let full_load = |objective: &NetObjective, x: &[Point]| objective.evaluate(x, false).energy - (settings.load_steps - 1) as f64 * objective.work(x);
     let energy_kinematic = full_load(&objective, &kinematic.positions);
     let energy_start = full_load(&objective, &x);
