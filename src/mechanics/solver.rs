@@ -245,11 +245,15 @@ fn start_forces(r: &Reduction, e: &Evaluation, bases: &[NodeBasis]) -> f64 {
 /// The force scale [`solve`] would use at `x` by default: the larger of the internal forces and
 /// the loads over the free directions of `cons` there.
 pub fn force_scale(objective: &dyn Objective, x: &[Point], cons: &Constraints) -> f64 {
-    let reduction = Reduction::new(&cons.freedom, &[]);
     let e = objective.evaluate(x, false);
-    let bases: Vec<NodeBasis> =
-        cons.freedom.par_iter().enumerate().map(|(k, f)| f.basis(&x[k], cons.tool, &(e.external[k] - e.internal[k]))).collect();
-    start_forces(&reduction, &e, &bases)
+    start_forces(&Reduction::new(&cons.freedom, &[]), &e, &bases_at(cons, x, &e))
+}
+
+/// Each node's basis of motion at `x`, for the pushes of the evaluation there (on-tool nodes
+/// pushed over the tool's open edge are held by it).
+fn bases_at(cons: &Constraints, x: &[Point], e: &Evaluation) -> Vec<NodeBasis> {
+    let (internal, external) = (&e.internal, &e.external);
+    cons.freedom.par_iter().enumerate().map(|(k, f)| f.basis(&x[k], cons.tool, &(external[k] - internal[k]))).collect()
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -261,16 +265,6 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let start = std::time::Instant::now();
     let reduction = Reduction::new(&cons.freedom, &objective.coupled_pairs());
     let movable: Vec<bool> = cons.freedom.iter().map(|f| f.dofs() > 0).collect();
-    // Bases at x for the pushes of the evaluation there (on-tool nodes pushed over the tool's
-    // open edge are held by it).
-    let bases_at = |x: &[Point], e: &Evaluation| -> Vec<NodeBasis> {
-        let (internal, external) = (&e.internal, &e.external);
-        cons.freedom
-            .par_iter()
-            .enumerate()
-            .map(|(k, f)| f.basis(&x[k], cons.tool, &(external[k] - internal[k])))
-            .collect()
-    };
     let rows_at = |x: &[Point]| -> Vec<ContactRow> {
         match (cons.mode, cons.tool) {
             (ContactMode::Free, Some(tool)) => contact_rows(tool, x, &movable, cons.spacing),
@@ -278,7 +272,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         }
     };
     let mut eval = objective.evaluate(x, true);
-    let mut bases = bases_at(x, &eval);
+    let mut bases = bases_at(cons, x, &eval);
     let mut rows = rows_at(x);
     let energy_start = eval.energy;
     let mut iterations = Vec::new();
@@ -356,7 +350,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 step_norm = norm(&y);
                 x.copy_from_slice(&trial);
                 eval = trial_eval;
-                bases = bases_at(x, &eval);
+                bases = bases_at(cons, x, &eval);
                 rows = rows_at(x);
                 if actual >= 0.75 * predicted {
                     damping = (damping / 4.0).max(1e-12);
