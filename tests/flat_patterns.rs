@@ -192,21 +192,9 @@ fn no_complete_cell_is_an_error_naming_the_ply() {
     assert!(e.to_string().contains("'lonely'"), "{e}");
 }
 
-/// A flat net of `cells` (i, j) on an nu x nv grid, spacing d: a hand-made pattern shape.
+/// The flat pattern of a hand-made net (see [`shape_net`]).
 fn shape(name: &str, d: f64, nu: usize, nv: usize, cells: impl Fn(usize, usize) -> bool) -> FlatPattern {
-    let mut net = DrapeNet::new(name, d, nu, nv, (nu / 2, nv / 2));
-    for i in 0..nu - 1 {
-        for j in 0..nv - 1 {
-            if cells(i, j) {
-                for (a, b) in [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)] {
-                    let k = net.index(a, b);
-                    net.positions[k] = Point::new(a as f64 * d, b as f64 * d, 0.0);
-                    net.status[k] = NodeStatus::Placed;
-                }
-            }
-        }
-    }
-    flat_pattern(&net).unwrap()
+    flat_pattern(&shape_net(name, d, nu, nv, cells)).unwrap()
 }
 
 /// A square ring (a hole in the middle) and two squares touching at a corner.
@@ -217,7 +205,7 @@ fn pinch() -> FlatPattern {
     shape("pinch", 0.01, 21, 21, |i, j| (i < 10) == (j < 10))
 }
 
-/// A flat net of `cells`, as a net (see [`shape`]).
+/// A flat net of `cells` (i, j) on an nu x nv grid, spacing d: a hand-made pattern shape.
 fn shape_net(name: &str, d: f64, nu: usize, nv: usize, cells: impl Fn(usize, usize) -> bool) -> DrapeNet {
     let mut net = DrapeNet::new(name, d, nu, nv, (nu / 2, nv / 2));
     for i in 0..nu - 1 {
