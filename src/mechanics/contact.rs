@@ -111,15 +111,18 @@ impl Freedom {
         }
     }
 
-    /// The basis of allowed motion at position `p` (tool normals for the on-tool kinds), for a
-    /// node the energy pushes along `descent`. An on-tool node on the tool's open boundary that
-    /// is pushed out over it is held there by the edge (it slides along the edge, or stays put at
-    /// a corner): the tool ends, and a pressed ply does not leave it.
-    pub fn basis(&self, p: &Point, tool: Option<&dyn ContactSurface>, descent: &Vector) -> NodeBasis {
-        let foot = || match tool {
-            Some(t) => t.locate(p),
-            None => Foot { point: *p, normal: Vector::z(), open_edges: [None; 2] },
-        };
+    /// Whether the node slides on the tool (its basis needs the node's [`Foot`]).
+    pub fn on_tool(&self) -> bool {
+        matches!(self, Freedom::OnTool | Freedom::OnToolInPlane(_))
+    }
+
+    /// The basis of allowed motion for a node the energy pushes along `descent`; the on-tool
+    /// kinds use the node's `foot` on the tool (its normal is +z without one). An on-tool node on
+    /// the tool's open boundary that is pushed out over it is held there by the edge (it slides
+    /// along the edge, or stays put at a corner): the tool ends, and a pressed ply does not
+    /// leave it.
+    pub fn basis(&self, foot: Option<&Foot>, descent: &Vector) -> NodeBasis {
+        let foot = || foot.copied().unwrap_or(Foot { point: Point::origin(), normal: Vector::z(), open_edges: [None; 2] });
         // The open edges the node is pushed over, as outward directions in the tangent plane.
         let held = |f: &Foot| -> Vec<Vector> {
             f.open_edges

@@ -1,7 +1,7 @@
 //! Sequential convex subproblems: at each iterate a quadratic model of the energy (convexified
 //! Hessian plus Levenberg-Marquardt damping) with the linearised contact constraints is solved by
 //! Clarabel; the step is accepted if the energy falls as predicted, else the damping grows.
-use super::contact::{contact_rows, ContactMode, ContactRow, ContactSurface, Freedom, NodeBasis};
+use super::contact::{contact_rows, ContactMode, ContactRow, ContactSurface, Foot, Freedom, NodeBasis};
 use crate::geometry::{Point, Vector};
 use rayon::prelude::*;
 use clarabel::algebra::CscMatrix;
@@ -246,14 +246,26 @@ fn start_forces(r: &Reduction, e: &Evaluation, bases: &[NodeBasis]) -> f64 {
 /// the loads over the free directions of `cons` there.
 pub fn force_scale(objective: &dyn Objective, x: &[Point], cons: &Constraints) -> f64 {
     let e = objective.evaluate(x, false);
-    start_forces(&Reduction::new(&cons.freedom, &[]), &e, &bases_at(cons, x, &e))
+    start_forces(&Reduction::new(&cons.freedom, &[]), &e, &bases_at(cons, x, &e, None))
 }
 
 /// Each node's basis of motion at `x`, for the pushes of the evaluation there (on-tool nodes
-/// pushed over the tool's open edge are held by it).
-fn bases_at(cons: &Constraints, x: &[Point], e: &Evaluation) -> Vec<NodeBasis> {
+/// pushed over the tool's open edge are held by it). `feet`: the on-tool nodes' feet when the
+/// caller has just found them, else they are located here.
+fn bases_at(cons: &Constraints, x: &[Point], e: &Evaluation, feet: Option<&[Option<Foot>]>) -> Vec<NodeBasis> {
     let (internal, external) = (&e.internal, &e.external);
-    cons.freedom.par_iter().enumerate().map(|(k, f)| f.basis(&x[k], cons.tool, &(external[k] - internal[k]))).collect()
+    cons.freedom
+        .par_iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let foot = match (f.on_tool(), feet.and_then(|feet| feet[k]), cons.tool) {
+                (false, _, _) => None,
+                (true, Some(known), _) => Some(known),
+                (true, None, tool) => tool.map(|t| t.locate(&x[k])),
+            };
+            f.basis(foot.as_ref(), &(external[k] - internal[k]))
+        })
+        .collect()
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -272,7 +284,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         }
     };
     let mut eval = objective.evaluate(x, true);
-    let mut bases = bases_at(cons, x, &eval);
+    let mut bases = bases_at(cons, x, &eval, None);
     let mut rows = rows_at(x);
     let energy_start = eval.energy;
     let mut iterations = Vec::new();
@@ -337,20 +349,30 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             }
             let delta = reduction.expand(&y, &bases);
             let mut trial: Vec<Point> = x.iter().zip(&delta).map(|(p, d)| p + d).collect();
-            if let (ContactMode::Pressed, Some(tool)) = (cons.mode, cons.tool) {
-                trial.par_iter_mut().zip(&cons.freedom).for_each(|(p, f)| {
-                    if matches!(f, Freedom::OnTool | Freedom::OnToolInPlane(_)) {
-                        *p = tool.locate(p).point;
-                    }
-                });
-            }
+            // Pressed nodes back onto the tool; their feet also give the next bases.
+            let feet: Option<Vec<Option<Foot>>> = match (cons.mode, cons.tool) {
+                (ContactMode::Pressed, Some(tool)) => Some(
+                    trial
+                        .par_iter_mut()
+                        .zip(&cons.freedom)
+                        .map(|(p, f)| {
+                            f.on_tool().then(|| {
+                                let foot = tool.locate(p);
+                                *p = foot.point;
+                                foot
+                            })
+                        })
+                        .collect(),
+                ),
+                _ => None,
+            };
             let trial_eval = objective.evaluate(&trial, true);
             let actual = eval.energy - trial_eval.energy;
             if actual >= ACCEPT_RATIO * predicted || (actual >= 0.0 && predicted <= 100.0 * floor) {
                 step_norm = norm(&y);
                 x.copy_from_slice(&trial);
                 eval = trial_eval;
-                bases = bases_at(cons, x, &eval);
+                bases = bases_at(cons, x, &eval, feet.as_deref());
                 rows = rows_at(x);
                 if actual >= 0.75 * predicted {
                     damping = (damping / 4.0).max(1e-12);
