@@ -46,11 +46,17 @@ fn energy(c: &mut Criterion) {
         group.throughput(Throughput::Elements((n * n) as u64));
         group.bench_with_input(BenchmarkId::new("energy_only", n), &x, |b, x| b.iter(|| model.energy(x)));
         let mut out = model.evaluate(&x, None);
-        group.bench_with_input(BenchmarkId::new("gradient", n), &x, |b, x| b.iter(|| model.evaluate_into(x, None, &mut out)));
+        group.bench_with_input(BenchmarkId::new("gradient", n), &x, |b, x| {
+            b.iter(|| model.evaluate_into(x, None, &mut out))
+        });
         for (name, kind) in [("hessian_convex", HessianKind::Convex), ("hessian_exact", HessianKind::Exact)] {
             let mut out: Evaluation = model.evaluate(&x, Some(kind));
-            group.bench_with_input(BenchmarkId::new(name, n), &x, |b, x| b.iter(|| model.evaluate_into(x, Some(kind), &mut out)));
-            group.bench_with_input(BenchmarkId::new(format!("{name}_fresh"), n), &x, |b, x| b.iter(|| model.evaluate(x, Some(kind))));
+            group.bench_with_input(BenchmarkId::new(name, n), &x, |b, x| {
+                b.iter(|| model.evaluate_into(x, Some(kind), &mut out))
+            });
+            group.bench_with_input(BenchmarkId::new(format!("{name}_fresh"), n), &x, |b, x| {
+                b.iter(|| model.evaluate(x, Some(kind)))
+            });
         }
     }
     group.finish();

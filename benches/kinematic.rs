@@ -16,7 +16,9 @@ fn fishnet(c: &mut Criterion) {
         let spacing = FRAC_PI_2 / half as f64 * 0.999;
         let settings = KinematicSettings::grid("b", Point::new(0.0, 0.0, 1.0), Vector::x(), spacing, nodes, nodes);
         group.throughput(Throughput::Elements(((nodes - 1) * (nodes - 1)) as u64));
-        group.bench_with_input(BenchmarkId::from_parameter(nodes), &settings, |b, s| b.iter(|| drape(&tool, s).unwrap()));
+        group.bench_with_input(BenchmarkId::from_parameter(nodes), &settings, |b, s| {
+            b.iter(|| drape(&tool, s).unwrap())
+        });
     }
     group.finish();
 }

@@ -20,7 +20,12 @@ fn flow_mesh(m: &TriangleMesh) -> FlowMesh {
             .triangles
             .iter()
             .enumerate()
-            .map(|(k, t)| FlowElement { id: k as u64 + 1, shape: ElementShape::Tria3, nodes: t.map(|v| v as usize).to_vec(), property: 0 })
+            .map(|(k, t)| FlowElement {
+                id: k as u64 + 1,
+                shape: ElementShape::Tria3,
+                nodes: t.map(|v| v as usize).to_vec(),
+                property: 0,
+            })
             .collect(),
     }
 }
@@ -29,7 +34,9 @@ fn layup(c: &mut Criterion) {
     let tool = shapes::hemisphere_with_triangles(1.0, 200_000).into_surface().unwrap();
     let nodes = 301;
     let spacing = FRAC_PI_2 / ((nodes - 1) / 2) as f64 * 0.999;
-    let net = drape(&tool, &KinematicSettings::grid("b", Point::new(0.0, 0.0, 1.0), Vector::x(), spacing, nodes, nodes)).unwrap();
+    let net =
+        drape(&tool, &KinematicSettings::grid("b", Point::new(0.0, 0.0, 1.0), Vector::x(), spacing, nodes, nodes))
+            .unwrap();
     let settings = PlyMapSettings {
         thickness: 5e-4,
         vf: 0.5,

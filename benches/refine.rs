@@ -11,7 +11,9 @@ use std::f64::consts::FRAC_PI_2;
 
 fn pressed_hemisphere(c: &mut Criterion) {
     let tool = shapes::hemisphere_with_triangles(1.0, 200_000).into_surface().unwrap();
-    let card = MaterialCard::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/carbon-twill.toml")).unwrap();
+    let card =
+        MaterialCard::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/carbon-twill.toml"))
+            .unwrap();
     let mut group = c.benchmark_group("refine_pressed_hemisphere_200k");
     group.sample_size(10);
     for nodes in [101usize, 201] {

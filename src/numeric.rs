@@ -3,7 +3,13 @@
 /// Golden-section search for a minimum of `f` on `[lo, hi]`: at most `max_iterations` steps,
 /// stopping early once the bracket is narrower than `rel_tol` times its upper end. Returns the
 /// better of the final bracket's two interior points and its value.
-pub fn golden_section_min(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, max_iterations: usize, rel_tol: f64) -> (f64, f64) {
+pub fn golden_section_min(
+    f: impl Fn(f64) -> f64,
+    mut lo: f64,
+    mut hi: f64,
+    max_iterations: usize,
+    rel_tol: f64,
+) -> (f64, f64) {
     let r = 0.5 * (5f64.sqrt() - 1.0);
     let mut x1 = hi - r * (hi - lo);
     let mut x2 = lo + r * (hi - lo);

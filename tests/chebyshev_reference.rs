@@ -134,10 +134,8 @@ fn matches_independent_rk4() {
     let rhs = |s: f64, y: [f64; 2]| [y[1], (y[0].cos() - y[1]) / s];
     let rk4 = |s_end: f64, steps: usize| {
         let s0 = 0.01f64;
-        let mut y = [
-            s0 - s0.powi(3) / 18.0 + 7.0 * s0.powi(5) / 1800.0,
-            1.0 - s0.powi(2) / 6.0 + 7.0 * s0.powi(4) / 360.0,
-        ];
+        let mut y =
+            [s0 - s0.powi(3) / 18.0 + 7.0 * s0.powi(5) / 1800.0, 1.0 - s0.powi(2) / 6.0 + 7.0 * s0.powi(4) / 360.0];
         let h = (s_end - s0) / steps as f64;
         for i in 0..steps {
             let s = s0 + i as f64 * h;
@@ -176,10 +174,7 @@ fn reference_values() {
     let s_star = collapse_s();
     println!("gamma(0.9R, 0.9R) = {g09:.15} rad = {:.12} deg", g09.to_degrees());
     println!("gamma(0.5R, 0.5R) = {g05:.15} rad = {:.12} deg", g05.to_degrees());
-    println!(
-        "collapse (gamma = 90 deg) at u v / R^2 = {s_star:.15} (u = v = {:.12} R)",
-        s_star.sqrt()
-    );
+    println!("collapse (gamma = 90 deg) at u v / R^2 = {s_star:.15} (u = v = {:.12} R)", s_star.sqrt());
     assert!((s_star - COLLAPSE_S).abs() < 1e-12);
     // Construction just below the collapse point works. Just above it panics.
     let near = SphereChebyshev::new(R, 0.999 * s_star * R * R);

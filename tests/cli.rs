@@ -29,7 +29,21 @@ fn plate_obj(dir: &Path) -> PathBuf {
 }
 
 fn kinematic_args<'a>(tool: &'a str, out: &'a str) -> Vec<&'a str> {
-    vec!["kinematic", "--tool", tool, "--origin", "0,0,0", "--warp", "1,1,0", "--spacing", "0.02", "--grid", "21,21", "--out", out]
+    vec![
+        "kinematic",
+        "--tool",
+        tool,
+        "--origin",
+        "0,0,0",
+        "--warp",
+        "1,1,0",
+        "--spacing",
+        "0.02",
+        "--grid",
+        "21,21",
+        "--out",
+        out,
+    ]
 }
 
 /// Run with `args` changed by `edit`, expect exit code 2, a message containing `needle`, and no
@@ -38,7 +52,8 @@ fn refused(edit: impl FnOnce(&mut Vec<String>), needle: &str) {
     let dir = tempfile::tempdir().unwrap();
     let tool = plate_obj(dir.path());
     let out = dir.path().join("out");
-    let mut args: Vec<String> = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap()).into_iter().map(String::from).collect();
+    let mut args: Vec<String> =
+        kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap()).into_iter().map(String::from).collect();
     edit(&mut args);
     let assert = drape().args(&args).assert().code(2);
     let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
@@ -71,7 +86,8 @@ fn one_ply_writes_the_contract_files() {
     let assert = drape().args(&args).assert().success();
     let stdout = String::from_utf8_lossy(&assert.get_output().stdout).to_string();
     assert!(stdout.contains("nodes placed") && stdout.contains("max") && stdout.contains("locking"), "{stdout}");
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("ply0.drape.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("ply0.drape.json")).unwrap()).unwrap();
     assert_eq!(json["ply"], "ply0");
     assert_eq!(json["method"], "kinematic");
     assert_eq!(json["spacing"], 0.02);
@@ -136,7 +152,8 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
     std::fs::write(&scene, good).unwrap();
     let out = dir.path().join("out");
     drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("b.drape.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("b.drape.json")).unwrap()).unwrap();
     // Millimetres in, metres out.
     assert_eq!(json["spacing"], 2e-5);
     assert!(out.join("a.vtu").is_file());
@@ -151,13 +168,19 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
         }
         assert!(!out.exists());
     };
-    check(&good.replace("spacing = 0.02\ngrid = [11, 11]\nthickness", "spacing = -1\ngrid = [11, 11]\nthickness"), &["ply 'a'", "line 4", "spacing"]);
+    check(
+        &good.replace("spacing = 0.02\ngrid = [11, 11]\nthickness", "spacing = -1\ngrid = [11, 11]\nthickness"),
+        &["ply 'a'", "line 4", "spacing"],
+    );
     check(&good.replace("thickness = 0.5\n", ""), &["ply 'a'", "line 4", "thickness", "plies above it"]);
     check(&good.replace("warp = [1, 1, 0]", "warp = [1, 1]"), &["line 15", "warp"]);
     check(&good.replace("name = \"b\"", "name = \"b\"\ncolour = \"red\""), &["colour"]);
     check(&good.replace("tool = \"plate.obj\"", "tool = \"missing.obj\""), &["missing.obj"]);
     check(&good.replace("units = \"mm\"", "units = \"inch\""), &["units"]);
-    check(&good.replace("origin = [0, 0, 0]\nwarp = [1, 1, 0]", "origin = [0, 0, 400]\nwarp = [1, 1, 0]"), &["ply 'b'", "from the tool"]);
+    check(
+        &good.replace("origin = [0, 0, 0]\nwarp = [1, 1, 0]", "origin = [0, 0, 400]\nwarp = [1, 1, 0]"),
+        &["ply 'b'", "from the tool"],
+    );
 }
 
 #[test]
@@ -165,27 +188,46 @@ fn steering_curve_and_outline_files_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
     let tool = plate_obj(dir.path());
     // A curve at 30 deg to x through the origin, and a square outline of half-size 0.2.
-    let curve: String = (-10..=10).map(|k| format!("{},{},0\n", 0.04 * k as f64 * 0.866, 0.04 * k as f64 * 0.5)).collect();
+    let curve: String =
+        (-10..=10).map(|k| format!("{},{},0\n", 0.04 * k as f64 * 0.866, 0.04 * k as f64 * 0.5)).collect();
     std::fs::write(dir.path().join("curve.csv"), format!("x,y,z\n{curve}")).unwrap();
-    std::fs::write(dir.path().join("outline.txt"), "# square\n-0.2 -0.2 0\n0.2 -0.2 0\n0.2 0.2 0\n-0.2 0.2 0\n").unwrap();
+    std::fs::write(dir.path().join("outline.txt"), "# square\n-0.2 -0.2 0\n0.2 -0.2 0\n0.2 0.2 0\n-0.2 0.2 0\n")
+        .unwrap();
     let out = dir.path().join("out");
     let steer = format!("steer:{}", dir.path().join("curve.csv").display());
     let outline = dir.path().join("outline.txt");
     let args = [
-        "kinematic", "--tool", tool.to_str().unwrap(), "--origin", "0,0,0", "--warp", "1,0,0", "--spacing", "0.02",
-        "--outline", outline.to_str().unwrap(), "--generators", &steer, "--name", "s",
-        "--out", out.to_str().unwrap(),
+        "kinematic",
+        "--tool",
+        tool.to_str().unwrap(),
+        "--origin",
+        "0,0,0",
+        "--warp",
+        "1,0,0",
+        "--spacing",
+        "0.02",
+        "--outline",
+        outline.to_str().unwrap(),
+        "--generators",
+        &steer,
+        "--name",
+        "s",
+        "--out",
+        out.to_str().unwrap(),
     ];
     drape().args(args).assert().success();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("s.drape.json")).unwrap()).unwrap();
-    let nodes: Vec<Option<[f64; 3]>> = json["nodes"].as_array().unwrap().iter().map(|n| serde_json::from_value(n.clone()).ok()).collect();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("s.drape.json")).unwrap()).unwrap();
+    let nodes: Vec<Option<[f64; 3]>> =
+        json["nodes"].as_array().unwrap().iter().map(|n| serde_json::from_value(n.clone()).ok()).collect();
     let placed: Vec<[f64; 3]> = nodes.iter().flatten().copied().collect();
     // Every placed node inside the outline; about (0.4 / 0.02)^2 of them.
     assert!(placed.iter().all(|p| p[0].abs() < 0.2 && p[1].abs() < 0.2));
     assert!((placed.len() as f64 - 400.0).abs() < 60.0, "{}", placed.len());
     // The warp follows the 30 deg curve: node (i0 + 1, j0) - origin is at 30 deg.
     let nv = json["grid"][1].as_u64().unwrap() as usize;
-    let [i0, j0] = [json["origin_node"][0].as_u64().unwrap() as usize, json["origin_node"][1].as_u64().unwrap() as usize];
+    let [i0, j0] =
+        [json["origin_node"][0].as_u64().unwrap() as usize, json["origin_node"][1].as_u64().unwrap() as usize];
     let (o, w) = (nodes[i0 * nv + j0].unwrap(), nodes[(i0 + 1) * nv + j0].unwrap());
     assert!(((w[1] - o[1]).atan2(w[0] - o[0]).to_degrees() - 30.0).abs() < 0.01);
 }
@@ -202,10 +244,25 @@ fn refine_and_cantilever_from_the_command_line() {
     let net = out.join("k.drape.json");
     let mech = dir.path().join("mech");
     drape()
-        .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card, "--mode", "pressed", "--max-iterations", "400", "--out", mech.to_str().unwrap()])
+        .args([
+            "refine",
+            "--net",
+            net.to_str().unwrap(),
+            "--tool",
+            tool.to_str().unwrap(),
+            "--material",
+            card,
+            "--mode",
+            "pressed",
+            "--max-iterations",
+            "400",
+            "--out",
+            mech.to_str().unwrap(),
+        ])
         .assert()
         .success();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(mech.join("k.drape.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(mech.join("k.drape.json")).unwrap()).unwrap();
     assert_eq!(json["method"], "mechanical");
     // A 20 deg pre-sheared net pressed on a plate relaxes to no shear (it is held only at the
     // origin and in the warp direction there).
@@ -216,12 +273,37 @@ fn refine_and_cantilever_from_the_command_line() {
     assert_eq!(json["meta"]["change_from_kinematic"]["shear_deg"].as_array().unwrap().len(), 20 * 20);
     // Bad input: a missing card is refused with exit code 2.
     drape()
-        .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", "/no/card.toml", "--mode", "free", "--out", mech.to_str().unwrap()])
+        .args([
+            "refine",
+            "--net",
+            net.to_str().unwrap(),
+            "--tool",
+            tool.to_str().unwrap(),
+            "--material",
+            "/no/card.toml",
+            "--mode",
+            "free",
+            "--out",
+            mech.to_str().unwrap(),
+        ])
         .assert()
         .code(2);
     let cant = dir.path().join("cant.json");
     drape()
-        .args(["test", "cantilever", "--material", card, "--direction", "warp", "--length", "0.05", "--nodes", "11", "--out", cant.to_str().unwrap()])
+        .args([
+            "test",
+            "cantilever",
+            "--material",
+            card,
+            "--direction",
+            "warp",
+            "--length",
+            "0.05",
+            "--nodes",
+            "11",
+            "--out",
+            cant.to_str().unwrap(),
+        ])
         .assert()
         .success();
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&cant).unwrap()).unwrap();
@@ -239,8 +321,12 @@ fn a_mechanical_ply_in_a_scene_is_refined_and_bad_mechanical_fields_are_named() 
     );
     std::fs::write(&scene, &text).unwrap();
     let out = dir.path().join("out");
-    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"]).assert().success();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("m.drape.json")).unwrap()).unwrap();
+    drape()
+        .args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .success();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("m.drape.json")).unwrap()).unwrap();
     assert_eq!(json["method"], "mechanical");
     assert!(json["meta"]["solver"]["outcome"].is_string());
     for (bad, needle) in [
@@ -249,7 +335,10 @@ fn a_mechanical_ply_in_a_scene_is_refined_and_bad_mechanical_fields_are_named() 
         (text.replace("method = \"mechanical\"", "method = \"kinematic\""), "only a ply with method"),
     ] {
         std::fs::write(&scene, bad).unwrap();
-        let a = drape().args(["run", scene.to_str().unwrap(), "--out", dir.path().join("bad").to_str().unwrap()]).assert().code(2);
+        let a = drape()
+            .args(["run", scene.to_str().unwrap(), "--out", dir.path().join("bad").to_str().unwrap()])
+            .assert()
+            .code(2);
         let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
         assert!(err.contains(needle) && err.contains("line 3"), "expected '{needle}' in: {err}");
     }

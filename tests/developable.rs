@@ -53,7 +53,11 @@ fn cylinder_drapes_without_shear_at_any_angle_error_shrinking_as_d_squared() {
         // The tangent plane at the top is spanned by x (around) and y (along the axis).
         let warp = warp_at(deg.to_radians(), Vector::y(), Vector::x());
         let (g1, g2) = shear_at_two_spacings(&tool, top, warp, 0.08, 0.48);
-        println!("cylinder {deg} deg: max |shear| {:.2e} deg (d = 0.08), {:.2e} deg (d = 0.04)", g1.to_degrees(), g2.to_degrees());
+        println!(
+            "cylinder {deg} deg: max |shear| {:.2e} deg (d = 0.08), {:.2e} deg (d = 0.04)",
+            g1.to_degrees(),
+            g2.to_degrees()
+        );
         // At 0 and 90 degrees the fibres follow generator lines and circles: exact.
         if deg == 0.0 || deg == 90.0 {
             assert!(g1 < 1e-7 && g2 < 1e-7, "{deg}: {g1} {g2}");
@@ -75,7 +79,11 @@ fn cone_drapes_without_shear_error_shrinking_as_d_squared() {
     for deg in [0.0f64, 30.0, 45.0, 75.0] {
         let warp = warp_at(deg.to_radians(), slant, Vector::y());
         let (g1, g2) = shear_at_two_spacings(&tool, seed, warp, 0.04, 0.16);
-        println!("cone {deg} deg: max |shear| {:.2e} deg (d = 0.04), {:.2e} deg (d = 0.02)", g1.to_degrees(), g2.to_degrees());
+        println!(
+            "cone {deg} deg: max |shear| {:.2e} deg (d = 0.04), {:.2e} deg (d = 0.02)",
+            g1.to_degrees(),
+            g2.to_degrees()
+        );
         assert!(g1 < 0.2f64.to_radians(), "{deg}: {}", g1.to_degrees());
         assert!(g2 < g1 / 3.0 || g2 < 1e-7, "{deg} deg: {g1} -> {g2}");
     }

@@ -50,7 +50,10 @@ fn gradients_match_finite_differences() {
             let x = perturbed(&grid, gamma, 0.05, seed);
             for (name, model) in all_models(&grid, &m) {
                 let ev = model.evaluate(&x, None);
-                assert!((ev.energy - model.energy(&x)).abs() <= 1e-14 * ev.energy.abs().max(1e-300), "{name}: energy() differs");
+                assert!(
+                    (ev.energy - model.energy(&x)).abs() <= 1e-14 * ev.energy.abs().max(1e-300),
+                    "{name}: energy() differs"
+                );
                 let g = flat(&ev.gradient);
                 let fd: Vec<f64> = (0..3 * grid.num_nodes())
                     .map(|k| (model.energy(&shifted(&x, k, h)) - model.energy(&shifted(&x, k, -h))) / (2.0 * h))
@@ -109,14 +112,18 @@ fn convex_hessians_are_positive_semidefinite() {
     for grid in grids() {
         for (gamma, seed) in cases() {
             for (noise, squeeze) in [(0.05, 1.0), (0.15, 0.85)] {
-                let x: Vec<Point> = perturbed(&grid, gamma, noise, seed).into_iter().map(|p| Point::from(p.coords * squeeze)).collect();
+                let x: Vec<Point> =
+                    perturbed(&grid, gamma, noise, seed).into_iter().map(|p| Point::from(p.coords * squeeze)).collect();
                 compressed |= squeeze < 1.0;
                 for (name, model) in all_models(&grid, &m) {
                     let exact = model.evaluate(&x, Some(HessianKind::Exact)).hessian.unwrap().to_dense();
                     let convex = model.evaluate(&x, Some(HessianKind::Convex)).hessian.unwrap().to_dense();
                     let eig = SymmetricEigen::new(convex).eigenvalues;
                     let (lo, hi) = (eig.min(), eig.max());
-                    assert!(lo >= -1e-9 * hi.abs().max(1e-300), "{name}, gamma {gamma:.3}: convex eigenvalues [{lo:e}, {hi:e}]");
+                    assert!(
+                        lo >= -1e-9 * hi.abs().max(1e-300),
+                        "{name}, gamma {gamma:.3}: convex eigenvalues [{lo:e}, {hi:e}]"
+                    );
                     if name == "bending" {
                         assert_eq!(exact, model.evaluate(&x, Some(HessianKind::Convex)).hessian.unwrap().to_dense());
                     }
@@ -157,7 +164,9 @@ fn shear_angle_matches_the_kinematic_convention() {
         net.positions = x.clone();
         net.status = vec![NodeStatus::Placed; 20];
         let expected: f64 =
-            (0..4).flat_map(|i| (0..3).map(move |j| (i, j))).map(|(i, j)| net.cell_shear(i, j).unwrap()).sum::<f64>() * D * D;
+            (0..4).flat_map(|i| (0..3).map(move |j| (i, j))).map(|(i, j)| net.cell_shear(i, j).unwrap()).sum::<f64>()
+                * D
+                * D;
         let model = Model::with_terms(grid.clone(), vec![Box::new(Shear::new(&Linear))]);
         let e = model.energy(&x);
         assert!((e - expected).abs() <= 1e-13 * expected.abs().max(D * D), "gamma {gamma}: {e} vs {expected}");
@@ -194,10 +203,14 @@ fn convex_hessian_is_the_clamped_gauss_newton_part() {
     for grid in grids() {
         for (gamma, seed) in cases() {
             for squeeze in [1.0, 0.85] {
-                let x: Vec<Point> = perturbed(&grid, gamma, 0.1, seed).into_iter().map(|p| Point::from(p.coords * squeeze)).collect();
+                let x: Vec<Point> =
+                    perturbed(&grid, gamma, 0.1, seed).into_iter().map(|p| Point::from(p.coords * squeeze)).collect();
                 let convex = full(&grid, &m).evaluate(&x, Some(HessianKind::Convex)).hessian.unwrap().to_dense();
-                let reference =
-                    Model::new(grid.clone(), &clamped, Vector::zeros()).evaluate(&x, Some(HessianKind::Exact)).hessian.unwrap().to_dense();
+                let reference = Model::new(grid.clone(), &clamped, Vector::zeros())
+                    .evaluate(&x, Some(HessianKind::Exact))
+                    .hessian
+                    .unwrap()
+                    .to_dense();
                 let err = (&convex - &reference).norm() / reference.norm();
                 assert!(err < 1e-13, "gamma {gamma}: {err:e}");
             }

@@ -5,12 +5,14 @@
 //! exactly the number of complete cells times d^2. The DXF and SVG are read back by
 //! tools/pattern_readback.py (ezdxf and xml.etree; `python3 -m pip install -r
 //! tools/requirements.txt`); DRAPE_SKIP_PYTHON=1 skips that part.
-use drape::export::pattern::{dxf_layer_names, svg_ids, write_cutting_plan, write_dxf, write_pattern_svg, write_svg, PatternError};
+use drape::export::pattern::{
+    dxf_layer_names, svg_ids, write_cutting_plan, write_dxf, write_pattern_svg, write_svg, PatternError,
+};
 use drape::geometry::{shapes, Point, ToolSurface, Vector};
 use drape::kinematic::{drape, DrapeNet, Extent, KinematicSettings, NodeStatus};
 use drape::layup::flat::{flat_pattern, flat_pattern_with_margin, shoelace_area, FlatError, FlatPattern, Region};
-use proptest::prelude::*;
 use drape::layup::nest::{nest, Nesting, Rotation};
+use proptest::prelude::*;
 use serde_json::Value;
 use std::path::Path;
 use std::process::Command;
@@ -30,7 +32,10 @@ fn hemisphere() -> &'static ToolSurface {
 
 /// Complete cells of a net, counted directly.
 fn complete_cells(net: &DrapeNet) -> usize {
-    (0..net.nu - 1).flat_map(|i| (0..net.nv - 1).map(move |j| (i, j))).filter(|&(i, j)| net.cell_corners(i, j).is_some()).count()
+    (0..net.nu - 1)
+        .flat_map(|i| (0..net.nv - 1).map(move |j| (i, j)))
+        .filter(|&(i, j)| net.cell_corners(i, j).is_some())
+        .count()
 }
 
 /// Loops of a pattern are closed, axis-aligned, on the grid of spacing d, simple (no repeated
@@ -56,7 +61,11 @@ fn check_pattern(p: &FlatPattern) {
                 for v in b {
                     assert!((v / d - (v / d).round()).abs() < 1e-9, "{}: vertex {b:?} off the grid", p.ply);
                 }
-                assert!(seen.insert([(b[0] / d).round() as i64, (b[1] / d).round() as i64]), "{}: vertex {b:?} repeated", p.ply);
+                assert!(
+                    seen.insert([(b[0] / d).round() as i64, (b[1] / d).round() as i64]),
+                    "{}: vertex {b:?} repeated",
+                    p.ply
+                );
                 let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
                 assert!(u[0].abs() < LEN_EPS || u[1].abs() < LEN_EPS, "{}: edge not along a fibre", p.ply);
                 assert!((u[0] * w[1] - u[1] * w[0]).abs() > 0.5 * d * d, "{}: vertex {b:?} is not a corner", p.ply);
@@ -73,7 +82,8 @@ fn plate_ply_fully_on_the_tool_is_one_rectangle() {
     let tool = shapes::plate(1.0, 1.0, 13, 17).into_surface().unwrap();
     let d = 0.02;
     let (nu, nv) = (31, 25);
-    let net = drape(&tool, &KinematicSettings::grid("rect", Point::new(0.05, -0.03, 0.01), Vector::x(), d, nu, nv)).unwrap();
+    let net =
+        drape(&tool, &KinematicSettings::grid("rect", Point::new(0.05, -0.03, 0.01), Vector::x(), d, nu, nv)).unwrap();
     let p = flat_pattern(&net).unwrap();
     check_pattern(&p);
     assert_eq!(p.regions.len(), 1);
@@ -106,7 +116,10 @@ fn plate_ply_larger_than_the_plate_is_the_plate_outline_to_within_d() {
         for j in 0..net.nv {
             if let Some(q) = net.node(i, j) {
                 let flat = [(i as f64 - i0 as f64) * d, (j as f64 - j0 as f64) * d];
-                assert!((q.x - seed.x - flat[0]).abs() < 1e-9 && (q.y - seed.y - flat[1]).abs() < 1e-9, "node ({i}, {j})");
+                assert!(
+                    (q.x - seed.x - flat[0]).abs() < 1e-9 && (q.y - seed.y - flat[1]).abs() < 1e-9,
+                    "node ({i}, {j})"
+                );
             }
         }
     }
@@ -124,10 +137,12 @@ fn plate_ply_larger_than_the_plate_is_the_plate_outline_to_within_d() {
 fn ply_trimmed_to_a_circular_outline() {
     let tool = shapes::plate(1.0, 1.0, 20, 20).into_surface().unwrap();
     let (r, d) = (0.2, 0.01);
-    let outline: Vec<Point> = (0..180).map(|k| {
-        let t = k as f64 * std::f64::consts::TAU / 180.0;
-        Point::new(r * t.cos(), r * t.sin(), 0.0)
-    }).collect();
+    let outline: Vec<Point> = (0..180)
+        .map(|k| {
+            let t = k as f64 * std::f64::consts::TAU / 180.0;
+            Point::new(r * t.cos(), r * t.sin(), 0.0)
+        })
+        .collect();
     let mut s = KinematicSettings::grid("disc", Point::new(0.0, 0.0, 0.0), Vector::x(), d, 3, 3);
     s.extent = Extent::Outline(outline);
     let net = drape(&tool, &s).unwrap();
@@ -139,9 +154,20 @@ fn ply_trimmed_to_a_circular_outline() {
     let sagitta = r * (1.0 - (std::f64::consts::PI / 180.0).cos());
     let inner = r - sagitta - std::f64::consts::SQRT_2 * d;
     let pi = std::f64::consts::PI;
-    assert!(p.area <= pi * r * r && p.area >= pi * inner * inner, "area {} not in [{}, {}]", p.area, pi * inner * inner, pi * r * r);
+    assert!(
+        p.area <= pi * r * r && p.area >= pi * inner * inner,
+        "area {} not in [{}, {}]",
+        p.area,
+        pi * inner * inner,
+        pi * r * r
+    );
     for k in 0..2 {
-        assert!(p.min[k] >= -r && p.max[k] <= r && p.min[k] < -r + 2.0 * d && p.max[k] > r - 2.0 * d, "bbox {:?} {:?}", p.min, p.max);
+        assert!(
+            p.min[k] >= -r && p.max[k] <= r && p.min[k] < -r + 2.0 * d && p.max[k] > r - 2.0 * d,
+            "bbox {:?} {:?}",
+            p.min,
+            p.max
+        );
     }
 }
 
@@ -153,7 +179,8 @@ fn cylinder_pattern_is_the_unrolled_patch() {
     let d = 0.02;
     // Warp along the axis (y), weft around; the grid overhangs the tool both ways. The seed is
     // off the grid of the tool's ends so that no node falls exactly on an end.
-    let net = drape(&tool, &KinematicSettings::grid("cyl", Point::new(0.0, 0.007, radius), Vector::y(), d, 61, 91)).unwrap();
+    let net =
+        drape(&tool, &KinematicSettings::grid("cyl", Point::new(0.0, 0.007, radius), Vector::y(), d, 61, 91)).unwrap();
     let p = flat_pattern(&net).unwrap();
     check_pattern(&p);
     // Arc length of the faceted section: the sum of its chords. Nodes d apart fit in a length L
@@ -161,7 +188,10 @@ fn cylinder_pattern_is_the_unrolled_patch() {
     let arc = n_around as f64 * 2.0 * radius * (std::f64::consts::PI / (2.0 * n_around as f64)).sin();
     let [along_axis, around] = p.size();
     println!("cylinder: pattern {along_axis} x {around} m, tool {length} x {arc} m, {} cells", p.cells);
-    assert!(along_axis <= length + LEN_EPS && along_axis >= length - d - LEN_EPS, "along the axis {along_axis} vs {length}");
+    assert!(
+        along_axis <= length + LEN_EPS && along_axis >= length - d - LEN_EPS,
+        "along the axis {along_axis} vs {length}"
+    );
     assert!(around <= arc + LEN_EPS && around >= arc - d - LEN_EPS, "around {around} vs arc {arc}");
     assert_eq!(p.regions.len(), 1);
 }
@@ -169,7 +199,8 @@ fn cylinder_pattern_is_the_unrolled_patch() {
 #[test]
 fn hemisphere_pattern_area_is_the_cell_count_exactly() {
     for (name, warp, n) in [("h0", Vector::x(), 61), ("h45", Vector::new(1.0, 1.0, 0.0), 71)] {
-        let net = drape(hemisphere(), &KinematicSettings::grid(name, Point::new(0.0, 0.0, 1.0), warp, 0.05, n, n)).unwrap();
+        let net =
+            drape(hemisphere(), &KinematicSettings::grid(name, Point::new(0.0, 0.0, 1.0), warp, 0.05, n, n)).unwrap();
         let p = flat_pattern(&net).unwrap();
         check_pattern(&p);
         let cells = complete_cells(&net);
@@ -177,7 +208,13 @@ fn hemisphere_pattern_area_is_the_cell_count_exactly() {
         // A woven cell keeps its fibre lengths: each draped cell is d x d undeformed.
         assert_eq!(p.area, cells as f64 * 0.05 * 0.05);
         let holes: usize = p.regions.iter().map(|r| r.loops.len() - 1).sum();
-        println!("{name}: {} cells, {} region(s), {holes} hole(s), area {:.4} m2, bbox {:?}", p.cells, p.regions.len(), p.area, p.size());
+        println!(
+            "{name}: {} cells, {} region(s), {holes} hole(s), area {:.4} m2, bbox {:?}",
+            p.cells,
+            p.regions.len(),
+            p.area,
+            p.size()
+        );
         // Deterministic.
         assert_eq!(flat_pattern(&net).unwrap(), p);
     }
@@ -236,7 +273,10 @@ fn check_margin(p: &FlatPattern, plain: &FlatPattern, margin: f64) {
     assert_eq!(p.cells, plain.cells);
     assert_eq!(p.regions.iter().map(|r| r.cells).sum::<usize>(), p.cells);
     for k in 0..2 {
-        assert!((p.min[k] - (plain.min[k] - margin)).abs() < LEN_EPS && (p.max[k] - (plain.max[k] + margin)).abs() < LEN_EPS);
+        assert!(
+            (p.min[k] - (plain.min[k] - margin)).abs() < LEN_EPS
+                && (p.max[k] - (plain.max[k] + margin)).abs() < LEN_EPS
+        );
     }
     assert!(p.area > plain.area);
 }
@@ -270,7 +310,11 @@ fn cutting_margin_grows_the_outline_with_square_corners() {
         assert!((p.area - want).abs() < 1e-14, "margin {m}: {} vs {want}", p.area);
     }
     // A margin that is not a whole number of spacings, on a hemisphere drape (pinches, stairs).
-    let net = drape(hemisphere(), &KinematicSettings::grid("hm", Point::new(0.1, 0.0, 1.0), Vector::new(1.0, 0.3, 0.0), 0.05, 61, 61)).unwrap();
+    let net = drape(
+        hemisphere(),
+        &KinematicSettings::grid("hm", Point::new(0.1, 0.0, 1.0), Vector::new(1.0, 0.3, 0.0), 0.05, 61, 61),
+    )
+    .unwrap();
     let plain = flat_pattern(&net).unwrap();
     for m in [0.0123, 0.025, 0.075] {
         check_margin(&flat_pattern_with_margin(&net, m).unwrap(), &plain, m);
@@ -290,7 +334,13 @@ fn check_nesting(patterns: &[FlatPattern], n: &Nesting) {
             let hi = corners.iter().map(|c| c[k]).fold(f64::NEG_INFINITY, f64::max);
             assert!((lo - q.min[k]).abs() < LEN_EPS && (hi - q.max[k]).abs() < LEN_EPS, "{}: box", p.ply);
         }
-        assert!(q.min[1] >= -LEN_EPS && q.max[1] <= n.roll_width + LEN_EPS, "{}: across {:?}..{:?}", p.ply, q.min, q.max);
+        assert!(
+            q.min[1] >= -LEN_EPS && q.max[1] <= n.roll_width + LEN_EPS,
+            "{}: across {:?}..{:?}",
+            p.ply,
+            q.min,
+            q.max
+        );
         assert!(q.min[0] >= -LEN_EPS && q.max[0] <= n.length + LEN_EPS);
     }
     // Boxes apart by at least the gap in x or in y.
@@ -299,7 +349,12 @@ fn check_nesting(patterns: &[FlatPattern], n: &Nesting) {
             let (p, q) = (&n.placements[a], &n.placements[b]);
             let sep_x = (q.min[0] - p.max[0]).max(p.min[0] - q.max[0]);
             let sep_y = (q.min[1] - p.max[1]).max(p.min[1] - q.max[1]);
-            assert!(sep_x >= n.gap - LEN_EPS || sep_y >= n.gap - LEN_EPS, "{} and {} overlap: {p:?} {q:?}", p.ply, q.ply);
+            assert!(
+                sep_x >= n.gap - LEN_EPS || sep_y >= n.gap - LEN_EPS,
+                "{} and {} overlap: {p:?} {q:?}",
+                p.ply,
+                q.ply
+            );
         }
     }
     let area: f64 = patterns.iter().map(|p| p.area).sum();
@@ -311,7 +366,8 @@ fn check_nesting(patterns: &[FlatPattern], n: &Nesting) {
 }
 
 fn some_patterns() -> Vec<FlatPattern> {
-    let h = drape(hemisphere(), &KinematicSettings::grid("hemi", Point::new(0.0, 0.0, 1.0), Vector::x(), 0.05, 31, 31)).unwrap();
+    let h = drape(hemisphere(), &KinematicSettings::grid("hemi", Point::new(0.0, 0.0, 1.0), Vector::x(), 0.05, 31, 31))
+        .unwrap();
     let mut v = vec![flat_pattern(&h).unwrap(), ring(), pinch()];
     for (k, (a, b)) in [(12, 5), (5, 30), (9, 9), (20, 3), (3, 3), (16, 11)].into_iter().enumerate() {
         v.push(shape(&format!("r{k}"), 0.02, a + 1, b + 1, |_, _| true));
@@ -322,13 +378,23 @@ fn some_patterns() -> Vec<FlatPattern> {
 #[test]
 fn nesting_places_every_piece_inside_the_roll_without_overlap() {
     let patterns = some_patterns();
-    for (width, gap, rot) in [(1.6, 0.01, Rotation::WarpAlongRoll), (3.0, 0.0, Rotation::WarpAlongRoll), (1.55, 0.005, Rotation::AllowQuarterTurn)] {
+    for (width, gap, rot) in [
+        (1.6, 0.01, Rotation::WarpAlongRoll),
+        (3.0, 0.0, Rotation::WarpAlongRoll),
+        (1.55, 0.005, Rotation::AllowQuarterTurn),
+    ] {
         let n = nest(&patterns, width, gap, rot).unwrap();
         check_nesting(&patterns, &n);
         if rot == Rotation::WarpAlongRoll {
             assert!(n.placements.iter().all(|q| !q.rotated && q.warp() == [1.0, 0.0]));
         }
-        println!("roll {width} m, gap {gap}: length {:.3} m, used {:.3} m2, patterns {:.3} m2, waste {:.1} %", n.length, n.used_area, n.pattern_area, 100.0 * n.waste_fraction);
+        println!(
+            "roll {width} m, gap {gap}: length {:.3} m, used {:.3} m2, patterns {:.3} m2, waste {:.1} %",
+            n.length,
+            n.used_area,
+            n.pattern_area,
+            100.0 * n.waste_fraction
+        );
         assert_eq!(nest(&patterns, width, gap, rot).unwrap(), n, "deterministic");
     }
 }
@@ -381,8 +447,14 @@ fn nesting_refuses_a_piece_wider_than_the_roll() {
     let n = nest(std::slice::from_ref(&wide), 1.0, 0.0, Rotation::AllowQuarterTurn).unwrap();
     assert!(n.placements[0].rotated && n.placements[0].warp() == [0.0, 1.0]);
     check_nesting(std::slice::from_ref(&wide), &n);
-    assert!(matches!(nest(&[], 0.0, 0.0, Rotation::WarpAlongRoll), Err(FlatError::BadNestParameter { field: "roll_width", .. })));
-    assert!(matches!(nest(&[], 1.0, -1.0, Rotation::WarpAlongRoll), Err(FlatError::BadNestParameter { field: "gap", .. })));
+    assert!(matches!(
+        nest(&[], 0.0, 0.0, Rotation::WarpAlongRoll),
+        Err(FlatError::BadNestParameter { field: "roll_width", .. })
+    ));
+    assert!(matches!(
+        nest(&[], 1.0, -1.0, Rotation::WarpAlongRoll),
+        Err(FlatError::BadNestParameter { field: "gap", .. })
+    ));
 }
 
 /// Whether the Python part should run; fails the test (with what to do) if ezdxf is missing.
@@ -404,8 +476,15 @@ fn python_ready() -> bool {
 fn readback(files: &[&Path]) -> Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/pattern_readback.py");
     let out = Command::new("python3").arg(&script).args(files).output().unwrap();
-    assert!(out.status.success(), "{} failed ({}):\n{}", script.display(), out.status, String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("readback output is not JSON ({e}):\n{}", String::from_utf8_lossy(&out.stdout)))
+    assert!(
+        out.status.success(),
+        "{} failed ({}):\n{}",
+        script.display(),
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("readback output is not JSON ({e}):\n{}", String::from_utf8_lossy(&out.stdout)))
 }
 
 fn num(v: &Value) -> f64 {
@@ -421,7 +500,10 @@ fn drawings_read_back_independently() {
     let mut patterns = some_patterns();
     patterns.truncate(5);
     patterns[4].ply = "odd name/<&>".into(); // must become a valid layer name and id
-    patterns.push(flat_pattern_with_margin(&shape_net("ring-margin", 0.01, 21, 21, |i, j| i < 5 || j < 5 || i >= 15), 0.0037).unwrap());
+    patterns.push(
+        flat_pattern_with_margin(&shape_net("ring-margin", 0.01, 21, 21, |i, j| i < 5 || j < 5 || i >= 15), 0.0037)
+            .unwrap(),
+    );
     let n = nest(&patterns, 1.6, 0.01, Rotation::AllowQuarterTurn).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let (dxf, svg, one) = (dir.path().join("nest.dxf"), dir.path().join("nest.svg"), dir.path().join("ring.svg"));
@@ -458,7 +540,11 @@ fn drawings_read_back_independently() {
         let holes: usize = p.regions.iter().map(|r| r.loops.len() - 1).sum();
         assert_eq!(s["closed_polylines"], p.loops().count(), "{layer}");
         assert_eq!((s["open_polylines"].as_u64(), s["self_intersecting"].as_u64()), (Some(0), Some(0)), "{layer}");
-        assert_eq!((s["loops_ccw"].as_u64(), s["loops_cw"].as_u64()), (Some(p.regions.len() as u64), Some(holes as u64)), "{layer}");
+        assert_eq!(
+            (s["loops_ccw"].as_u64(), s["loops_cw"].as_u64()),
+            (Some(p.regions.len() as u64), Some(holes as u64)),
+            "{layer}"
+        );
         let area = num(&s["signed_area_mm2"]) * 1e-6;
         assert!(close(area, p.area, FILE_AREA_REL), "{layer}: DXF area {area} vs {}", p.area);
         let bb: Vec<f64> = s["bbox_mm"].as_array().unwrap().iter().map(num).collect();
@@ -470,14 +556,24 @@ fn drawings_read_back_independently() {
     }
 
     let s = &r[svg.to_str().unwrap()];
-    assert_eq!((s["width"].as_str().unwrap().ends_with("mm"), s["height"].as_str().unwrap().ends_with("mm")), (true, true));
+    assert_eq!(
+        (s["width"].as_str().unwrap().ends_with("mm"), s["height"].as_str().unwrap().ends_with("mm")),
+        (true, true)
+    );
     let vb: Vec<f64> = s["viewbox"].as_array().unwrap().iter().map(num).collect();
-    assert!(close(vb[2], n.length * 1e3 + 20.0, 1e-12) && close(vb[3], n.roll_width * 1e3 + 20.0, 1e-12), "viewBox {vb:?}");
+    assert!(
+        close(vb[2], n.length * 1e3 + 20.0, 1e-12) && close(vb[3], n.roll_width * 1e3 + 20.0, 1e-12),
+        "viewBox {vb:?}"
+    );
     assert!(s["groups"]["roll"].is_object());
     for (p, id) in patterns.iter().zip(&ids) {
         let g = &s["groups"][id.as_str()];
         assert_eq!(g["data_ply"], p.ply.as_str(), "{id}");
-        assert_eq!((g["cut_paths"].as_u64(), g["subpaths"].as_u64()), (Some(1), Some(p.loops().count() as u64)), "{id}");
+        assert_eq!(
+            (g["cut_paths"].as_u64(), g["subpaths"].as_u64()),
+            (Some(1), Some(p.loops().count() as u64)),
+            "{id}"
+        );
         assert_eq!((g["open_subpaths"].as_u64(), g["self_intersecting"].as_u64()), (Some(0), Some(0)), "{id}");
         assert_eq!(g["fill_rule"], "evenodd");
         assert_eq!(g["warp_segments"], 3);

@@ -56,7 +56,18 @@ fn drape_ply() -> Case {
     Command::cargo_bin("drape")
         .unwrap()
         .args(["kinematic", "--tool", tool.to_str().unwrap(), "--origin", "0,0,0.1", "--warp", "1,1,0"])
-        .args(["--spacing", "0.004", "--grid", "79,79", "--name", "p45", "--format", "json", "--out", d.to_str().unwrap()])
+        .args([
+            "--spacing",
+            "0.004",
+            "--grid",
+            "79,79",
+            "--name",
+            "p45",
+            "--format",
+            "json",
+            "--out",
+            d.to_str().unwrap(),
+        ])
         .assert()
         .success();
     let net = read_net(&d.join("p45.drape.json")).unwrap();
@@ -112,9 +123,20 @@ fn angle_deg(a: &Vector, b: &Vector) -> f64 {
 }
 
 /// Check a covered element's directions: unit, in plane, angle = 90 - shear, shear = the net's.
-fn check_directions(e: &Element, warp: &Vector, weft: &Vector, shear_deg: f64, expected: (f64, Vector), worst: &mut f64, what: &str) {
+fn check_directions(
+    e: &Element,
+    warp: &Vector,
+    weft: &Vector,
+    shear_deg: f64,
+    expected: (f64, Vector),
+    worst: &mut f64,
+    what: &str,
+) {
     assert!((warp.norm() - 1.0).abs() < UNIT_TOL && (weft.norm() - 1.0).abs() < UNIT_TOL, "{what}: not unit");
-    assert!(warp.dot(&e.normal).abs() < UNIT_TOL && weft.dot(&e.normal).abs() < UNIT_TOL, "{what}: not in the element plane");
+    assert!(
+        warp.dot(&e.normal).abs() < UNIT_TOL && weft.dot(&e.normal).abs() < UNIT_TOL,
+        "{what}: not in the element plane"
+    );
     assert!((angle_deg(warp, weft) - (90.0 - shear_deg)).abs() < 1e-7, "{what}: angle(warp, weft) != 90 - shear");
     let diff = (shear_deg - expected.0).abs();
     *worst = worst.max(diff);
@@ -142,7 +164,8 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
     let mut elements = std::collections::HashMap::new();
     let (mut covered, mut worst) = (0, 0.0f64);
     for (k, c) in cells.iter().enumerate() {
-        let corners: Vec<Point> = c["nodes"].as_array().unwrap().iter().map(|n| points[n.as_u64().unwrap() as usize]).collect();
+        let corners: Vec<Point> =
+            c["nodes"].as_array().unwrap().iter().map(|n| points[n.as_u64().unwrap() as usize]).collect();
         let e = element(&corners);
         let scalar = |name: &str| data[name][k][0].as_f64().unwrap();
         let id = scalar("element_id") as u64;
@@ -152,7 +175,15 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
         if let Some(expected) = at {
             covered += 1;
             let shear = scalar("shear_deg");
-            check_directions(&e, &v3(&data["warp"][k]), &v3(&data["weft"][k]), shear, expected, &mut worst, &format!("VTU element {id}"));
+            check_directions(
+                &e,
+                &v3(&data["warp"][k]),
+                &v3(&data["weft"][k]),
+                shear,
+                expected,
+                &mut worst,
+                &format!("VTU element {id}"),
+            );
             // Fixed cavity: Vf = Vf0 / cos(shear) with the card's Vf0.
             let vf = scalar("vf");
             assert!((vf - 0.429 / shear.to_radians().cos()).abs() < 1e-9, "element {id}: vf {vf}");
@@ -187,15 +218,23 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
     let mut thetas = 0;
     for (id, el) in deck["elements"].as_object().unwrap() {
         let id: u64 = id.parse().unwrap();
-        let corners: Vec<Point> =
-            el["nodes"].as_array().unwrap().iter().map(|n| Point::from(v3(&grids[n.as_u64().unwrap().to_string()]))).collect();
+        let corners: Vec<Point> = el["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|n| Point::from(v3(&grids[n.as_u64().unwrap().to_string()])))
+            .collect();
         let e = element(&corners);
         // Uncovered elements go to PID 2 with a blank THETA (which pyNastran reads as 0).
         let pid = el["pid"].as_u64().unwrap();
         match (&elements[&id].1, el["theta"].as_f64().filter(|_| pid == 1)) {
             (Some((_, warp)), Some(theta)) => {
-                let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(e.normal), theta.to_radians());
-                assert!(angle_deg(&(r * e.edge), warp) < 1e-6, "Nastran element {id}: THETA {theta} does not give the warp");
+                let r =
+                    nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(e.normal), theta.to_radians());
+                assert!(
+                    angle_deg(&(r * e.edge), warp) < 1e-6,
+                    "Nastran element {id}: THETA {theta} does not give the warp"
+                );
                 thetas += 1;
             }
             (None, None) => assert_eq!(pid, 2, "Nastran element {id}: uncovered, PID {pid}"),
@@ -230,11 +269,18 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
         let Some((shear, warp)) = elements[&id.parse::<u64>().unwrap()].1 else { continue };
         let d = drape[id].as_array().expect("a covered element has a DRAPE row");
         let (t, dtheta) = (d[0].as_f64().unwrap(), d[1].as_f64().unwrap());
-        assert!((t - 1.0 / shear.to_radians().cos()).abs() < 0.02 * t, "OptiStruct element {id}: thinning {t}, shear {shear}");
+        assert!(
+            (t - 1.0 / shear.to_radians().cos()).abs() < 0.02 * t,
+            "OptiStruct element {id}: thinning {t}, shear {shear}"
+        );
         let theta = el["theta"].as_f64().unwrap_or(0.0) + ply["theta"].as_f64().unwrap() + dtheta;
         let g = &fem["grids"];
-        let corners: Vec<Point> =
-            el["nodes"].as_array().unwrap().iter().map(|n| Point::from(v3(&g[n.as_u64().unwrap().to_string()]))).collect();
+        let corners: Vec<Point> = el["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|n| Point::from(v3(&g[n.as_u64().unwrap().to_string()])))
+            .collect();
         let e = element(&corners);
         let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(e.normal), theta.to_radians());
         assert!(angle_deg(&(r * e.edge), &warp) < 1e-6, "OptiStruct element {id}: angles do not give the warp");
@@ -252,6 +298,9 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
     assert_eq!(rtm["tris"].as_object().unwrap().len(), covered, "the 2k mesh is all triangles: none split");
     for p in rtm["params"].as_array().unwrap() {
         let porosity = p[1].as_f64().unwrap();
-        assert!(porosity > 1.0 - 0.429 / 50f64.to_radians().cos() && porosity <= 1.0 - 0.429 + 1e-9, "porosity {porosity}");
+        assert!(
+            porosity > 1.0 - 0.429 / 50f64.to_radians().cos() && porosity <= 1.0 - 0.429 + 1e-9,
+            "porosity {porosity}"
+        );
     }
 }

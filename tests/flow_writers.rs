@@ -142,8 +142,7 @@ fn layup_map(mesh: &FlowMesh, layup: bool) -> LayupMap {
         let t: f64 = cov.iter().map(|f| f.thickness).sum();
         thickness[e] = t;
         mean_vf[e] = Some(cov.iter().map(|f| f.vf * f.thickness).sum::<f64>() / t);
-        permeability[e] =
-            Some(cov.iter().fold(Matrix3::zeros(), |s, f| s + f.permeability.unwrap() * f.thickness) / t);
+        permeability[e] = Some(cov.iter().fold(Matrix3::zeros(), |s, f| s + f.permeability.unwrap() * f.thickness) / t);
     }
     LayupMap { plies, layup, thickness, mean_vf, permeability }
 }
@@ -229,7 +228,8 @@ fn vtu_fields_and_frames() {
         for (e, el) in mesh.elements.iter().enumerate() {
             let ty = if el.shape == ElementShape::Tria3 { "triangle" } else { "quad" };
             assert_eq!(cells[e]["type"], ty);
-            let nodes: Vec<usize> = cells[e]["nodes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
+            let nodes: Vec<usize> =
+                cells[e]["nodes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
             assert_eq!(nodes, el.nodes);
             assert_eq!(data["element_id"][e][0].as_f64().unwrap(), el.id as f64);
             for p in &map.plies {
@@ -315,7 +315,11 @@ fn nastran_theta_reproduces_warp() {
                         assert!((theta - fib.theta.to_degrees()).abs() < LARGE_FIELD_DEG_TOL, "{theta}");
                         let n = back.normal(e).unwrap();
                         let warp = rotate(back.first_edge(e).unwrap(), n, theta.to_radians());
-                        assert!((warp - fib.warp).norm() < LARGE_FIELD_DIR_TOL, "element {}: THETA does not give the warp", el.id);
+                        assert!(
+                            (warp - fib.warp).norm() < LARGE_FIELD_DIR_TOL,
+                            "element {}: THETA does not give the warp",
+                            el.id
+                        );
                     }
                 }
             }
@@ -407,7 +411,9 @@ fn optistruct_ply_drape() {
             let warp = rotate(mesh.first_edge(e).unwrap(), mesh.normal(e).unwrap(), total.to_radians());
             assert!((warp - fib.warp).norm() < LARGE_FIELD_DIR_TOL, "element {}: angles do not give the warp", el.id);
         }
-        assert!((wrap_deg(p["theta"].as_f64().unwrap()) - wrap_deg((PLIES[k].1 - PLIES[0].1).to_degrees())).abs() < 1e-8);
+        assert!(
+            (wrap_deg(p["theta"].as_f64().unwrap()) - wrap_deg((PLIES[k].1 - PLIES[0].1).to_degrees())).abs() < 1e-8
+        );
     }
     // Element 16 is covered by the base ply only in the single-net map; here p45 covers it.
     assert_eq!(els["16"]["pid"], 1);
@@ -420,7 +426,8 @@ fn rtmsim_mesh_sets_and_parameters() {
         let map = layup_map(&mesh, layup);
         let dir = tempfile::tempdir().unwrap();
         let report = write_rtmsim(&mesh, &map, &dir.path().join("flow.bdf")).unwrap();
-        let names: Vec<String> = report.files.iter().map(|f| f.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        let names: Vec<String> =
+            report.files.iter().map(|f| f.file_name().unwrap().to_string_lossy().into_owned()).collect();
         assert_eq!(names, ["flow.bdf", "flow_input.txt"]);
         eprintln!(
             "rtmsim layup={layup}: {} group(s) found, {} region(s), {} merged, max direction error {:.3} deg",
@@ -478,7 +485,8 @@ fn rtmsim_mesh_sets_and_parameters() {
         let mut region_of_tri = std::collections::BTreeMap::new();
         for (r, reg) in report.regions.iter().enumerate() {
             let p = &params[r];
-            let want = [reg.thickness, reg.porosity, reg.permeability, reg.ratio, reg.refdir.x, reg.refdir.y, reg.refdir.z];
+            let want =
+                [reg.thickness, reg.porosity, reg.permeability, reg.ratio, reg.refdir.x, reg.refdir.y, reg.refdir.z];
             assert_eq!(p[..], want[..], "region {r} parameters");
             if r > 0 {
                 assert_eq!(types[r - 1], 2);
@@ -517,7 +525,11 @@ fn rtmsim_mesh_sets_and_parameters() {
                 assert!((por - params[r][1]).abs() <= drape::export::flow::POROSITY_BIN, "porosity");
             }
         }
-        assert!((max_err - report.max_direction_error_deg).abs() < 1e-6, "{max_err} vs {}", report.max_direction_error_deg);
+        assert!(
+            (max_err - report.max_direction_error_deg).abs() < 1e-6,
+            "{max_err} vs {}",
+            report.max_direction_error_deg
+        );
     }
 }
 

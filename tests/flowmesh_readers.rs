@@ -28,10 +28,14 @@ const NODES: [(u64, [f64; 3]); 7] = [
     (70, [250.25, 75.0, 1500.0]),
 ];
 /// The plate's elements: (id, corner node ids, property).
-const ELEMENTS: [(u64, &[u64], u64); 3] = [(101, &[10, 20, 50, 40], 1), (102, &[20, 30, 60, 50], 1), (103, &[30, 70, 60], 2)];
+const ELEMENTS: [(u64, &[u64], u64); 3] =
+    [(101, &[10, 20, 50, 40], 1), (102, &[20, 30, 60, 50], 1), (103, &[30, 70, 60], 2)];
 /// Fixtures meshio 5.3.5 cannot read, and why (checked against the known answer only).
 const MESHIO_CANNOT: [(&str, &str); 5] = [
-    ("plate_bin.msh", "meshio wrote it but reads it back with KeyError (the line's curve entity); checked against the ASCII plate"),
+    (
+        "plate_bin.msh",
+        "meshio wrote it but reads it back with KeyError (the line's curve entity); checked against the ASCII plate",
+    ),
     ("plate_quirks.bdf", "tabs, large free fields, implicit continuations, D exponents, reals in CQUAD4 continuations"),
     ("plate_parts.inp", "parts/instances, *INCLUDE and continued data lines"),
     ("pentagon.obj", "line continuation with a backslash"),
@@ -191,7 +195,10 @@ fn nastran_local_coordinate_systems() {
 
     let e = err_text("undef.bdf", "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,9,0.,1.,0.\nCTRIA3,1,1,1,2,3\n");
     assert!(e.contains("GRID 3") && e.contains("CP=9") && e.contains("line 3"), "{e}");
-    let e = err_text("cord1.bdf", "CORD1R,7,1,2,3\nGRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,7,0.,1.,0.\nCTRIA3,1,1,1,2,3\n");
+    let e = err_text(
+        "cord1.bdf",
+        "CORD1R,7,1,2,3\nGRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,7,0.,1.,0.\nCTRIA3,1,1,1,2,3\n",
+    );
     assert!(e.contains("GRID 3") && e.contains("CORD1R") && e.contains("CORD2R"), "{e}");
 }
 
@@ -217,11 +224,15 @@ fn errors_name_the_line_and_what_to_do() {
     assert!(e.contains("line 3") && e.contains("node 3"), "{e}");
     let e = err_text("dup.inp", "*NODE\n1, 0., 0., 0.\n2, 1., 0., 0.\n1, 0., 1., 0.\n*ELEMENT, TYPE=S3\n1, 1, 2, 1\n");
     assert!(e.contains("line 4") && e.contains("node id 1"), "{e}");
-    let e = err_text("solid.inp", "*NODE\n1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n");
+    let e = err_text(
+        "solid.inp",
+        "*NODE\n1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n",
+    );
     assert!(e.contains("1 C3D4"), "{e}");
     let e = err_text("gen.inp", "*NODE\n1, 0., 0., 0.\n*NGEN, NSET=x\n1, 5, 1\n");
     assert!(e.contains("line 3") && e.contains("*NGEN"), "{e}");
-    let e = err_text("nopart.inp", "*Assembly, name=A\n*Instance, name=I, part=Missing\n*End Instance\n*End Assembly\n");
+    let e =
+        err_text("nopart.inp", "*Assembly, name=A\n*Instance, name=I, part=Missing\n*End Instance\n*End Assembly\n");
     assert!(e.contains("line 2") && e.contains("MISSING"), "{e}");
     let e = err_text("twice.inp", "*Part, name=P\n*Node\n1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n*Element, type=S3\n1, 1, 2, 3\n*End Part\n*Assembly, name=A\n*Instance, name=I1, part=P\n*End Instance\n*Instance, name=I2, part=P\n*End Instance\n*End Assembly\n");
     assert!(e.contains("instance I2") && e.contains("flattened deck"), "{e}");
@@ -285,7 +296,8 @@ fn meshio(path: &Path) -> Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/read_mesh.py");
     let out = Command::new("python3").arg(&script).arg(path).output().unwrap();
     assert!(out.status.success(), "{} failed: {}", script.display(), String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&out.stdout)))
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&out.stdout)))
 }
 
 /// Our connectivity of one shape, as meshio lists it.
@@ -319,7 +331,9 @@ fn meshio_agrees_on_the_fixtures() {
         if quads {
             assert_eq!(s["quad"], ours(&m, ElementShape::Quad4), "{f}: quads");
         } else {
-            eprintln!("{f}: meshio 5.3.5 ignores CQUAD4* (large field) cards; quads checked against the known answer only");
+            eprintln!(
+                "{f}: meshio 5.3.5 ignores CQUAD4* (large field) cards; quads checked against the known answer only"
+            );
         }
         eprintln!("{f}: meshio agrees ({})", s["cells"]);
     }
@@ -358,13 +372,18 @@ fn scan_counts(text: &str) -> (usize, usize) {
 
 #[test]
 fn bladelike_abaqus_decks() {
-    let dir = std::env::var("DRAPE_BLADELIKE_DIR").map(PathBuf::from).unwrap_or_else(|_| "/work/shared/data/bladelike".into());
+    let dir = std::env::var("DRAPE_BLADELIKE_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| "/work/shared/data/bladelike".into());
     if !dir.is_dir() {
         eprintln!("bladelike_abaqus_decks: skipped ({} is absent)", dir.display());
         return;
     }
-    let mut names: Vec<PathBuf> =
-        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "inp")).collect();
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "inp"))
+        .collect();
     names.sort();
     assert!(!names.is_empty());
     for p in names {
@@ -372,7 +391,13 @@ fn bladelike_abaqus_decks() {
         let m = read_flow_mesh(&p, 1.0).unwrap_or_else(|e| panic!("{e}"));
         let dt = t0.elapsed();
         let (n, t) = scan_counts(&std::fs::read_to_string(&p).unwrap());
-        eprintln!("{}: {} nodes, {} triangles, read in {:.1} ms", p.display(), m.nodes.len(), m.elements.len(), dt.as_secs_f64() * 1e3);
+        eprintln!(
+            "{}: {} nodes, {} triangles, read in {:.1} ms",
+            p.display(),
+            m.nodes.len(),
+            m.elements.len(),
+            dt.as_secs_f64() * 1e3
+        );
         assert_eq!((m.nodes.len(), m.elements.len()), (n, t), "{}", p.display());
         assert!(m.elements.iter().all(|e| e.shape == ElementShape::Tria3 && e.property == 0));
         assert!((0..m.elements.len()).all(|e| m.area(e) > 0.0), "degenerate triangle in {}", p.display());
@@ -402,7 +427,13 @@ fn large_nastran_deck_reads_whole() {
     let id = |i: usize, j: usize| i * (n + 1) + j + 1;
     for i in 0..=n {
         for j in 0..=n {
-            s.push_str(&format!("GRID    {:>8}        {:>8.3}{:>8.3}{:>8}\n", id(i, j), i as f64 * 0.01, j as f64 * 0.01, "0."));
+            s.push_str(&format!(
+                "GRID    {:>8}        {:>8.3}{:>8.3}{:>8}\n",
+                id(i, j),
+                i as f64 * 0.01,
+                j as f64 * 0.01,
+                "0."
+            ));
         }
     }
     for i in 0..n {
@@ -432,7 +463,9 @@ fn large_nastran_deck_reads_whole() {
     assert_eq!(m.elements.len(), n * n);
     assert_eq!(m.nodes.len(), (n + 1) * (n + 1));
     let last = m.elements.len() - 1;
-    assert_eq!(m.element_node_ids(last), [id(n - 1, n - 1) as u64, id(n, n - 1) as u64, id(n, n) as u64, id(n - 1, n) as u64]);
+    assert_eq!(
+        m.element_node_ids(last),
+        [id(n - 1, n - 1) as u64, id(n, n - 1) as u64, id(n, n) as u64, id(n - 1, n) as u64]
+    );
     assert!((m.nodes[m.nodes.len() - 1].x - n as f64 * 0.01).abs() < 1e-12);
 }
-

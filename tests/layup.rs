@@ -35,7 +35,10 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let scene = root().join("geometries/hemisphere/scene.toml");
-    let run = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"]).assert().success();
+    let run = drape()
+        .args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .success();
     let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
     assert!(stdout.contains("layup: 4 plies"), "{stdout}");
     let layup = read_json(&out.join("layup.json"));
@@ -47,7 +50,10 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
     for (k, p) in plies.iter().enumerate() {
         // At the pole the tool normal is +z: the warp is the reference turned by the ply angle.
         let w = [0, 1, 2].map(|c| p["warp"][c].as_f64().unwrap());
-        assert!((w[0] - expected_warp[k][0]).abs() < 1e-9 && (w[1] - expected_warp[k][1]).abs() < 1e-9 && w[2].abs() < 1e-9, "ply {k} warp {w:?}");
+        assert!(
+            (w[0] - expected_warp[k][0]).abs() < 1e-9 && (w[1] - expected_warp[k][1]).abs() < 1e-9 && w[2].abs() < 1e-9,
+            "ply {k} warp {w:?}"
+        );
         assert_eq!(p["material"], "glass");
         assert_eq!(p["method"], if k == 0 { "mechanical" } else { "kinematic" });
         assert!((p["thickness_m"].as_f64().unwrap() - GLASS_T).abs() < 1e-15);
@@ -132,7 +138,10 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let scene = root().join("geometries/double-dome/scene.toml");
-    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"]).assert().success();
+    drape()
+        .args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .success();
     let layup = read_json(&out.join("layup.json"));
     let plies = layup["plies"].as_array().unwrap();
     assert_eq!(plies.len(), 4);
@@ -158,7 +167,8 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
 fn scene_refused(scene: &str, needle: &str) {
     let dir = tempfile::tempdir().unwrap();
     let tool = root().join("geometries/hemisphere/hemisphere-2k.obj");
-    let text = scene.replace("TOOL", tool.to_str().unwrap()).replace("CARDS", root().join("materials").to_str().unwrap());
+    let text =
+        scene.replace("TOOL", tool.to_str().unwrap()).replace("CARDS", root().join("materials").to_str().unwrap());
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, text).unwrap();
     let out = dir.path().join("out");
@@ -173,8 +183,14 @@ const PLY: &str = "[[ply]]\nname = \"a\"\norigin = [0.0, 0.0, 0.1]\nspacing = 0.
 #[test]
 fn scene_errors_name_the_field_and_the_line() {
     let head = "tool = \"TOOL\"\n";
-    scene_refused(&format!("{head}{PLY}angle_deg = 45.0\nwarp = [1.0, 0.0, 0.0]\n"), "(line 2), field `warp`: give either warp or angle_deg");
-    scene_refused(&format!("{head}{PLY}material = \"nylon\"\n"), "field `material`: 'nylon' is neither a name in [materials]");
+    scene_refused(
+        &format!("{head}{PLY}angle_deg = 45.0\nwarp = [1.0, 0.0, 0.0]\n"),
+        "(line 2), field `warp`: give either warp or angle_deg",
+    );
+    scene_refused(
+        &format!("{head}{PLY}material = \"nylon\"\n"),
+        "field `material`: 'nylon' is neither a name in [materials]",
+    );
     scene_refused(
         &format!("{head}{PLY}{}", PLY.replace("\"a\"", "\"b\"")),
         "ply 'a' (line 2), field `thickness`: a ply with plies above it needs a thickness",
@@ -182,8 +198,14 @@ fn scene_errors_name_the_field_and_the_line() {
     scene_refused(&format!("{head}stack_side = \"up\"\n{PLY}"), "field `stack_side`");
     scene_refused(&format!("{head}reference = [0.0, 0.0, 0.0]\n{PLY}"), "field `reference`");
     scene_refused(&format!("{head}[materials]\nglass = \"CARDS/nope.toml\"\n{PLY}"), "[materials] `glass`");
-    scene_refused(&format!("{head}[export]\nmesh = \"x.bdf\"\nformats = [\"stl\"]\n{PLY}"), "field `formats`: unknown format 'stl'");
-    scene_refused(&format!("{head}[export]\nmesh = \"x.bdf\"\n{PLY}"), "[export] (line 2), field `mesh`: no flow mesh at");
+    scene_refused(
+        &format!("{head}[export]\nmesh = \"x.bdf\"\nformats = [\"stl\"]\n{PLY}"),
+        "field `formats`: unknown format 'stl'",
+    );
+    scene_refused(
+        &format!("{head}[export]\nmesh = \"x.bdf\"\n{PLY}"),
+        "[export] (line 2), field `mesh`: no flow mesh at",
+    );
     // A reference along the normal at the seed (the pole) has no direction on the tool there.
     scene_refused(&format!("{head}reference = [0.0, 0.0, 1.0]\n{PLY}"), "normal to the tool at the seed");
 }

@@ -33,11 +33,7 @@ fn s(p: &Path) -> &str {
 fn picture_frame_two_slope_in_mm() {
     let dir = tempfile::tempdir().unwrap();
     let card = base_card(dir.path());
-    let truth = ShearLaw::TwoSlope {
-        g1: 4.0,
-        g2: 120.0,
-        locking_angle_deg: 33.0,
-    };
+    let truth = ShearLaw::TwoSlope { g1: 4.0, g2: 120.0, locking_angle_deg: 33.0 };
     let side = 0.15;
     let pts: Vec<(f64, f64)> = (1..=200)
         .map(|i| {
@@ -48,51 +44,20 @@ fn picture_frame_two_slope_in_mm() {
     let data = write_csv(dir.path(), "pf.csv", "displacement_mm,force_N", &pts);
     let out = dir.path().join("fitted.toml");
     let assert = drape()
-        .args([
-            "calibrate",
-            "picture-frame",
-            "--data",
-            s(&data),
-            "--side",
-            "150",
-            "--units",
-            "mm",
-        ])
-        .args([
-            "--law",
-            "two-slope",
-            "--card",
-            s(&card),
-            "--out",
-            s(&out),
-            "--name",
-            "glass-fitted",
-        ])
+        .args(["calibrate", "picture-frame", "--data", s(&data), "--side", "150", "--units", "mm"])
+        .args(["--law", "two-slope", "--card", s(&card), "--out", s(&out), "--name", "glass-fitted"])
         .assert()
         .success();
     let stdout = String::from_utf8_lossy(&assert.get_output().stdout).to_string();
-    assert!(
-        stdout.contains("R^2") && stdout.contains("rms") && stdout.contains("max |residual|"),
-        "{stdout}"
-    );
+    assert!(stdout.contains("R^2") && stdout.contains("rms") && stdout.contains("max |residual|"), "{stdout}");
     let fitted = MaterialCard::load(&out).unwrap();
     let base = MaterialCard::load(&card).unwrap();
     assert_eq!(fitted.name, "glass-fitted");
-    assert_eq!(
-        (fitted.tension, fitted.bending, fitted.areal_mass),
-        (base.tension, base.bending, base.areal_mass)
-    );
+    assert_eq!((fitted.tension, fitted.bending, fitted.areal_mass), (base.tension, base.bending, base.areal_mass));
     assert!(fitted.source.as_deref().unwrap().contains("picture-frame"));
     match fitted.shear {
-        ShearLaw::TwoSlope {
-            g1,
-            g2,
-            locking_angle_deg,
-        } => {
-            assert!(
-                (g1 / 4.0 - 1.0).abs() < 1e-6 && (g2 / 120.0 - 1.0).abs() < 1e-6,
-                "{g1} {g2}"
-            );
+        ShearLaw::TwoSlope { g1, g2, locking_angle_deg } => {
+            assert!((g1 / 4.0 - 1.0).abs() < 1e-6 && (g2 / 120.0 - 1.0).abs() < 1e-6, "{g1} {g2}");
             assert!((locking_angle_deg / 33.0 - 1.0).abs() < 1e-6, "{locking_angle_deg}");
         }
         other => panic!("{other:?}"),
@@ -103,9 +68,7 @@ fn picture_frame_two_slope_in_mm() {
 fn bias_extension_polynomial() {
     let dir = tempfile::tempdir().unwrap();
     let card = base_card(dir.path());
-    let truth = ShearLaw::Polynomial {
-        coefficients: vec![1.5, 4.0, 30.0],
-    };
+    let truth = ShearLaw::Polynomial { coefficients: vec![1.5, 4.0, 30.0] };
     let (l, w) = (0.2, 0.08);
     let pts: Vec<(f64, f64)> = (0..=100)
         .map(|i| {
@@ -116,16 +79,7 @@ fn bias_extension_polynomial() {
     let data = write_csv(dir.path(), "be.csv", "d,F", &pts);
     let out = dir.path().join("fitted.toml");
     drape()
-        .args([
-            "calibrate",
-            "bias-extension",
-            "--data",
-            s(&data),
-            "--length",
-            "0.2",
-            "--width",
-            "0.08",
-        ])
+        .args(["calibrate", "bias-extension", "--data", s(&data), "--length", "0.2", "--width", "0.08"])
         .args(["--law", "polynomial:3", "--card", s(&card), "--out", s(&out)])
         .assert()
         .success();
@@ -143,46 +97,20 @@ fn bias_extension_polynomial() {
 fn knit_weft() {
     let dir = tempfile::tempdir().unwrap();
     let card = base_card(dir.path());
-    let truth = KnitParams {
-        c: 300.0,
-        beta: 15.0,
-        alpha: 2.0,
-    };
-    let pts: Vec<(f64, f64)> = (0..=80)
-        .map(|i| (0.45 * i as f64 / 80.0, knit_stress(&truth, 0.45 * i as f64 / 80.0)))
-        .collect();
+    let truth = KnitParams { c: 300.0, beta: 15.0, alpha: 2.0 };
+    let pts: Vec<(f64, f64)> =
+        (0..=80).map(|i| (0.45 * i as f64 / 80.0, knit_stress(&truth, 0.45 * i as f64 / 80.0))).collect();
     let data = write_csv(dir.path(), "knit.csv", "strain,stress_N_per_m", &pts);
     let out = dir.path().join("knit.toml");
     drape()
-        .args([
-            "calibrate",
-            "knit",
-            "--data",
-            s(&data),
-            "--direction",
-            "weft",
-            "--card",
-            s(&card),
-            "--out",
-            s(&out),
-        ])
+        .args(["calibrate", "knit", "--data", s(&data), "--direction", "weft", "--card", s(&card), "--out", s(&out)])
         .assert()
         .success();
     let fitted = MaterialCard::load(&out).unwrap();
     match fitted.tension.law {
         TensionLaw::Knit { warp, weft } => {
-            assert_eq!(
-                warp,
-                KnitParams {
-                    c: 8.0e6,
-                    beta: 0.0,
-                    alpha: 0.0
-                }
-            ); // the base card's linear warp
-            assert!(
-                (weft.c / 300.0 - 1.0).abs() < 1e-6 && (weft.beta / 15.0 - 1.0).abs() < 1e-6,
-                "{weft:?}"
-            );
+            assert_eq!(warp, KnitParams { c: 8.0e6, beta: 0.0, alpha: 0.0 }); // the base card's linear warp
+            assert!((weft.c / 300.0 - 1.0).abs() < 1e-6 && (weft.beta / 15.0 - 1.0).abs() < 1e-6, "{weft:?}");
             assert!((weft.alpha / 2.0 - 1.0).abs() < 1e-6, "{weft:?}");
         }
         other => panic!("{other:?}"),
@@ -197,53 +125,20 @@ fn bad_input_exits_2_and_writes_nothing() {
     let out = dir.path().join("never.toml");
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, "d,F\n0.001,1.0\n0.002,oops\n").unwrap();
-    let good = write_csv(
-        dir.path(),
-        "good.csv",
-        "d,F",
-        &[(0.001, 1.0), (0.002, 2.0), (0.003, 3.5), (0.004, 6.0)],
-    );
+    let good = write_csv(dir.path(), "good.csv", "d,F", &[(0.001, 1.0), (0.002, 2.0), (0.003, 3.5), (0.004, 6.0)]);
     let broken_card = dir.path().join("broken.toml");
-    std::fs::write(
-        &broken_card,
-        std::fs::read_to_string(&card)
-            .unwrap()
-            .replace("g2 = 200.0", "g2 = -200.0"),
-    )
-    .unwrap();
+    std::fs::write(&broken_card, std::fs::read_to_string(&card).unwrap().replace("g2 = 200.0", "g2 = -200.0")).unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["picture-frame", "--data", s(&bad), "--side", "0.15"], "line 3"),
         (vec!["picture-frame", "--data", s(&good), "--side=-1"], "--side must be"),
-        (
-            vec!["picture-frame", "--data", s(&good), "--side", "0.15", "--law", "spline"],
-            "spline",
-        ),
-        (
-            vec!["picture-frame", "--data", s(&good), "--side", "0.001"],
-            "beyond the travel",
-        ),
-        (
-            vec![
-                "bias-extension",
-                "--data",
-                s(&good),
-                "--length",
-                "0.1",
-                "--width",
-                "0.08",
-            ],
-            "twice",
-        ),
+        (vec!["picture-frame", "--data", s(&good), "--side", "0.15", "--law", "spline"], "spline"),
+        (vec!["picture-frame", "--data", s(&good), "--side", "0.001"], "beyond the travel"),
+        (vec!["bias-extension", "--data", s(&good), "--length", "0.1", "--width", "0.08"], "twice"),
         (vec!["knit", "--data", s(&bad), "--direction", "weft"], "line 3"),
         (vec!["knit", "--data", s(&good), "--direction", "bias"], "bias"),
     ];
     for (args, needle) in cases {
-        let assert = drape()
-            .arg("calibrate")
-            .args(&args)
-            .args(["--card", s(&card), "--out", s(&out)])
-            .assert()
-            .code(2);
+        let assert = drape().arg("calibrate").args(&args).args(["--card", s(&card), "--out", s(&out)]).assert().code(2);
         let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
         assert!(err.contains(needle), "{args:?}: expected '{needle}' in: {err}");
         assert!(!err.contains("panicked"), "{err}");

@@ -16,7 +16,10 @@ fn tool() -> &'static ToolSurface {
 
 fn card() -> &'static MaterialCard {
     static CARD: OnceLock<MaterialCard> = OnceLock::new();
-    CARD.get_or_init(|| MaterialCard::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/sze-liu-table1.toml")).unwrap())
+    CARD.get_or_init(|| {
+        MaterialCard::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/sze-liu-table1.toml"))
+            .unwrap()
+    })
 }
 
 proptest! {

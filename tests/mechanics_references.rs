@@ -6,9 +6,9 @@ mod common;
 
 use common::elastica::{heavy_elastica, heavy_elastica_with_steps, Elastica};
 use common::shear_frames::{
-    be_displacement, be_energy, be_force, be_moment_from_force, be_shear, be_shear_rate,
-    be_zone_areas, be_zone_shears, half_angle_factor, pf_displacement, pf_energy, pf_force,
-    pf_moment_from_force, pf_shear, pf_shear_rate, shear_energy_density,
+    be_displacement, be_energy, be_force, be_moment_from_force, be_shear, be_shear_rate, be_zone_areas, be_zone_shears,
+    half_angle_factor, pf_displacement, pf_energy, pf_force, pf_moment_from_force, pf_shear, pf_shear_rate,
+    shear_energy_density,
 };
 use std::f64::consts::{FRAC_PI_2, SQRT_2};
 

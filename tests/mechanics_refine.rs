@@ -23,7 +23,13 @@ fn max_strain(net: &DrapeNet) -> f64 {
     for i in 0..net.nu {
         for j in 0..net.nv {
             let Some(p) = net.node(i, j) else { continue };
-            for q in [(i + 1 < net.nu).then(|| net.node(i + 1, j)).flatten(), (j + 1 < net.nv).then(|| net.node(i, j + 1)).flatten()].into_iter().flatten() {
+            for q in [
+                (i + 1 < net.nu).then(|| net.node(i + 1, j)).flatten(),
+                (j + 1 < net.nv).then(|| net.node(i, j + 1)).flatten(),
+            ]
+            .into_iter()
+            .flatten()
+            {
                 worst = worst.max(((q - p).norm() - net.spacing).abs() / net.spacing);
             }
         }
@@ -52,7 +58,11 @@ fn pressed_refinement_stays_on_the_tool_keeps_fibre_lengths_and_lowers_the_energ
         if r.net.status[k] == NodeStatus::Placed {
             let p = r.net.positions[k];
             assert!((smooth.project(&p).point - p).norm() < 1e-12, "node {k} off the tool");
-            assert!((p.coords.norm() - 0.1).abs() < facet_depth / 10.0, "node {k}: {} from the sphere", p.coords.norm() - 0.1);
+            assert!(
+                (p.coords.norm() - 0.1).abs() < facet_depth / 10.0,
+                "node {k}: {} from the sphere",
+                p.coords.norm() - 0.1
+            );
         }
     }
     // Stiff fibres (8e6 N/m against a shear stiffness of 5 N/m): lengths stay within 1e-4.
@@ -77,10 +87,20 @@ fn free_drape_never_leaves_a_node_inside_the_tool() {
     let tool = shapes::hemisphere_with_triangles(0.1, 20_000).into_surface().unwrap();
     let net = hemisphere_net(&tool, 21);
     let fabric = card("sze-liu-table1.toml");
-    let settings = RefineSettings { mode: ContactMode::Free, load_steps: 5, solver: SolverSettings::default().max_iterations(300), ..RefineSettings::default() };
+    let settings = RefineSettings {
+        mode: ContactMode::Free,
+        load_steps: 5,
+        solver: SolverSettings::default().max_iterations(300),
+        ..RefineSettings::default()
+    };
     let r = refine(&net, &tool, &fabric, &settings).unwrap();
     let iterations: usize = r.steps.iter().map(|s| s.iterations.len()).sum();
-    println!("free drape: {:?} after {iterations} iterations, energy {} -> {}", r.outcome(), r.energy_kinematic, r.energy_final);
+    println!(
+        "free drape: {:?} after {iterations} iterations, energy {} -> {}",
+        r.outcome(),
+        r.energy_kinematic,
+        r.energy_final
+    );
     assert!(r.ok(), "{:?}", r.outcome());
     assert!(r.energy_final < r.energy_kinematic);
     for k in 0..r.net.positions.len() {

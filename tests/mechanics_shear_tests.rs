@@ -24,7 +24,8 @@ use common::shear_frames::{
 use drape::material::MaterialCard;
 use drape::mechanics::refine::NetObjective;
 use drape::mechanics::virtual_tests::{
-    bias_extension_observed, cell_shears, picture_frame, picture_frame_observed, BiasExtension, PictureFrame, ShearState,
+    bias_extension_observed, cell_shears, picture_frame, picture_frame_observed, BiasExtension, PictureFrame,
+    ShearState,
 };
 use drape::mechanics::Objective;
 use std::f64::consts::SQRT_2;
@@ -56,7 +57,8 @@ const LAWS: [(&str, &str); 3] = [("linear", LINEAR), ("cubic", CUBIC), ("two-slo
 fn picture_frame_shears_uniformly_with_the_frame_force() {
     let side = 0.1;
     let steps = 8;
-    let spec = PictureFrame { side, spacing: side / 12.0, displacement: pf_displacement(40f64.to_radians(), side), steps };
+    let spec =
+        PictureFrame { side, spacing: side / 12.0, displacement: pf_displacement(40f64.to_radians(), side), steps };
     for (name, law) in LAWS {
         let card = stiff_card(law);
         let m = |g: f64| card.shear(g).1;
@@ -143,9 +145,11 @@ impl drape::mechanics::energy::Laws for BrokenPast20Deg {
 #[test]
 fn a_failed_load_step_keeps_the_last_equilibrium() {
     let side = 0.1;
-    let spec = PictureFrame { side, spacing: side / 6.0, displacement: pf_displacement(30f64.to_radians(), side), steps: 6 };
+    let spec =
+        PictureFrame { side, spacing: side / 6.0, displacement: pf_displacement(30f64.to_radians(), side), steps: 6 };
     let r = picture_frame(&BrokenPast20Deg, &spec).unwrap();
-    let reachable = (1..=6).filter(|s| pf_shear(spec.displacement * *s as f64 / 6.0, side) <= 20f64.to_radians()).count();
+    let reachable =
+        (1..=6).filter(|s| pf_shear(spec.displacement * *s as f64 / 6.0, side) <= 20f64.to_radians()).count();
     println!(
         "broken law: {} of {} steps ({reachable} below 20 deg), {} solves, last {:?}",
         r.completed,
@@ -248,7 +252,13 @@ fn run_bias_extension(name: &str, law: &str, length: f64, width: f64, k: usize, 
     let card = stiff_card(law);
     let steps = 8;
     let spacing = width / (SQRT_2 * k as f64);
-    let spec = BiasExtension { length, width, spacing, displacement: be_displacement(40f64.to_radians(), length, width), steps };
+    let spec = BiasExtension {
+        length,
+        width,
+        spacing,
+        displacement: be_displacement(40f64.to_radians(), length, width),
+        steps,
+    };
     let m = |g: f64| card.shear(g).1;
     let dd = length - width;
     let mut observe = |s: &ShearState| {
@@ -385,7 +395,18 @@ fn cli_writes_both_shear_tests() {
         .success();
     println!("{}", String::from_utf8_lossy(&out.get_output().stdout));
     let out = drape()
-        .args(["test", "bias-extension", "--material", card, "--length", "0.2", "--width", "0.1", "--displacement", "0.02"])
+        .args([
+            "test",
+            "bias-extension",
+            "--material",
+            card,
+            "--length",
+            "0.2",
+            "--width",
+            "0.1",
+            "--displacement",
+            "0.02",
+        ])
         .args(["--steps", "4", "--spacing", "0.0125", "--out", be.to_str().unwrap()])
         .assert()
         .success();
@@ -400,7 +421,8 @@ fn cli_writes_both_shear_tests() {
         assert_eq!((d[0], f[0]), (0.0, 0.0));
         assert!((d[4] - 0.02).abs() < 1e-15);
         assert!(d.windows(2).all(|w| w[1] > w[0]) && f.windows(2).all(|w| w[1] > w[0]), "{d:?} {f:?}");
-        let grid: Vec<usize> = json["net"]["grid"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
+        let grid: Vec<usize> =
+            json["net"]["grid"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
         let nodes = json["net"]["nodes"].as_array().unwrap();
         assert_eq!(nodes.len(), grid[0] * grid[1]);
         let placed: Vec<&serde_json::Value> = nodes.iter().filter(|n| !n.is_null()).collect();
@@ -431,16 +453,19 @@ fn cli_refuses_bad_shear_test_arguments() {
     let out = dir.path().join("out.json");
     let o = out.to_str().unwrap().to_string();
     let pf = |extra: &[&str]| -> Vec<String> {
-        let mut a: Vec<String> = ["test", "picture-frame", "--material", &card, "--side", "0.1", "--steps", "2", "--out", &o]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let mut a: Vec<String> =
+            ["test", "picture-frame", "--material", &card, "--side", "0.1", "--steps", "2", "--out", &o]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
         a.extend(extra.iter().map(|s| s.to_string()));
         a
     };
     let be = |extra: &[&str]| -> Vec<String> {
-        let mut a: Vec<String> =
-            ["test", "bias-extension", "--material", &card, "--width", "0.1", "--out", &o].iter().map(|s| s.to_string()).collect();
+        let mut a: Vec<String> = ["test", "bias-extension", "--material", &card, "--width", "0.1", "--out", &o]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         a.extend(extra.iter().map(|s| s.to_string()));
         a
     };
@@ -448,7 +473,10 @@ fn cli_refuses_bad_shear_test_arguments() {
         (pf(&["--displacement", "0.07", "--spacing", "0.01"]), "travel"),
         (pf(&["--displacement", "0.01", "--spacing", "0.08"]), "at least 2 cells"),
         (pf(&["--displacement", "0.01", "--spacing", "0"]), "spacing"),
-        (be(&["--length", "0.15", "--displacement", "0.01", "--spacing", "0.01", "--steps", "2"]), "length >= 2 x width"),
+        (
+            be(&["--length", "0.15", "--displacement", "0.01", "--spacing", "0.01", "--steps", "2"]),
+            "length >= 2 x width",
+        ),
         (be(&["--length", "0.2", "--displacement", "0.05", "--spacing", "0.01", "--steps", "2"]), "90 deg"),
         (be(&["--length", "0.2", "--displacement", "0.01", "--spacing", "0.01", "--steps", "0"]), "load steps"),
     ];

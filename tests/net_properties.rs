@@ -26,9 +26,12 @@ fn segment_error(net: &DrapeNet) -> (f64, usize) {
     for i in 0..net.nu {
         for j in 0..net.nv {
             let Some(p) = net.node(i, j) else { continue };
-            for q in [(i + 1 < net.nu).then(|| net.node(i + 1, j)).flatten(), (j + 1 < net.nv).then(|| net.node(i, j + 1)).flatten()]
-                .into_iter()
-                .flatten()
+            for q in [
+                (i + 1 < net.nu).then(|| net.node(i + 1, j)).flatten(),
+                (j + 1 < net.nv).then(|| net.node(i, j + 1)).flatten(),
+            ]
+            .into_iter()
+            .flatten()
             {
                 worst = worst.max(((q - p).norm() - net.spacing).abs() / net.spacing);
                 count += 1;
@@ -94,7 +97,8 @@ fn mirror_symmetric_tool_gives_a_mirror_symmetric_net() {
     }
     assert!(checked > 500);
     // The saddle is symmetric under x -> -x: node (i0 + a, j) mirrors (i0 - a, j).
-    let net = drape(saddle(), &KinematicSettings::grid("s", Point::new(0.0, 0.0, 0.0), Vector::x(), 0.04, 41, 41)).unwrap();
+    let net =
+        drape(saddle(), &KinematicSettings::grid("s", Point::new(0.0, 0.0, 0.0), Vector::x(), 0.04, 41, 41)).unwrap();
     let (i0, _) = net.origin_node;
     for a in 1..=i0 {
         for j in 0..net.nv {
@@ -134,9 +138,20 @@ fn geodesic_generators_follow_great_circles() {
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
     // 601 x 601 nodes: long anti-diagonals are filled in parallel too.
-    let s = KinematicSettings::grid("h", Point::from(Vector::new(0.1, 0.2, 1.0).normalize()), Vector::new(1.0, 0.4, 0.0), 0.004, 601, 601);
+    let s = KinematicSettings::grid(
+        "h",
+        Point::from(Vector::new(0.1, 0.2, 1.0).normalize()),
+        Vector::new(1.0, 0.4, 0.0),
+        0.004,
+        601,
+        601,
+    );
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| drape(hemisphere(), &s).unwrap())
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| drape(hemisphere(), &s).unwrap())
     };
     let one = run(1);
     for threads in [2, 3] {
@@ -221,10 +236,12 @@ fn min_shear_generators_shear_the_strip_cells_less_than_geodesics() {
 fn steered_warp_follows_the_curve() {
     // On the cylinder (axis y), a curve around the circumference at y = 0.1: a steered warp.
     let tool = shapes::cylinder(0.5, 2.0, std::f64::consts::PI, 360, 40).into_surface().unwrap();
-    let curve: Vec<Point> = (0..=60).map(|k| {
-        let a = -1.2 + 2.4 * k as f64 / 60.0;
-        Point::new(0.5 * a.sin(), 0.1 + 0.05 * a, 0.5 * a.cos())
-    }).collect();
+    let curve: Vec<Point> = (0..=60)
+        .map(|k| {
+            let a = -1.2 + 2.4 * k as f64 / 60.0;
+            Point::new(0.5 * a.sin(), 0.1 + 0.05 * a, 0.5 * a.cos())
+        })
+        .collect();
     let mut s = KinematicSettings::grid("c", Point::new(0.0, 0.1, 0.5), Vector::x(), 0.02, 41, 21);
     s.generators = GeneratorKind::Steer(curve.clone());
     let net = drape(&tool, &s).unwrap();
@@ -254,7 +271,8 @@ fn an_outline_sizes_the_grid_and_drops_the_nodes_outside_it() {
     let mut s = KinematicSettings::grid("o", Point::new(0.05, -0.02, 0.0), Vector::new(1.0, 1.0, 0.0), d, 2, 2);
     s.extent = Extent::Outline(outline);
     let net = drape(&tool, &s).unwrap();
-    let placed: Vec<Point> = (0..net.positions.len()).filter(|&k| net.status[k] == NodeStatus::Placed).map(|k| net.positions[k]).collect();
+    let placed: Vec<Point> =
+        (0..net.positions.len()).filter(|&k| net.status[k] == NodeStatus::Placed).map(|k| net.positions[k]).collect();
     // Inside the 96-gon (inscribed in the circle of radius r).
     assert!(placed.iter().all(|p| p.x.hypot(p.y) < r));
     // One node per d^2 of the polygon's area (to within its perimeter's worth of nodes).
@@ -280,8 +298,10 @@ fn a_closed_sphere_is_draped_past_its_equator_into_the_undercut() {
     assert_eq!(tool.report().boundary_edges, 0, "{:?}", tool.report());
     assert_eq!(tool.report().flipped_faces, 0);
     // Generators of 40 x 0.05 = 2.0 > pi/2: past the equator on every side.
-    let net = drape(&tool, &KinematicSettings::grid("ball", Point::new(0.0, 0.0, 1.0), Vector::x(), 0.05, 81, 81)).unwrap();
-    let below = (0..net.positions.len()).filter(|&k| net.status[k] == NodeStatus::Placed && net.positions[k].z < -0.3).count();
+    let net =
+        drape(&tool, &KinematicSettings::grid("ball", Point::new(0.0, 0.0, 1.0), Vector::x(), 0.05, 81, 81)).unwrap();
+    let below =
+        (0..net.positions.len()).filter(|&k| net.status[k] == NodeStatus::Placed && net.positions[k].z < -0.3).count();
     assert!(below > 8, "{below} nodes below the equator");
     let (e, _) = segment_error(&net);
     assert!(e < LENGTH_TOLERANCE);

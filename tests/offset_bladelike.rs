@@ -80,5 +80,9 @@ fn a_ply_drapes_on_the_bladelike_mould() {
         stats.mean_abs.to_degrees()
     );
     assert!(stats.cells > net.num_cells() / 4, "only {} cells", stats.cells);
-    assert!(net.positions.iter().zip(&net.status).all(|(p, s)| *s != drape::kinematic::NodeStatus::Placed || p.coords.iter().all(|x| x.is_finite())));
+    assert!(net
+        .positions
+        .iter()
+        .zip(&net.status)
+        .all(|(p, s)| *s != drape::kinematic::NodeStatus::Placed || p.coords.iter().all(|x| x.is_finite())));
 }

@@ -5,7 +5,10 @@
 use drape::export::{write_net, Format};
 use drape::geometry::{shapes, Point, Vector};
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, Method};
-use drape::report::{bin_shares, bin_width, change_limit, colour_limit, shear_colour, tool_greys, write_report, ReportError, HEIGHT, WIDTH};
+use drape::report::{
+    bin_shares, bin_width, change_limit, colour_limit, shear_colour, tool_greys, write_report, ReportError, HEIGHT,
+    WIDTH,
+};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -38,7 +41,8 @@ fn make_run(dir: &Path, subdivisions: usize) -> (DrapeNet, DrapeNet) {
             net.cell_shear(i, j).map(|_| 0.02 * (i as f64 - j as f64))
         })
         .collect();
-    mech.meta.insert("change_from_kinematic".into(), serde_json::json!({"shear_deg": change, "warp_angle_deg": change}));
+    mech.meta
+        .insert("change_from_kinematic".into(), serde_json::json!({"shear_deg": change, "warp_angle_deg": change}));
     mech.meta.insert("material".into(), serde_json::json!("materials/glass-plain-weave.toml"));
     write_net(&net, dir, &[Format::Json]).unwrap();
     write_net(&mech, dir, &[Format::Json]).unwrap();
@@ -106,7 +110,12 @@ fn check_svg(path: &Path, min_polygons: usize) {
     let s = std::fs::read_to_string(path).unwrap();
     let t = s.trim();
     assert!(t.starts_with("<svg") && t.ends_with("</svg>"), "{}: not an SVG document", path.display());
-    assert_eq!(s.matches("<text").count(), s.matches("</text>").count(), "{}: unbalanced text elements", path.display());
+    assert_eq!(
+        s.matches("<text").count(),
+        s.matches("</text>").count(),
+        "{}: unbalanced text elements",
+        path.display()
+    );
     let shapes = s.matches("<polygon").count() + s.matches("<rect").count();
     assert!(shapes >= min_polygons, "{}: {shapes} shapes, expected at least {min_polygons}", path.display());
     assert!(!s.contains("NaN"), "{}", path.display());
@@ -127,8 +136,17 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     assert_eq!(
         names(&summary.files),
         [
-            "p0-shear.png", "p0-shear.svg", "p0-histogram.png", "p0-histogram.svg", "p0mech-shear.png", "p0mech-shear.svg",
-            "p0mech-histogram.png", "p0mech-histogram.svg", "p0mech-change.png", "p0mech-change.svg", "index.html"
+            "p0-shear.png",
+            "p0-shear.svg",
+            "p0-histogram.png",
+            "p0-histogram.svg",
+            "p0mech-shear.png",
+            "p0mech-shear.svg",
+            "p0mech-histogram.png",
+            "p0mech-histogram.svg",
+            "p0mech-change.png",
+            "p0mech-change.svg",
+            "index.html"
         ]
     );
     assert!(summary.files.iter().all(|f| f.is_file() && f.starts_with(&out)));
@@ -204,7 +222,11 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     let again = dir.join("again");
     write_report(dir, &again, false).unwrap();
     for f in ["p0-shear.png", "p0mech-change.svg", "index.html"] {
-        assert_eq!(std::fs::read(out.join(f)).unwrap(), std::fs::read(again.join(f)).unwrap(), "{f} differs between runs");
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(again.join(f)).unwrap(),
+            "{f} differs between runs"
+        );
     }
 }
 

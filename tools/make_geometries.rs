@@ -42,9 +42,7 @@ fn main() -> anyhow::Result<()> {
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--large" => large = true,
-            "--out" => {
-                out = PathBuf::from(args.next().ok_or_else(|| anyhow::anyhow!("--out needs a directory"))?)
-            }
+            "--out" => out = PathBuf::from(args.next().ok_or_else(|| anyhow::anyhow!("--out needs a directory"))?),
             "-h" | "--help" => {
                 println!("usage: make_geometries [--large] [--out DIR]");
                 return Ok(());
@@ -81,10 +79,8 @@ fn write(root: &Path, name: &str, mesh: &TriangleMesh) -> anyhow::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let text = format!(
-        "# {name}: written by `cargo run --release --example make_geometries`\n{}",
-        mesh.to_obj_string()
-    );
+    let text =
+        format!("# {name}: written by `cargo run --release --example make_geometries`\n{}", mesh.to_obj_string());
     std::fs::write(&path, &text).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     println!(
         "{:<36} {:>8} triangles {:>8} vertices {:>10} bytes",

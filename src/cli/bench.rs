@@ -43,11 +43,22 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         .map_err(|e| input(anyhow::anyhow!("cannot start {} threads: {e}", a.threads.unwrap_or(0))))?;
     let t = Instant::now();
     let tool = shapes::hemisphere_with_triangles(1.0, a.triangles).into_surface().map_err(input)?;
-    println!("hemisphere R = 1 m: {} triangles, built in {:.0} ms", tool.num_triangles(), t.elapsed().as_secs_f64() * 1e3);
+    println!(
+        "hemisphere R = 1 m: {} triangles, built in {:.0} ms",
+        tool.num_triangles(),
+        t.elapsed().as_secs_f64() * 1e3
+    );
     // Spacing so the generators reach from the pole to the rim: quarter circumference / half-size.
     let half = (a.nodes - 1) / 2;
     let spacing = std::f64::consts::FRAC_PI_2 / half.max(1) as f64 * 0.999;
-    let settings = KinematicSettings::grid("bench", Point::new(0.0, 0.0, 1.0), Vector::new(1.0, 0.0, 0.0), spacing, a.nodes, a.nodes);
+    let settings = KinematicSettings::grid(
+        "bench",
+        Point::new(0.0, 0.0, 1.0),
+        Vector::new(1.0, 0.0, 0.0),
+        spacing,
+        a.nodes,
+        a.nodes,
+    );
     let mut best = f64::INFINITY;
     let mut total = 0.0;
     let mut placed_cells = 0;
@@ -76,7 +87,10 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
     if let Some(card) = &a.refine {
         let material = MaterialCard::load(card).map_err(input)?;
         let net = pool.install(|| drape(&tool, &settings)).map_err(input)?;
-        let refine_settings = RefineSettings { solver: SolverSettings::default().max_iterations(a.max_iterations), ..RefineSettings::default() };
+        let refine_settings = RefineSettings {
+            solver: SolverSettings::default().max_iterations(a.max_iterations),
+            ..RefineSettings::default()
+        };
         let t = Instant::now();
         let refined = pool.install(|| refine(&net, &tool, &material, &refine_settings)).map_err(input)?;
         let total = t.elapsed().as_secs_f64();

@@ -155,11 +155,7 @@ pub fn run(a: CalibrateArgs) -> Result<(), Failure> {
                 Direction::Warp => Fibre::Warp,
                 Direction::Weft => Fibre::Weft,
             };
-            println!(
-                "knit fit of {} ({} points), residuals of the stress in N/m:",
-                k.data.display(),
-                report.points
-            );
+            println!("knit fit of {} ({} points), residuals of the stress in N/m:", k.data.display(), report.points);
             println!(
                 "  {}: C = {:.6e} N/m, beta = {:.6e} N/m, alpha = {:.6e} (1/alpha = {:.4})",
                 fibre.name(),
@@ -172,29 +168,16 @@ pub fn run(a: CalibrateArgs) -> Result<(), Failure> {
             // A linear card becomes a knit card; the other family keeps its rigidity (beta = 0).
             let (mut warp, mut weft) = match card.tension.law {
                 TensionLaw::Knit { warp, weft } => (warp, weft),
-                TensionLaw::Linear { warp, weft } => (
-                    KnitParams {
-                        c: warp,
-                        beta: 0.0,
-                        alpha: 0.0,
-                    },
-                    KnitParams {
-                        c: weft,
-                        beta: 0.0,
-                        alpha: 0.0,
-                    },
-                ),
+                TensionLaw::Linear { warp, weft } => {
+                    (KnitParams { c: warp, beta: 0.0, alpha: 0.0 }, KnitParams { c: weft, beta: 0.0, alpha: 0.0 })
+                }
             };
             match fibre {
                 Fibre::Warp => warp = p,
                 Fibre::Weft => weft = p,
             }
             card.tension.law = TensionLaw::Knit { warp, weft };
-            let what = format!(
-                "{} knit tension fitted to uniaxial data {}",
-                fibre.name(),
-                k.data.display()
-            );
+            let what = format!("{} knit tension fitted to uniaxial data {}", fibre.name(), k.data.display());
             finish(card, &what, &report, &k.files)
         }
     }
@@ -231,10 +214,7 @@ fn fit_failure(e: FitError) -> Failure {
 }
 
 fn print_report(r: &FitReport, unit: &str) {
-    println!(
-        "  rms {:.4e} {unit}   R^2 {:.6}   max |residual| {:.4e} {unit}",
-        r.rms, r.r_squared, r.max_abs_residual
-    );
+    println!("  rms {:.4e} {unit}   R^2 {:.6}   max |residual| {:.4e} {unit}", r.rms, r.r_squared, r.max_abs_residual);
 }
 
 fn finish_shear(
@@ -255,11 +235,7 @@ fn finish_shear(
                 println!("  (the unconstrained fit was not monotone: fitted with every coefficient >= 0)");
             }
         }
-        ShearLaw::TwoSlope {
-            g1,
-            g2,
-            locking_angle_deg,
-        } => {
+        ShearLaw::TwoSlope { g1, g2, locking_angle_deg } => {
             println!(
                 "  two-slope g1 = {g1:.6e} N/m, g2 = {g2:.6e} N/m per rad, locking angle {locking_angle_deg:.3} deg"
             );
@@ -268,11 +244,7 @@ fn finish_shear(
     }
     print_report(&report, unit);
     card.shear = law;
-    let what = format!(
-        "shear ({}) fitted to {test} data {}",
-        card.shear.law_name(),
-        data.display()
-    );
+    let what = format!("shear ({}) fitted to {test} data {}", card.shear.law_name(), data.display());
     finish(card, &what, &report, files)
 }
 
@@ -281,16 +253,12 @@ fn finish(mut card: MaterialCard, what: &str, report: &FitReport, files: &CardFi
     if let Some(name) = &files.name {
         card.name = name.clone();
     }
-    let note = format!(
-        "{what} by drape calibrate ({} points, R^2 = {:.6})",
-        report.points, report.r_squared
-    );
+    let note = format!("{what} by drape calibrate ({} points, R^2 = {:.6})", report.points, report.r_squared);
     card.source = Some(match card.source.take() {
         Some(s) if !s.trim().is_empty() => format!("{s}; {note}"),
         _ => note,
     });
-    card.validate()
-        .map_err(|e| compute(anyhow!("the fitted card is not valid: {e}")))?;
+    card.validate().map_err(|e| compute(anyhow!("the fitted card is not valid: {e}")))?;
     let text = card.to_toml_string();
     write_atomic(&files.out, |w| w.write_all(text.as_bytes())).map_err(compute)?;
     println!("wrote {}", files.out.display());

@@ -69,7 +69,10 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     let card_path = a.material.clone().or_else(|| net.meta.get("material").and_then(|m| m.as_str()).map(PathBuf::from));
     let card = match &card_path {
         Some(p) => Some(MaterialCard::load(p).map_err(|e| {
-            input(anyhow::anyhow!("{e}{}", if a.material.is_none() { " (the card the net records; give --material)" } else { "" }))
+            input(anyhow::anyhow!(
+                "{e}{}",
+                if a.material.is_none() { " (the card the net records; give --material)" } else { "" }
+            ))
         })?),
         None => None,
     };

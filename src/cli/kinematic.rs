@@ -64,13 +64,19 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
     let scale = unit_scale(&a.units).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?;
     if !(a.locking_angle > 0.0 && a.locking_angle < 90.0) {
-        return Err(input(anyhow::anyhow!("--locking-angle must lie strictly between 0 and 90 degrees, got {}", a.locking_angle)));
+        return Err(input(anyhow::anyhow!(
+            "--locking-angle must lie strictly between 0 and 90 degrees, got {}",
+            a.locking_angle
+        )));
     }
     let base = std::env::current_dir().unwrap_or_default();
-    let generators = parse_generators(&a.generators, &base, scale).map_err(|m| input(anyhow::anyhow!("--generators: {m}")))?;
+    let generators =
+        parse_generators(&a.generators, &base, scale).map_err(|m| input(anyhow::anyhow!("--generators: {m}")))?;
     let extent = match (&a.grid, &a.outline) {
         (Some([nu, nv]), _) => Extent::Grid { nu: *nu, nv: *nv, origin_node: a.origin_node.map(|[i, j]| (i, j)) },
-        (None, Some(f)) => Extent::Outline(read_points(f, scale).map_err(|m| input(anyhow::anyhow!("--outline: {m}")))?),
+        (None, Some(f)) => {
+            Extent::Outline(read_points(f, scale).map_err(|m| input(anyhow::anyhow!("--outline: {m}")))?)
+        }
         (None, None) => return Err(input(anyhow::anyhow!("give --grid NU,NV or --outline FILE"))),
     };
     let settings = KinematicSettings {

@@ -90,7 +90,10 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     // The last consistent state is written even when the solver did not converge.
     let t_write = Instant::now();
     let written = write_net(&out, &a.out, &formats).map_err(compute)?;
-    println!("{}", summary(&out, DEFAULT_LOCKING_ANGLE_DEG.to_radians(), load_ms, t_write.elapsed().as_secs_f64() * 1e3));
+    println!(
+        "{}",
+        summary(&out, DEFAULT_LOCKING_ANGLE_DEG.to_radians(), load_ms, t_write.elapsed().as_secs_f64() * 1e3)
+    );
     print_solver(&refined);
     for p in written {
         println!("  wrote {}", p.display());

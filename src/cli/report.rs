@@ -19,7 +19,9 @@ pub fn run(a: ReportArgs) -> Result<(), Failure> {
     let out = a.out.clone().unwrap_or_else(|| a.dir.join("report"));
     let summary = write_report(&a.dir, &out, true).map_err(|e| match e {
         // Failing to write or draw is not the input's fault.
-        ReportError::CreateDir { .. } | ReportError::Draw { .. } | ReportError::Net(ExportError::Write { .. }) => compute(e),
+        ReportError::CreateDir { .. } | ReportError::Draw { .. } | ReportError::Net(ExportError::Write { .. }) => {
+            compute(e)
+        }
         _ => input(e),
     })?;
     for p in &summary.plies {

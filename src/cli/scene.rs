@@ -4,16 +4,16 @@ use super::kinematic::print_tool_report;
 use super::refine::print_solver;
 use super::summary::summary;
 use super::{compute, input, Failure};
-use crate::export::{write_atomic, write_net, Format};
-use crate::kinematic::fishnet::check_settings;
-use crate::layup::stack::{drape_layup, PlyResult};
 use crate::export::flow::write_flow;
 use crate::export::flowmesh::read_flow_mesh;
 use crate::export::map::{map_net, LayupMap, PermeabilityModel, PlyMapSettings};
 use crate::export::pattern::write_cutting_plan;
+use crate::export::{write_atomic, write_net, Format};
+use crate::kinematic::fishnet::check_settings;
 use crate::layup::flat::{flat_pattern_with_margin, FlatError};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::scene::SceneExport;
+use crate::layup::stack::{drape_layup, PlyResult};
 use crate::layup::Scene;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -36,8 +36,9 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
     let scene = Scene::load(&a.scene).map_err(input)?;
     for ply in &scene.plies {
-        check_settings(&ply.settings)
-            .map_err(|e| input(anyhow::anyhow!("scene {}: ply '{}' (line {}): {e}", a.scene.display(), ply.settings.name, ply.line)))?;
+        check_settings(&ply.settings).map_err(|e| {
+            input(anyhow::anyhow!("scene {}: ply '{}' (line {}): {e}", a.scene.display(), ply.settings.name, ply.line))
+        })?;
     }
     let t_load = Instant::now();
     let tool = crate::layup::load_tool(&scene.tool, scene.scale).map_err(|m| input(anyhow::anyhow!(m)))?;
@@ -164,7 +165,8 @@ fn cutting_plan(scene: &Scene, results: &[PlyResult], out: &Path) -> Result<Opti
 /// `DIR/flow.<ext>` (`FlowFormat::scene_file`; field names prefixed by the ply).
 fn export_flow(scene: &Scene, export: &SceneExport, results: &[PlyResult], out: &Path) -> Result<(), Failure> {
     let t = Instant::now();
-    let mesh = read_flow_mesh(&export.mesh, scene.scale).map_err(|e| input(anyhow::anyhow!("scene {}: [export] mesh: {e}", scene.path.display())))?;
+    let mesh = read_flow_mesh(&export.mesh, scene.scale)
+        .map_err(|e| input(anyhow::anyhow!("scene {}: [export] mesh: {e}", scene.path.display())))?;
     let mut plies = Vec::new();
     for (ply, r) in scene.plies.iter().zip(results) {
         let card = ply.material.as_ref().map(|m| &m.card);

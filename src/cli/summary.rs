@@ -6,11 +6,8 @@ pub fn summary(net: &DrapeNet, locking_angle: f64, load_ms: f64, write_ms: f64) 
     let counts = net.status_counts();
     let total = net.nu * net.nv;
     let placed = counts.iter().find(|(s, _)| *s == NodeStatus::Placed).map_or(0, |c| c.1);
-    let failed: Vec<String> = counts
-        .iter()
-        .filter(|(s, _)| *s != NodeStatus::Placed)
-        .map(|(s, c)| format!("{} {c}", s.name()))
-        .collect();
+    let failed: Vec<String> =
+        counts.iter().filter(|(s, _)| *s != NodeStatus::Placed).map(|(s, c)| format!("{} {c}", s.name())).collect();
     let stats = net.shear_stats(locking_angle);
     let mut out = format!("ply {}: {} x {} nodes, spacing {} m\n", net.name, net.nu, net.nv, net.spacing);
     out += &format!(
@@ -32,7 +29,9 @@ pub fn summary(net: &DrapeNet, locking_angle: f64, load_ms: f64, write_ms: f64) 
             load_ms, t.generators_ms, t.fill_ms, write_ms
         ),
         // A refined net keeps its solve time where the kinematic stages keep their fill time.
-        Method::Mechanical => format!("  time: load {:.1} ms, solve {:.1} ms, write {:.1} ms", load_ms, t.fill_ms, write_ms),
+        Method::Mechanical => {
+            format!("  time: load {:.1} ms, solve {:.1} ms, write {:.1} ms", load_ms, t.fill_ms, write_ms)
+        }
     };
     out
 }

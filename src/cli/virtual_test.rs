@@ -17,7 +17,9 @@
 use super::{compute, input, Failure};
 use crate::export::write_atomic;
 use crate::material::{Fibre, MaterialCard};
-use crate::mechanics::virtual_tests::{bias_extension, cantilever, picture_frame, BiasExtension, PictureFrame, ShearTest};
+use crate::mechanics::virtual_tests::{
+    bias_extension, cantilever, picture_frame, BiasExtension, PictureFrame, ShearTest,
+};
 use clap::{Args, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
@@ -121,7 +123,8 @@ pub fn run(a: TestArgs) -> Result<(), Failure> {
             let card = MaterialCard::load(&material).map_err(input)?;
             let spec = BiasExtension { length, width, spacing, displacement, steps };
             let result = bias_extension(&card, &spec).map_err(|m| input(anyhow::anyhow!(m)))?;
-            let sample = serde_json::json!({"length": result.sample.0, "width": result.sample.1, "spacing": result.sample.2});
+            let sample =
+                serde_json::json!({"length": result.sample.0, "width": result.sample.1, "spacing": result.sample.2});
             finish_shear_test("bias-extension", &result, sample, &out)
         }
         VirtualTest::Cantilever { material, direction, length, nodes, out } => {
@@ -150,7 +153,10 @@ pub fn run(a: TestArgs) -> Result<(), Failure> {
                 tip[2]
             );
             if !result.ok() {
-                return Err(compute(anyhow::anyhow!("the solver did not reach equilibrium; the last state was written to {}", out.display())));
+                return Err(compute(anyhow::anyhow!(
+                    "the solver did not reach equilibrium; the last state was written to {}",
+                    out.display()
+                )));
             }
             Ok(())
         }
@@ -174,7 +180,12 @@ fn check_out(out: &std::path::Path) -> Result<(), Failure> {
 
 /// Write a shear test's JSON, print a summary, and fail (exit code 1) if a load step did not
 /// reach equilibrium (the file then holds the steps up to the last equilibrium).
-fn finish_shear_test(name: &str, r: &ShearTest, sample: serde_json::Value, out: &std::path::Path) -> Result<(), Failure> {
+fn finish_shear_test(
+    name: &str,
+    r: &ShearTest,
+    sample: serde_json::Value,
+    out: &std::path::Path,
+) -> Result<(), Failure> {
     let nodes: Vec<serde_json::Value> = r
         .nodes
         .iter()
@@ -193,11 +204,15 @@ fn finish_shear_test(name: &str, r: &ShearTest, sample: serde_json::Value, out: 
         "iterations": r.iterations(),
         "notes": r.notes,
     });
-    let finite = r.force.iter().all(|f| f.is_finite()) && r.nodes.iter().all(|p| p.coords.iter().all(|c| c.is_finite()));
+    let finite =
+        r.force.iter().all(|f| f.is_finite()) && r.nodes.iter().all(|p| p.coords.iter().all(|c| c.is_finite()));
     if !finite {
-        return Err(compute(anyhow::anyhow!("the {name} test produced non-finite forces or positions; nothing was written")));
+        return Err(compute(anyhow::anyhow!(
+            "the {name} test produced non-finite forces or positions; nothing was written"
+        )));
     }
-    write_atomic(out, |w| w.write_all(serde_json::to_string_pretty(&json).unwrap_or_default().as_bytes())).map_err(compute)?;
+    write_atomic(out, |w| w.write_all(serde_json::to_string_pretty(&json).unwrap_or_default().as_bytes()))
+        .map_err(compute)?;
     for note in &r.notes {
         println!("note: {note}");
     }

@@ -6,8 +6,8 @@ use crate::geometry::surface::closest_point_on_triangle;
 use crate::geometry::{Point, Vector};
 use crate::kinematic::DrapeNet;
 use nalgebra::Matrix3;
-use std::collections::HashMap;
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// What happens to a sheared ply's thickness (REFERENCES.md §5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -311,11 +311,27 @@ impl<'a> NetSampler<'a> {
         let l = barycentric(p, &net.positions[k0], &net.positions[k1], &net.positions[k2]);
         let (s, t) = if half == 0 { (l[1] + l[2], l[2]) } else { (l[1], l[1] + l[2]) };
         let complete = |a: isize, b: isize| {
-            a >= 0 && b >= 0 && (a as usize) + 1 < net.nu && (b as usize) + 1 < net.nv && net.cell_corners(a as usize, b as usize).is_some()
+            a >= 0
+                && b >= 0
+                && (a as usize) + 1 < net.nu
+                && (b as usize) + 1 < net.nv
+                && net.cell_corners(a as usize, b as usize).is_some()
         };
         let (ci, cj) = (i as isize, j as isize);
-        let di = if s < 0.0 { -1 } else if s > 1.0 { 1 } else { 0 };
-        let dj = if t < 0.0 { -1 } else if t > 1.0 { 1 } else { 0 };
+        let di = if s < 0.0 {
+            -1
+        } else if s > 1.0 {
+            1
+        } else {
+            0
+        };
+        let dj = if t < 0.0 {
+            -1
+        } else if t > 1.0 {
+            1
+        } else {
+            0
+        };
         let over_s = if s < 0.0 { -s } else { (s - 1.0).max(0.0) };
         let over_t = if t < 0.0 { -t } else { (t - 1.0).max(0.0) };
         let mut beyond = 0.0f64;
@@ -383,7 +399,10 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
         return Err(settings_error(format!("ply thickness must be positive, got {}", settings.thickness)));
     }
     if !(settings.vf > 0.0 && settings.vf < VF_MAX_HEX) {
-        return Err(settings_error(format!("fibre volume fraction must lie in (0, {VF_MAX_HEX:.3}), got {}", settings.vf)));
+        return Err(settings_error(format!(
+            "fibre volume fraction must lie in (0, {VF_MAX_HEX:.3}), got {}",
+            settings.vf
+        )));
     }
     let sampler = NetSampler::new(net).ok_or_else(|| MapError::EmptyNet { ply: net.name.clone() })?;
     let elements: Result<Vec<Option<ElementFibres>>, MapError> = (0..mesh.elements.len())
@@ -404,7 +423,8 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
             let shear = crate::kinematic::net::corner_shear(&warp, &weft);
             let reference = mesh.first_edge(e).expect("a non-degenerate element has a first edge");
             let theta = signed_angle(&reference, &warp, &normal);
-            let angle_change = in_plane(&settings.nominal_warp, &normal).map_or(0.0, |n| signed_angle(&n, &warp, &normal));
+            let angle_change =
+                in_plane(&settings.nominal_warp, &normal).map_or(0.0, |n| signed_angle(&n, &warp, &normal));
             let cos = shear.cos().max(f64::MIN_POSITIVE);
             let (thickness, vf) = match settings.cavity {
                 Cavity::Fixed => (settings.thickness, (settings.vf / cos).min(VF_CAP)),

@@ -73,19 +73,14 @@ fn piece(p: &FlatPattern, at: &Placement) -> Piece {
     // Below the arrow (across it), so the two do not overlap.
     let n = [-w[1], w[0]];
     let label_at = [a[0] - 2.0 * label_height * n[0], a[1] - 2.0 * label_height * n[1]];
-    let label = format!(
-        "{}  area {:.6} m2  bbox {:.1} x {:.1} mm  warp ->",
-        p.ply,
-        p.area,
-        sx * MM,
-        sy * MM
-    );
+    let label = format!("{}  area {:.6} m2  bbox {:.1} x {:.1} mm  warp ->", p.ply, p.area, sx * MM, sy * MM);
     Piece { ply: p.ply.clone(), loops, arrow, label_at, label_height, label }
 }
 
 /// The pieces of a nesting, checked against the patterns and for finite numbers.
 fn pieces(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Result<Vec<Piece>, PatternError> {
-    let same = patterns.len() == nesting.placements.len() && patterns.iter().zip(&nesting.placements).all(|(p, q)| p.ply == q.ply);
+    let same = patterns.len() == nesting.placements.len()
+        && patterns.iter().zip(&nesting.placements).all(|(p, q)| p.ply == q.ply);
     if !same {
         return Err(PatternError::Mismatch {
             path: path.to_path_buf(),
@@ -100,7 +95,11 @@ fn pieces(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Result<Ve
         check_finite(pc, path)?;
     }
     if !(nesting.roll_width.is_finite() && nesting.length.is_finite()) {
-        return Err(PatternError::NonFinite { path: path.to_path_buf(), ply: "ROLL".into(), what: "roll width or length" });
+        return Err(PatternError::NonFinite {
+            path: path.to_path_buf(),
+            ply: "ROLL".into(),
+            what: "roll width or length",
+        });
     }
     Ok(out)
 }
@@ -124,7 +123,11 @@ const MM_DECIMALS: usize = 6;
 fn mm(v: f64) -> String {
     let s = format!("{:.*}", MM_DECIMALS, v * MM);
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".to_string() } else { s.to_string() }
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
 }
 
 /// DXF layer names of the plies, in order: each name with characters other than ASCII letters,
@@ -186,7 +189,9 @@ pub fn write_dxf(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Re
         g(0, "TABLE")?;
         g(2, "LTYPE")?;
         g(70, "1")?;
-        for (c, v) in [(0, "LTYPE"), (2, "CONTINUOUS"), (70, "0"), (3, "Solid line"), (72, "65"), (73, "0"), (40, "0.0")] {
+        for (c, v) in
+            [(0, "LTYPE"), (2, "CONTINUOUS"), (70, "0"), (3, "Solid line"), (72, "65"), (73, "0"), (40, "0.0")]
+        {
             g(c, v)?;
         }
         g(0, "ENDTAB")?;
@@ -270,7 +275,10 @@ pub fn svg_ids(patterns: &[FlatPattern]) -> Vec<String> {
     for p in patterns {
         let base: String = format!(
             "ply-{}",
-            p.ply.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect::<String>()
+            p.ply
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' })
+                .collect::<String>()
         );
         let mut id = base.clone();
         let mut k = 2;
@@ -289,7 +297,15 @@ fn svg_xy(p: [f64; 2]) -> String {
 }
 
 /// Write an SVG of `pieces` over the box `lo..hi` (m, roll frame), with the roll if given.
-fn write_svg_pieces(path: &Path, pcs: &[Piece], ids: &[String], lo: [f64; 2], hi: [f64; 2], roll: Option<(f64, f64)>, title: &str) -> Result<(), PatternError> {
+fn write_svg_pieces(
+    path: &Path,
+    pcs: &[Piece],
+    ids: &[String],
+    lo: [f64; 2],
+    hi: [f64; 2],
+    roll: Option<(f64, f64)>,
+    title: &str,
+) -> Result<(), PatternError> {
     let (x0, y0) = (lo[0] * MM - SVG_MARGIN_MM, -hi[1] * MM - SVG_MARGIN_MM);
     let (width, height) = ((hi[0] - lo[0]) * MM + 2.0 * SVG_MARGIN_MM, (hi[1] - lo[1]) * MM + 2.0 * SVG_MARGIN_MM);
     write_atomic(path, |f| {
@@ -327,11 +343,24 @@ fn write_svg_pieces(path: &Path, pcs: &[Piece], ids: &[String], lo: [f64; 2], hi
                 }
                 d.push_str(" Z ");
             }
-            writeln!(f, r##"<path class="cut" d="{}" fill="#cde" fill-rule="evenodd" stroke="#000" stroke-width="{stroke}"/>"##, d.trim_end())?;
+            writeln!(
+                f,
+                r##"<path class="cut" d="{}" fill="#cde" fill-rule="evenodd" stroke="#000" stroke-width="{stroke}"/>"##,
+                d.trim_end()
+            )?;
             let a: Vec<String> = pc.arrow.iter().map(|s| format!("M {} L {}", svg_xy(s[0]), svg_xy(s[1]))).collect();
-            writeln!(f, r##"<path class="warp" d="{}" fill="none" stroke="#c00" stroke-width="{stroke}"/>"##, a.join(" "))?;
+            writeln!(
+                f,
+                r##"<path class="warp" d="{}" fill="none" stroke="#c00" stroke-width="{stroke}"/>"##,
+                a.join(" ")
+            )?;
             let [tx, ty] = [mm(pc.label_at[0]), mm(-pc.label_at[1])];
-            writeln!(f, r#"<text x="{tx}" y="{ty}" font-size="{}" font-family="sans-serif" text-anchor="middle">{}</text>"#, mm(pc.label_height), xml(&pc.label))?;
+            writeln!(
+                f,
+                r#"<text x="{tx}" y="{ty}" font-size="{}" font-family="sans-serif" text-anchor="middle">{}</text>"#,
+                mm(pc.label_height),
+                xml(&pc.label)
+            )?;
             writeln!(f, "</g>")?;
         }
         writeln!(f, "</svg>")
@@ -345,14 +374,21 @@ fn write_svg_pieces(path: &Path, pcs: &[Piece], ids: &[String], lo: [f64; 2], hi
 pub fn write_svg(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Result<(), PatternError> {
     let pcs = pieces(patterns, nesting, path)?;
     let (w, len) = (nesting.roll_width, nesting.length);
-    let title = format!("{} piece(s) on a {} mm roll, {} mm used, {:.1} % waste", pcs.len(), mm(w), mm(len), 100.0 * nesting.waste_fraction);
+    let title = format!(
+        "{} piece(s) on a {} mm roll, {} mm used, {:.1} % waste",
+        pcs.len(),
+        mm(w),
+        mm(len),
+        100.0 * nesting.waste_fraction
+    );
     write_svg_pieces(path, &pcs, &svg_ids(patterns), [0.0, 0.0], [len, w], Some((w, len)), &title)
 }
 
 /// Write one flat pattern as an SVG (millimetres) in its own frame (warp along +x, the seed node
 /// at the origin), atomically; same layout as [`write_svg`] without the roll.
 pub fn write_pattern_svg(pattern: &FlatPattern, path: &Path) -> Result<(), PatternError> {
-    let at = Placement { ply: pattern.ply.clone(), rotated: false, offset: [0.0, 0.0], min: pattern.min, max: pattern.max };
+    let at =
+        Placement { ply: pattern.ply.clone(), rotated: false, offset: [0.0, 0.0], min: pattern.min, max: pattern.max };
     let pc = piece(pattern, &at);
     check_finite(&pc, path)?;
     let title = format!("ply {}: flat pattern, area {:.6} m2", pattern.ply, pattern.area);
@@ -363,7 +399,12 @@ pub fn write_pattern_svg(pattern: &FlatPattern, path: &Path) -> Result<(), Patte
 /// `<stem>.svg`, and each pattern on its own as `<id>.svg` with `id` from [`svg_ids`]
 /// (`ply-NAME`, file-name safe). Returns the paths written, in that order. Everything is checked
 /// before the first file is written.
-pub fn write_cutting_plan(patterns: &[FlatPattern], nesting: &Nesting, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PatternError> {
+pub fn write_cutting_plan(
+    patterns: &[FlatPattern],
+    nesting: &Nesting,
+    dir: &Path,
+    stem: &str,
+) -> Result<Vec<PathBuf>, PatternError> {
     let dxf = dir.join(format!("{stem}.dxf"));
     pieces(patterns, nesting, &dxf)?;
     std::fs::create_dir_all(dir).map_err(|source| ExportError::CreateDir { path: dir.to_path_buf(), source })?;

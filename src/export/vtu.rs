@@ -134,7 +134,9 @@ mod tests {
         assert!(text.contains("Name=\"offsets\" format=\"ascii\">\n4 8 12\n"), "{text}");
         assert!(text.contains("Name=\"types\" format=\"ascii\">\n9 9 9\n"), "{text}");
         assert!(
-            text.contains("Name=\"normal\" NumberOfComponents=\"3\" format=\"ascii\">\n0.0 0.0 1.0 0.0 0.0 1.0\n0.0 0.0 1.0\n"),
+            text.contains(
+                "Name=\"normal\" NumberOfComponents=\"3\" format=\"ascii\">\n0.0 0.0 1.0 0.0 0.0 1.0\n0.0 0.0 1.0\n"
+            ),
             "{text}"
         );
     }

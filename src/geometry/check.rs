@@ -37,22 +37,12 @@ pub struct MendedMesh {
 /// (in any order). Pieces are the sets of triangles connected through manifold edges; each is
 /// wound like the majority of its triangles (ties: like its first triangle). A non-orientable
 /// piece (a Moebius strip) keeps the winding a breadth-first walk gives it.
-pub fn mend(
-    raw: RawMesh,
-    weld_tolerance: f64,
-    path: &Path,
-    report: &mut MeshReport,
-) -> Result<MendedMesh, ObjError> {
+pub fn mend(raw: RawMesh, weld_tolerance: f64, path: &Path, report: &mut MeshReport) -> Result<MendedMesh, ObjError> {
     let RawMesh { vertices, triangles } = raw;
     let count = vertices.len();
     for (face, tri) in triangles.iter().enumerate() {
         if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
-            return Err(ObjError::BadIndex {
-                path: path.into(),
-                face,
-                index: index as usize,
-                count,
-            });
+            return Err(ObjError::BadIndex { path: path.into(), face, index: index as usize, count });
         }
     }
 
@@ -74,9 +64,7 @@ pub fn mend(
         let (ab, ac, bc) = (b - a, c - a, c - b);
         let double_area2 = ab.cross(&ac).norm_squared();
         let longest = ab.norm_squared().max(ac.norm_squared()).max(bc.norm_squared());
-        if !(double_area2 > min_double_area * min_double_area
-            && double_area2 > (DEGENERATE_SINE * longest).powi(2))
-        {
+        if !(double_area2 > min_double_area * min_double_area && double_area2 > (DEGENERATE_SINE * longest).powi(2)) {
             degenerate += 1;
             continue;
         }
@@ -209,9 +197,8 @@ fn weld_map(vertices: &[Point], tolerance: f64) -> Vec<u32> {
         return rep;
     }
     // Cells are counted from the lowest corner so that cell numbers stay small.
-    let lo = vertices.iter().fold(Point::from(Vector::repeat(f64::INFINITY)), |m, p| {
-        Point::from(m.coords.inf(&p.coords))
-    });
+    let lo =
+        vertices.iter().fold(Point::from(Vector::repeat(f64::INFINITY)), |m, p| Point::from(m.coords.inf(&p.coords)));
     let inv_cell = 1.0 / (WELD_CELL * tolerance);
     let reach = 1.0 / WELD_CELL; // the tolerance in cell units
     let tol2 = tolerance * tolerance;
@@ -418,8 +405,7 @@ mod tests {
     fn mend_raw(vertices: Vec<Point>, triangles: Vec<[u32; 3]>) -> (MendedMesh, MeshReport) {
         let tolerance = WELD_TOLERANCE_REL * bounding_diagonal(&vertices);
         let mut report = MeshReport::default();
-        let mesh =
-            mend(RawMesh { vertices, triangles }, tolerance, Path::new("t"), &mut report).unwrap();
+        let mesh = mend(RawMesh { vertices, triangles }, tolerance, Path::new("t"), &mut report).unwrap();
         check_adjacency(&mesh);
         (mesh, report)
     }
@@ -437,8 +423,7 @@ mod tests {
                 }
                 assert_ne!(n as usize, t);
                 let other = mesh.triangles[n as usize];
-                let back: Vec<usize> =
-                    (0..3).filter(|&j| mesh.neighbours[n as usize][j] == t as u32).collect();
+                let back: Vec<usize> = (0..3).filter(|&j| mesh.neighbours[n as usize][j] == t as u32).collect();
                 assert_eq!(back.len(), 1, "triangle {n} must link back to {t} exactly once");
                 let edge = |tri: [u32; 3], k: usize| {
                     let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
@@ -535,8 +520,7 @@ mod tests {
         ];
         let triangles = vec![[0, 1, 2], [3, 4, 5]];
         let mut report = MeshReport::default();
-        let mesh =
-            mend(RawMesh { vertices, triangles }, 1e-3, Path::new("t"), &mut report).unwrap();
+        let mesh = mend(RawMesh { vertices, triangles }, 1e-3, Path::new("t"), &mut report).unwrap();
         assert_eq!(report.vertices_welded, 1);
         assert_eq!(mesh.vertices.len(), 5);
         assert_eq!(mesh.vertices[1], Point::new(1.0, 0.0, 0.0), "first vertex wins");
@@ -569,9 +553,7 @@ mod tests {
         for _ in 0..400 {
             let centre = Point::new(coord(1.0), coord(1.0), coord(1.0));
             for _ in 0..4 {
-                vertices.push(
-                    centre + Vector::new(coord(2.4 * tol), coord(2.4 * tol), coord(2.4 * tol)),
-                );
+                vertices.push(centre + Vector::new(coord(2.4 * tol), coord(2.4 * tol), coord(2.4 * tol)));
             }
         }
         for i in (1..vertices.len()).rev() {
@@ -581,8 +563,7 @@ mod tests {
         let mut expected: Vec<u32> = Vec::new();
         let mut heads: Vec<u32> = Vec::new();
         for (i, p) in vertices.iter().enumerate() {
-            let near =
-                heads.iter().copied().filter(|&h| (vertices[h as usize] - p).norm() <= tol).min();
+            let near = heads.iter().copied().filter(|&h| (vertices[h as usize] - p).norm() <= tol).min();
             expected.push(near.unwrap_or_else(|| {
                 heads.push(i as u32);
                 i as u32
@@ -596,9 +577,7 @@ mod tests {
         let mut exact = vertices.clone();
         exact.extend_from_slice(&vertices[..100]);
         let map = weld_map(&exact, 0.0);
-        assert!(
-            (0..vertices.len()).all(|i| map[i] as usize == i || exact[map[i] as usize] == exact[i])
-        );
+        assert!((0..vertices.len()).all(|i| map[i] as usize == i || exact[map[i] as usize] == exact[i]));
         assert!((0..100).all(|i| exact[map[vertices.len() + i] as usize] == vertices[i]));
     }
 
@@ -697,8 +676,7 @@ mod tests {
     #[test]
     fn same_orientation_through_obj_file() {
         // 2x2 grid of quads, the third one wound the other way.
-        let text =
-            "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nv 0 2 0\nv 1 2 0\nv 2 2 0\n\
+        let text = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nv 0 2 0\nv 1 2 0\nv 2 2 0\n\
                     f 1 2 5 4\nf 2 3 6 5\nf 4 7 8 5\nf 5 6 9 8\n";
         let (mesh, report) = load(text).unwrap();
         assert_eq!(report.flipped_faces, 2, "both triangles of the third quad");

@@ -173,10 +173,17 @@ impl TraceState {
         if let Some(c) = self.at_corner {
             let v = tool.triangle(self.triangle)[c];
             let (total, closed) = vertex_angle(tool, self.triangle, v);
-            let scaled = if closed { angle.rem_euclid(std::f64::consts::TAU) * total / std::f64::consts::TAU } else { angle };
+            let scaled =
+                if closed { angle.rem_euclid(std::f64::consts::TAU) * total / std::f64::consts::TAU } else { angle };
             let (t2, d2) = turn_about_vertex(tool, self.triangle, v, &self.dir, scaled)?;
             let c2 = corner_of(tool, t2, v)?;
-            return Some(TraceState { point: self.point, triangle: t2, dir: d2, entry_edge: None, at_corner: Some(c2) });
+            return Some(TraceState {
+                point: self.point,
+                triangle: t2,
+                dir: d2,
+                entry_edge: None,
+                at_corner: Some(c2),
+            });
         }
         let n = tool.normal(self.triangle);
         let d = (self.dir * angle.cos() + n.cross(&self.dir) * angle.sin()).normalize();

@@ -8,8 +8,8 @@ pub mod shapes;
 pub mod smooth;
 pub mod surface;
 
-pub use obj::{MeshReport, ObjError};
 pub use check::NO_NEIGHBOUR;
+pub use obj::{MeshReport, ObjError};
 pub use smooth::{SmoothPoint, SmoothSurface};
 pub use surface::{SurfacePoint, ToolSurface};
 

@@ -38,7 +38,9 @@ pub enum ObjError {
     Io { path: PathBuf, source: std::io::Error },
     #[error("tool mesh {path} is not a valid OBJ file: {reason}. Export the surface again as a Wavefront OBJ with triangles or polygons.")]
     Parse { path: PathBuf, reason: String },
-    #[error("tool mesh {path} has no faces. Export the surface (not only its points or curves) as triangles or polygons.")]
+    #[error(
+        "tool mesh {path} has no faces. Export the surface (not only its points or curves) as triangles or polygons."
+    )]
     Empty { path: PathBuf },
     /// `index` is the vertex number: 1-based in file order (as OBJ counts) for a file, 0-based
     /// for an in-memory mesh.
@@ -68,8 +70,7 @@ pub struct RawMesh {
 /// comments are ignored. Faces with fewer than three corners are dropped and counted as
 /// degenerate. Vertices no face uses are left out.
 pub fn read_obj(path: &Path) -> Result<(RawMesh, MeshReport), ObjError> {
-    let mut bytes =
-        std::fs::read(path).map_err(|source| ObjError::Io { path: path.into(), source })?;
+    let mut bytes = std::fs::read(path).map_err(|source| ObjError::Io { path: path.into(), source })?;
     let parse_error = |reason: String| ObjError::Parse { path: path.into(), reason };
     if bytes.contains(&0) {
         return Err(parse_error(
@@ -112,19 +113,15 @@ pub fn read_obj(path: &Path) -> Result<(RawMesh, MeshReport), ObjError> {
             let p = Point::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
             if let Some(&value) = p.coords.iter().find(|x| !x.is_finite()) {
                 // tobj renumbers vertices; look the offending one up in the file.
-                let (index, value) = first_non_finite_vertex(&bytes, &mesh.positions)
-                    .unwrap_or((raw.vertices.len() + 1, value));
+                let (index, value) =
+                    first_non_finite_vertex(&bytes, &mesh.positions).unwrap_or((raw.vertices.len() + 1, value));
                 return Err(ObjError::NonFinite { path: path.into(), index, value });
             }
             raw.vertices.push(p);
         }
         let count = raw.vertices.len();
         // tobj leaves `face_arities` empty when every face is a triangle.
-        let faces = if mesh.face_arities.is_empty() {
-            mesh.indices.len() / 3
-        } else {
-            mesh.face_arities.len()
-        };
+        let faces = if mesh.face_arities.is_empty() { mesh.indices.len() / 3 } else { mesh.face_arities.len() };
         let mut start = 0;
         for f in 0..faces {
             let n = mesh.face_arities.get(f).map_or(3, |&n| n as usize);
@@ -273,13 +270,11 @@ fn explain_load_error(e: tobj::LoadError, bytes: &[u8], path: &Path) -> ObjError
             numbered_lines(bytes).find(|(_, l)| keyword(l) == b"f" && !face_line_ok(l)),
             "a face is `f` followed by vertex numbers, such as `f 1 2 3` or `f 1/1/1 2/2/2 3/3/3`",
         ),
-        L::ReadError => at(
-            numbered_lines(bytes).find(|(_, l)| std::str::from_utf8(l).is_err()),
-            "the file must be plain text",
-        ),
-        L::FaceVertexOutOfBounds => bad_index(bytes, path).unwrap_or_else(|| {
-            parse(format!("{e} (a face refers to a vertex that does not exist)"))
-        }),
+        L::ReadError => {
+            at(numbered_lines(bytes).find(|(_, l)| std::str::from_utf8(l).is_err()), "the file must be plain text")
+        }
+        L::FaceVertexOutOfBounds => bad_index(bytes, path)
+            .unwrap_or_else(|| parse(format!("{e} (a face refers to a vertex that does not exist)"))),
         _ => parse(e.to_string()),
     }
 }
@@ -287,9 +282,7 @@ fn explain_load_error(e: tobj::LoadError, bytes: &[u8], path: &Path) -> ObjError
 /// Whether a `v` line is one tobj accepts.
 fn vertex_line_ok(line: &[u8]) -> bool {
     let (w, n) = words::<7>(line);
-    let num = |k: usize| {
-        std::str::from_utf8(&line[w[k].0..w[k].1]).ok().and_then(|s| s.parse::<f64>().ok())
-    };
+    let num = |k: usize| std::str::from_utf8(&line[w[k].0..w[k].1]).ok().and_then(|s| s.parse::<f64>().ok());
     n >= 4
         && (1..4).all(|k| num(k).is_some())
         && match n {
@@ -345,9 +338,7 @@ fn bad_index(bytes: &[u8], path: &Path) -> Option<ObjError> {
         if index > 0 && index as usize > count {
             Some(ObjError::BadIndex { path: path.into(), face, index: index as usize, count })
         } else if index == 0 {
-            Some(parse(format!(
-                "face {face} (line {line}) refers to vertex 0, but OBJ vertex numbers start at 1"
-            )))
+            Some(parse(format!("face {face} (line {line}) refers to vertex 0, but OBJ vertex numbers start at 1")))
         } else if index < 0 && index.unsigned_abs() > before {
             Some(parse(format!(
                 "face {face} (line {line}) refers to relative vertex {index}, but only {before} \
@@ -365,23 +356,19 @@ fn first_non_finite_vertex<T>(bytes: &[u8], _like: &[T]) -> Option<(usize, f64)>
 where
     T: std::str::FromStr + Copy + Into<f64> + std::ops::Div<Output = T>,
 {
-    numbered_lines(bytes).filter(|(_, l)| keyword(l) == b"v").enumerate().find_map(
-        |(i, (_, line))| {
-            let (w, n) = words::<5>(line);
-            let num = |k: usize| -> Option<T> {
-                std::str::from_utf8(&line[w[k].0..w[k].1]).ok()?.parse::<T>().ok()
-            };
-            let weight = if n == 5 { num(4) } else { None };
-            (1..4).find_map(|k| {
-                let mut x = num(k)?;
-                if let Some(w) = weight {
-                    x = x / w;
-                }
-                let x: f64 = x.into();
-                (!x.is_finite()).then_some((i + 1, x))
-            })
-        },
-    )
+    numbered_lines(bytes).filter(|(_, l)| keyword(l) == b"v").enumerate().find_map(|(i, (_, line))| {
+        let (w, n) = words::<5>(line);
+        let num = |k: usize| -> Option<T> { std::str::from_utf8(&line[w[k].0..w[k].1]).ok()?.parse::<T>().ok() };
+        let weight = if n == 5 { num(4) } else { None };
+        (1..4).find_map(|k| {
+            let mut x = num(k)?;
+            if let Some(w) = weight {
+                x = x / w;
+            }
+            let x: f64 = x.into();
+            (!x.is_finite()).then_some((i + 1, x))
+        })
+    })
 }
 
 #[cfg(test)]
@@ -413,10 +400,7 @@ mod tests {
         assert_eq!(report.degenerate_faces_dropped, 0);
         assert_eq!(raw.vertices.len(), 5);
         assert_eq!(raw.vertices[4], Point::new(0.5, 1.5, 0.0));
-        assert_eq!(
-            raw.triangles,
-            vec![[0, 1, 2], [0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 2, 4], [0, 4, 3]]
-        );
+        assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 2, 4], [0, 4, 3]]);
     }
 
     #[test]
@@ -444,12 +428,8 @@ mod tests {
         assert_eq!(raw.triangles.len(), 3);
         assert_eq!(raw.vertices.len(), 4);
         assert_eq!(report.vertices_read, 4);
-        let tri: Vec<[Point; 3]> =
-            raw.triangles.iter().map(|t| t.map(|i| raw.vertices[i as usize])).collect();
-        assert_eq!(
-            tri[0],
-            [Point::new(0., 0., 0.), Point::new(1., 0., 0.), Point::new(1., 1., 0.)]
-        );
+        let tri: Vec<[Point; 3]> = raw.triangles.iter().map(|t| t.map(|i| raw.vertices[i as usize])).collect();
+        assert_eq!(tri[0], [Point::new(0., 0., 0.), Point::new(1., 0., 0.), Point::new(1., 1., 0.)]);
         assert_eq!(tri[1][2], Point::new(0., 1., 0.));
 
         // Raw tobj overflows (panics in debug builds) on this out-of-range texture index.
@@ -494,10 +474,7 @@ mod tests {
             e => panic!("expected NonFinite, got {e}"),
         }
         let err = read_text("v 0 0 0\nv 1 0 -inf\nv 1 1 0\nf 1 2 3\n").unwrap_err();
-        assert!(
-            matches!(err, ObjError::NonFinite { index: 2, value, .. } if value == f64::NEG_INFINITY),
-            "{err}"
-        );
+        assert!(matches!(err, ObjError::NonFinite { index: 2, value, .. } if value == f64::NEG_INFINITY), "{err}");
         // Unused non-finite vertices are harmless.
         assert!(read_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv nan 0 0\nf 1 2 3\n").is_ok());
     }
@@ -575,8 +552,7 @@ mod tests {
                 0 => (0..200).map(|_| (rnd() % 256) as u8).collect(),
                 1 => (0..200).map(|_| (rnd() % 255 + 1) as u8).collect(),
                 _ => {
-                    let words: Vec<&str> =
-                        (0..60).map(|_| tokens[(rnd() % tokens.len() as u64) as usize]).collect();
+                    let words: Vec<&str> = (0..60).map(|_| tokens[(rnd() % tokens.len() as u64) as usize]).collect();
                     words.join(" ").into_bytes()
                 }
             };

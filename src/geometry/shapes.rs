@@ -239,11 +239,8 @@ pub fn cylinder(radius: f64, length: f64, sweep: f64, n_around: usize, n_along: 
     assert!(n_around > 0 && n_along > 0, "cylinder needs at least one cell each way");
     let closed = is_full_turn(sweep);
     assert!(!closed || n_around >= 3, "a closed cylinder needs n_around >= 3");
-    let angles = if closed {
-        linspace(-TAU / 2.0, TAU / 2.0, n_around)
-    } else {
-        linspace(-sweep / 2.0, sweep / 2.0, n_around)
-    };
+    let angles =
+        if closed { linspace(-TAU / 2.0, TAU / 2.0, n_around) } else { linspace(-sweep / 2.0, sweep / 2.0, n_around) };
     let ys = linspace(-length / 2.0, length / 2.0, n_along);
     let dirs: Vec<(f64, f64)> = angles.iter().map(|a| a.sin_cos()).collect();
     grid_mesh(n_around, n_along, closed, |i, j| {
@@ -261,24 +258,14 @@ pub fn cylinder(radius: f64, length: f64, sweep: f64, n_around: usize, n_along: 
 /// # Panics
 /// If a radius or the height is not positive, the sweep is not in `(0, 2 pi]` or a count is zero
 /// (or `n_around < 3` for a closed ring).
-pub fn cone(
-    r_base: f64,
-    r_top: f64,
-    height: f64,
-    sweep: f64,
-    n_around: usize,
-    n_along: usize,
-) -> TriangleMesh {
+pub fn cone(r_base: f64, r_top: f64, height: f64, sweep: f64, n_around: usize, n_along: usize) -> TriangleMesh {
     assert!(r_base > 0.0 && r_top > 0.0 && height > 0.0, "cone radii and height must be positive");
     assert!(sweep > 0.0 && sweep <= TAU + 1e-12, "cone sweep must be in (0, 2 pi], got {sweep}");
     assert!(n_around > 0 && n_along > 0, "cone needs at least one cell each way");
     let closed = is_full_turn(sweep);
     assert!(!closed || n_around >= 3, "a closed cone needs n_around >= 3");
-    let angles = if closed {
-        linspace(-TAU / 2.0, TAU / 2.0, n_around)
-    } else {
-        linspace(-sweep / 2.0, sweep / 2.0, n_around)
-    };
+    let angles =
+        if closed { linspace(-TAU / 2.0, TAU / 2.0, n_around) } else { linspace(-sweep / 2.0, sweep / 2.0, n_around) };
     let dirs: Vec<(f64, f64)> = angles.iter().map(|a| a.sin_cos()).collect();
     let zs = linspace(0.0, height, n_along);
     let radii = linspace(r_base, r_top, n_along);
@@ -431,29 +418,20 @@ impl DoubleDome {
             self.base_fillet,
             self.top_fillet,
         ];
-        assert!(
-            all.iter().all(|v| v.is_finite() && *v > 0.0),
-            "double dome sizes must be positive: {self:?}"
-        );
+        assert!(all.iter().all(|v| v.is_finite() && *v > 0.0), "double dome sizes must be positive: {self:?}");
         assert!(
             self.wall_angle > 0.0 && self.wall_angle < FRAC_PI_2,
             "double dome wall angle must be in (0, pi/2) for a height field, got {}",
             self.wall_angle
         );
-        assert!(
-            self.body_length >= self.body_width,
-            "double dome body must be at least as long as it is wide"
-        );
+        assert!(self.body_length >= self.body_width, "double dome body must be at least as long as it is wide");
         assert!(
             self.body_length < self.flange_length && self.body_width < self.flange_width,
             "double dome body must fit inside the flange"
         );
         let (u1, u2, u3, z1, z2) = self.profile_breaks();
         assert!(z1 <= z2 && u1 <= u2, "double dome fillets are too large for its height");
-        assert!(
-            u3 < self.body_width / 2.0,
-            "double dome has no flat top: walls and fillets are wider than the body"
-        );
+        assert!(u3 < self.body_width / 2.0, "double dome has no flat top: walls and fillets are wider than the body");
     }
 }
 
@@ -510,8 +488,7 @@ pub fn double_dome(p: &DoubleDome, n: usize) -> TriangleMesh {
     p.validate();
     assert!(n >= 4, "double dome needs at least 4 cells across the body");
     let h = p.body_width / n as f64;
-    let xs =
-        graded_axis(p.flange_length / 2.0, (p.body_length / 2.0 + 2.0 * h).min(p.flange_length / 2.0), h);
+    let xs = graded_axis(p.flange_length / 2.0, (p.body_length / 2.0 + 2.0 * h).min(p.flange_length / 2.0), h);
     let ys = graded_axis(p.flange_width / 2.0, (p.body_width / 2.0 + 2.0 * h).min(p.flange_width / 2.0), h);
     grid_mesh(xs.len() - 1, ys.len() - 1, false, |i, j| {
         let (x, y) = (xs[i], ys[j]);
@@ -558,29 +535,13 @@ impl HatBox {
     }
 
     fn validate(&self) {
-        let all = [
-            self.length,
-            self.width,
-            self.height,
-            self.corner_radius,
-            self.base_fillet,
-            self.top_fillet,
-            self.flange,
-        ];
+        let all =
+            [self.length, self.width, self.height, self.corner_radius, self.base_fillet, self.top_fillet, self.flange];
         assert!(all.iter().all(|v| v.is_finite() && *v > 0.0), "hat box sizes must be positive: {self:?}");
         assert!(self.length >= self.width, "hat box length must be at least its width");
-        assert!(
-            2.0 * self.corner_radius < self.width,
-            "hat box corner radius must be less than half its width"
-        );
-        assert!(
-            self.top_fillet < self.corner_radius,
-            "hat box top fillet must be smaller than the plan corner radius"
-        );
-        assert!(
-            self.base_fillet + self.top_fillet < self.height,
-            "hat box fillets must leave a vertical wall"
-        );
+        assert!(2.0 * self.corner_radius < self.width, "hat box corner radius must be less than half its width");
+        assert!(self.top_fillet < self.corner_radius, "hat box top fillet must be smaller than the plan corner radius");
+        assert!(self.base_fillet + self.top_fillet < self.height, "hat box fillets must leave a vertical wall");
         assert!(self.base_fillet < self.flange, "hat box flange must be wider than the base fillet");
     }
 }
@@ -778,10 +739,7 @@ mod tests {
         let mut undirected: HashMap<(u32, u32), usize> = HashMap::new();
         for (t, tri) in mesh.triangles.iter().enumerate() {
             assert!(tri.iter().all(|&i| (i as usize) < nv), "triangle {t} has a bad index");
-            assert!(
-                tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2],
-                "triangle {t} repeats a vertex"
-            );
+            assert!(tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2], "triangle {t} repeats a vertex");
             let [a, b, c] = mesh.corners(t);
             let scale = (b - a).norm().max((c - a).norm());
             assert!((b - a).cross(&(c - a)).norm() > 1e-6 * scale * scale, "triangle {t} is degenerate");
@@ -871,12 +829,9 @@ mod tests {
                 assert!(v.z >= 0.0);
             }
             assert!(mesh.vertices.contains(&Point::new(0.0, 0.0, r)), "pole missing");
-            for rim in [
-                Point::new(r, 0.0, 0.0),
-                Point::new(0.0, r, 0.0),
-                Point::new(-r, 0.0, 0.0),
-                Point::new(0.0, -r, 0.0),
-            ] {
+            for rim in
+                [Point::new(r, 0.0, 0.0), Point::new(0.0, r, 0.0), Point::new(-r, 0.0, 0.0), Point::new(0.0, -r, 0.0)]
+            {
                 assert!(mesh.vertices.contains(&rim), "rim point {rim:?} missing");
             }
             let on_rim = mesh.vertices.iter().filter(|v| v.z == 0.0).count();
@@ -1081,8 +1036,7 @@ mod tests {
         }
         assert!(wall > 0, "no vertical wall triangles");
         // Wall points lie on the rounded-rectangle outline.
-        let (ax, by, rc) =
-            (p.length / 2.0 - p.corner_radius, p.width / 2.0 - p.corner_radius, p.corner_radius);
+        let (ax, by, rc) = (p.length / 2.0 - p.corner_radius, p.width / 2.0 - p.corner_radius, p.corner_radius);
         for v in mesh.vertices.iter().filter(|v| v.z > p.base_fillet && v.z < p.height - p.top_fillet) {
             let (dx, dy) = ((v.x.abs() - ax).max(0.0), (v.y.abs() - by).max(0.0));
             assert!(((dx * dx + dy * dy).sqrt() - rc).abs() < 1e-12, "{v:?} off the wall");
@@ -1110,9 +1064,7 @@ mod tests {
         for line in text.lines() {
             let w: Vec<&str> = line.split_whitespace().collect();
             match w.first() {
-                Some(&"v") => {
-                    vs.push(Point::new(w[1].parse().unwrap(), w[2].parse().unwrap(), w[3].parse().unwrap()))
-                }
+                Some(&"v") => vs.push(Point::new(w[1].parse().unwrap(), w[2].parse().unwrap(), w[3].parse().unwrap())),
                 Some(&"f") => fs.push([0, 1, 2].map(|k| w[k + 1].parse::<u32>().unwrap() - 1)),
                 Some(&"#") | None => {}
                 other => panic!("unexpected line {other:?}"),

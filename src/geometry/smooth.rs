@@ -243,7 +243,17 @@ mod tests {
                 let Some(n) = tool.neighbour(t, k) else { continue };
                 let (a, b) = (tris[t as usize][(k + 1) % 3], tris[t as usize][(k + 2) % 3]);
                 for s in [0.25, 0.5, 0.8] {
-                    let bary = |tri: [u32; 3]| tri.map(|v| if v == a { 1.0 - s } else if v == b { s } else { 0.0 });
+                    let bary = |tri: [u32; 3]| {
+                        tri.map(|v| {
+                            if v == a {
+                                1.0 - s
+                            } else if v == b {
+                                s
+                            } else {
+                                0.0
+                            }
+                        })
+                    };
                     let p = smooth.point(t, &bary(tris[t as usize]));
                     let q = smooth.point(n, &bary(tris[n as usize]));
                     assert!((p - q).norm() < 1e-12 * tool.diagonal(), "crack between {t} and {n}");

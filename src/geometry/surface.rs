@@ -97,11 +97,7 @@ impl ToolSurface {
 
     /// Build from in-memory triangles (analytic shapes, tests); goes through the same checks.
     pub fn from_triangles(vertices: Vec<Point>, triangles: Vec<[u32; 3]>) -> Result<Self, ObjError> {
-        let report = MeshReport {
-            vertices_read: vertices.len(),
-            faces_read: triangles.len(),
-            ..Default::default()
-        };
+        let report = MeshReport { vertices_read: vertices.len(), faces_read: triangles.len(), ..Default::default() };
         let path = Path::new("<memory>");
         if triangles.is_empty() {
             return Err(ObjError::Empty { path: path.into() });

@@ -38,7 +38,9 @@ pub enum DrapeError {
     TooLarge { nu: usize, nv: usize, need_mb: u64, have_mb: u64 },
     #[error("the origin ({x}, {y}, {z}) is {distance:.4} from the tool, more than one spacing ({spacing}): give a seed point on (or within one spacing of) the tool surface, in the tool's units")]
     OriginOffTool { x: f64, y: f64, z: f64, distance: f64, spacing: f64 },
-    #[error("the warp direction {0:?} is normal to the tool at the origin (or zero): give a direction along the surface")]
+    #[error(
+        "the warp direction {0:?} is normal to the tool at the origin (or zero): give a direction along the surface"
+    )]
     WarpNormal([f64; 3]),
     #[error("pre-shear must lie strictly between -90 and 90 degrees, got {0} deg")]
     PreShear(f64),
@@ -150,7 +152,13 @@ pub fn circle_root(tool: &ToolSurface, circle: &Circle, reach: f64, seeds: [u32;
 
 /// Best acceptable root among triangles connected to `seeds` that may meet the ball around the
 /// circle, by flood fill over edge neighbours.
-fn local_roots(tool: &ToolSurface, circle: &Circle, reach: f64, seeds: [u32; 2], s: &mut Scratch) -> Option<CircleRoot> {
+fn local_roots(
+    tool: &ToolSurface,
+    circle: &Circle,
+    reach: f64,
+    seeds: [u32; 2],
+    s: &mut Scratch,
+) -> Option<CircleRoot> {
     let stamp = s.next_stamp(tool.num_triangles());
     s.stack.clear();
     s.roots.clear();
@@ -260,10 +268,7 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
             nb: if sj > 0 { nv - j0 } else { j0 + 1 },
         })
         .collect();
-    let filled: Vec<QuadrantNodes> = quadrants
-        .par_iter()
-        .map(|q| fill_quadrant(tool, settings, &net, q))
-        .collect();
+    let filled: Vec<QuadrantNodes> = quadrants.par_iter().map(|q| fill_quadrant(tool, settings, &net, q)).collect();
     for (q, nodes) in quadrants.iter().zip(&filled) {
         for a in 1..q.na {
             for b in 1..q.nb {
@@ -333,12 +338,7 @@ pub fn check_memory(nu: usize, nv: usize) -> Result<(), DrapeError> {
     let need = (nu as u128 * nv as u128 * BYTES_PER_NODE as u128) as f64;
     let have = available_memory_bytes().unwrap_or(u64::MAX) as f64;
     if need > 0.8 * have || nu.checked_mul(nv).is_none() {
-        return Err(DrapeError::TooLarge {
-            nu,
-            nv,
-            need_mb: (need / 1e6).ceil() as u64,
-            have_mb: (have / 1e6) as u64,
-        });
+        return Err(DrapeError::TooLarge { nu, nv, need_mb: (need / 1e6).ceil() as u64, have_mb: (have / 1e6) as u64 });
     }
     Ok(())
 }

@@ -52,12 +52,8 @@ pub fn lay_generators(
         GeneratorKind::Geodesic | GeneratorKind::MinShear => {
             let origin = Placed { point: seed.point, triangle: seed.triangle };
             let start = TraceState::new(tool, seed.point, seed.triangle, &settings.warp).ok_or_else(warp_err)?;
-            let states = [
-                Some(start),
-                start.turned(tool, PI),
-                start.turned(tool, omega),
-                start.turned(tool, PI + omega),
-            ];
+            let states =
+                [Some(start), start.turned(tool, PI), start.turned(tool, omega), start.turned(tool, PI + omega)];
             let min_shear = settings.generators == GeneratorKind::MinShear;
             let mut halves: Vec<Vec<Result<Placed, NodeStatus>>> = Vec::with_capacity(4);
             if !min_shear {
@@ -75,10 +71,12 @@ pub fn lay_generators(
                     .map(|s| s.and_then(|s| trace_half(tool, s, origin.point, 1, d).pop()?.ok()))
                     .collect();
                 // (is_warp, sign, the two neighbouring halves' first nodes with their side signs)
-                let specs = [(true, 1.0, [(first[2], 1.0), (first[3], -1.0)]),
+                let specs = [
+                    (true, 1.0, [(first[2], 1.0), (first[3], -1.0)]),
                     (true, -1.0, [(first[2], 1.0), (first[3], -1.0)]),
                     (false, 1.0, [(first[0], 1.0), (first[1], -1.0)]),
-                    (false, -1.0, [(first[0], 1.0), (first[1], -1.0)])];
+                    (false, -1.0, [(first[0], 1.0), (first[1], -1.0)]),
+                ];
                 for ((state, n), (is_warp, sign, sides)) in states.iter().zip(counts).zip(specs) {
                     halves.push(match state {
                         Some(s) => min_shear_half(tool, settings, *s, origin, n, is_warp, sign, sides),
@@ -102,7 +100,13 @@ pub fn lay_generators(
 }
 
 /// Follow a geodesic from `from`, placing `n` nodes at straight-line distance d from each other.
-fn trace_half(tool: &ToolSurface, mut state: TraceState, from: Point, n: usize, d: f64) -> Vec<Result<Placed, NodeStatus>> {
+fn trace_half(
+    tool: &ToolSurface,
+    mut state: TraceState,
+    from: Point,
+    n: usize,
+    d: f64,
+) -> Vec<Result<Placed, NodeStatus>> {
     let mut out = Vec::with_capacity(n);
     let mut prev = from;
     while out.len() < n {
@@ -165,12 +169,20 @@ fn min_shear_half(
             match shoot(turn) {
                 Some((_, x)) => {
                     let (c, _) = evaluate(&prev, &x, &strip);
-                    if c.is_nan() { turn * turn } else { c }
+                    if c.is_nan() {
+                        turn * turn
+                    } else {
+                        c
+                    }
                 }
                 None => f64::INFINITY,
             }
         };
-        let turn = if out.is_empty() { 0.0 } else { golden_section_min(cost, -MAX_STEER_TURN, MAX_STEER_TURN, GOLDEN_ITERATIONS, 0.0).0 };
+        let turn = if out.is_empty() {
+            0.0
+        } else {
+            golden_section_min(cost, -MAX_STEER_TURN, MAX_STEER_TURN, GOLDEN_ITERATIONS, 0.0).0
+        };
         let turn = if cost(turn) <= cost(0.0) { turn } else { 0.0 };
         let Some((s, x)) = shoot(turn) else { break };
         let (_, next) = evaluate(&prev, &x, &strip);
@@ -268,7 +280,13 @@ fn closest_on_polyline(line: &[Point], p: &Point) -> (usize, f64, f64) {
 
 /// Nodes at straight-line distance d along a path on the tool, each the point of the tool at
 /// distance d from the previous node nearest to where the path crosses that distance.
-fn follow_curve(tool: &ToolSurface, path: &[Point], origin: Placed, n: usize, d: f64) -> Vec<Result<Placed, NodeStatus>> {
+fn follow_curve(
+    tool: &ToolSurface,
+    path: &[Point],
+    origin: Placed,
+    n: usize,
+    d: f64,
+) -> Vec<Result<Placed, NodeStatus>> {
     let mut out = Vec::with_capacity(n);
     let mut prev = origin;
     let mut seg = 0usize;

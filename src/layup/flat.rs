@@ -132,7 +132,11 @@ pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPatte
         traced
             .iter()
             .map(|r| Region {
-                loops: r.loops.iter().map(|l| l.iter().map(|&[i, j]| to_flat([i as f64, j as f64])).collect()).collect(),
+                loops: r
+                    .loops
+                    .iter()
+                    .map(|l| l.iter().map(|&[i, j]| to_flat([i as f64, j as f64])).collect())
+                    .collect(),
                 cells: r.cells,
                 area: r.cells as f64 * d * d,
             })
@@ -160,7 +164,17 @@ pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPatte
     let a = traced[0].anchor;
     let anchor = to_flat([a[0] as f64 + 0.5, a[1] as f64 + 0.5]);
     let area = if margin == 0.0 { cells as f64 * d * d } else { regions.iter().map(|r| r.area).sum() };
-    Ok(FlatPattern { ply: net.name.clone(), spacing: d, origin_node: net.origin_node, regions, cells, area, min, max, anchor })
+    Ok(FlatPattern {
+        ply: net.name.clone(),
+        spacing: d,
+        origin_node: net.origin_node,
+        regions,
+        cells,
+        area,
+        min,
+        max,
+        anchor,
+    })
 }
 
 /// Sorted distinct coordinates, those within [`SNAP`] of a kept one dropped.
@@ -184,7 +198,10 @@ fn snap_index(axis: &[f64], x: f64) -> usize {
 /// every side: the rectangles' edges make a compressed grid, whose covered cells (by a 2-D
 /// difference array) are traced like the cells of the net.
 fn grown(mask: &CellMask, u: f64) -> Vec<(Vec<Vec<[f64; 2]>>, usize)> {
-    let filled: Vec<[usize; 2]> = (0..mask.nx).flat_map(|i| (0..mask.ny).map(move |j| [i, j])).filter(|&[i, j]| mask.get(i as i64, j as i64)).collect();
+    let filled: Vec<[usize; 2]> = (0..mask.nx)
+        .flat_map(|i| (0..mask.ny).map(move |j| [i, j]))
+        .filter(|&[i, j]| mask.get(i as i64, j as i64))
+        .collect();
     let grow = |k: usize| [k as f64 - u, k as f64 + 1.0 + u];
     let xs = snapped(filled.iter().flat_map(|c| grow(c[0])).collect());
     let ys = snapped(filled.iter().flat_map(|c| grow(c[1])).collect());
@@ -231,7 +248,9 @@ fn grown(mask: &CellMask, u: f64) -> Vec<(Vec<Vec<[f64; 2]>>, usize)> {
     regions
         .into_iter()
         .zip(counts)
-        .map(|(r, n)| (r.loops.iter().map(|l| l.iter().map(|&[a, b]| [xs[a as usize], ys[b as usize]]).collect()).collect(), n))
+        .map(|(r, n)| {
+            (r.loops.iter().map(|l| l.iter().map(|&[a, b]| [xs[a as usize], ys[b as usize]]).collect()).collect(), n)
+        })
         .collect()
 }
 
@@ -266,7 +285,11 @@ impl CellMask {
     }
     /// Whether cell (i, j) is filled; cells outside the grid are empty.
     pub fn get(&self, i: i64, j: i64) -> bool {
-        i >= 0 && j >= 0 && (i as usize) < self.nx && (j as usize) < self.ny && self.filled[i as usize * self.ny + j as usize]
+        i >= 0
+            && j >= 0
+            && (i as usize) < self.nx
+            && (j as usize) < self.ny
+            && self.filled[i as usize * self.ny + j as usize]
     }
 }
 
@@ -340,7 +363,12 @@ pub fn trace(mask: &CellMask) -> Vec<GridRegion> {
                 continue;
             }
             // (start vertex, direction, neighbour across the edge)
-            let edges = [([i, j], 0, [i, j - 1]), ([i + 1, j], 1, [i + 1, j]), ([i + 1, j + 1], 2, [i, j + 1]), ([i, j + 1], 3, [i - 1, j])];
+            let edges = [
+                ([i, j], 0, [i, j - 1]),
+                ([i + 1, j], 1, [i + 1, j]),
+                ([i + 1, j + 1], 2, [i, j + 1]),
+                ([i, j + 1], 3, [i - 1, j]),
+            ];
             for (v, dir, nb) in edges {
                 if !mask.get(nb[0], nb[1]) {
                     *out.entry(v).or_insert(0) |= 1 << dir;
@@ -386,7 +414,8 @@ pub fn trace(mask: &CellMask) -> Vec<GridRegion> {
             let (sx, sy) = cells.iter().fold((0.0, 0.0), |(x, y), c| (x + c[0] as f64, y + c[1] as f64));
             let (cx, cy) = (sx / n, sy / n);
             let dist = |c: &[i64; 2]| (c[0] as f64 - cx).powi(2) + (c[1] as f64 - cy).powi(2);
-            let anchor = *cells.iter().min_by(|a, b| dist(a).total_cmp(&dist(b)).then(a.cmp(b))).expect("regions are not empty");
+            let anchor =
+                *cells.iter().min_by(|a, b| dist(a).total_cmp(&dist(b)).then(a.cmp(b))).expect("regions are not empty");
             GridRegion { loops, cells: cells.len(), anchor, members: cells }
         })
         .collect();
@@ -426,10 +455,7 @@ fn split_at_repeats(chain: Vec<[i64; 2]>) -> Vec<Vec<[i64; 2]>> {
 fn merge_collinear(l: Vec<[i64; 2]>) -> Vec<[i64; 2]> {
     let n = l.len();
     let dir = |a: [i64; 2], b: [i64; 2]| [(b[0] - a[0]).signum(), (b[1] - a[1]).signum()];
-    (0..n)
-        .filter(|&k| dir(l[(k + n - 1) % n], l[k]) != dir(l[k], l[(k + 1) % n]))
-        .map(|k| l[k])
-        .collect()
+    (0..n).filter(|&k| dir(l[(k + n - 1) % n], l[k]) != dir(l[k], l[(k + 1) % n])).map(|k| l[k]).collect()
 }
 
 #[cfg(test)]

@@ -24,7 +24,9 @@ pub fn read_points(path: &Path, scale: f64) -> Result<Vec<Point>, String> {
         let fields: Vec<&str> = line.split(|c: char| c == ',' || c.is_whitespace()).filter(|f| !f.is_empty()).collect();
         let numbers: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
         match numbers {
-            Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => points.push(Point::new(v[0], v[1], v[2]) * scale),
+            Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
+                points.push(Point::new(v[0], v[1], v[2]) * scale)
+            }
             Err(_) if points.is_empty() && n == 0 => continue, // header
             _ => {
                 return Err(format!(
@@ -44,8 +46,12 @@ pub fn parse_generators(s: &str, base: &Path, scale: f64) -> Result<GeneratorKin
         "geodesic" => Ok(GeneratorKind::Geodesic),
         "min-shear" => Ok(GeneratorKind::MinShear),
         other => match other.strip_prefix("steer:") {
-            Some(file) if !file.trim().is_empty() => Ok(GeneratorKind::Steer(read_points(&base.join(file.trim()), scale)?)),
-            _ => Err(format!("unknown generators '{other}': use geodesic, min-shear or steer:FILE (a curve, x,y,z per line)")),
+            Some(file) if !file.trim().is_empty() => {
+                Ok(GeneratorKind::Steer(read_points(&base.join(file.trim()), scale)?))
+            }
+            _ => Err(format!(
+                "unknown generators '{other}': use geodesic, min-shear or steer:FILE (a curve, x,y,z per line)"
+            )),
         },
     }
 }

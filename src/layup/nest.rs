@@ -85,10 +85,18 @@ struct Span {
 /// every allowed orientation (naming the ply and by how much).
 pub fn nest(patterns: &[FlatPattern], roll_width: f64, gap: f64, rotation: Rotation) -> Result<Nesting, FlatError> {
     if !(roll_width.is_finite() && roll_width > 0.0) {
-        return Err(FlatError::BadNestParameter { field: "roll_width", value: roll_width, reason: "must be a positive length in metres" });
+        return Err(FlatError::BadNestParameter {
+            field: "roll_width",
+            value: roll_width,
+            reason: "must be a positive length in metres",
+        });
     }
     if !(gap.is_finite() && gap >= 0.0) {
-        return Err(FlatError::BadNestParameter { field: "gap", value: gap, reason: "must be zero or a positive length in metres" });
+        return Err(FlatError::BadNestParameter {
+            field: "gap",
+            value: gap,
+            reason: "must be zero or a positive length in metres",
+        });
     }
     // Every piece must fit across the roll in some allowed orientation.
     let turns: &[bool] = match rotation {
@@ -97,19 +105,30 @@ pub fn nest(patterns: &[FlatPattern], roll_width: f64, gap: f64, rotation: Rotat
     };
     let across = |p: &FlatPattern, turned: bool| if turned { p.size()[0] } else { p.size()[1] };
     for p in patterns {
-        let (best, turned) = turns.iter().map(|&t| (across(p, t), t)).min_by(|a, b| a.0.total_cmp(&b.0)).expect("one orientation at least");
+        let (best, turned) = turns
+            .iter()
+            .map(|&t| (across(p, t), t))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .expect("one orientation at least");
         if best > roll_width {
             let orientation = match (rotation, turned) {
                 (Rotation::WarpAlongRoll, _) => "warp along the roll; turning is not allowed",
                 _ => "in its narrower orientation",
             };
-            return Err(FlatError::TooWide { ply: p.ply.clone(), across: best, roll_width, excess: best - roll_width, orientation });
+            return Err(FlatError::TooWide {
+                ply: p.ply.clone(),
+                across: best,
+                roll_width,
+                excess: best - roll_width,
+                orientation,
+            });
         }
     }
 
     // Longest pieces first; ties keep the given order (stable sort).
     let mut order: Vec<usize> = (0..patterns.len()).collect();
-    let longest = |p: &FlatPattern| turns.iter().map(|&t| if t { p.size()[1] } else { p.size()[0] }).fold(0.0, f64::max);
+    let longest =
+        |p: &FlatPattern| turns.iter().map(|&t| if t { p.size()[1] } else { p.size()[0] }).fold(0.0, f64::max);
     order.sort_by(|&a, &b| longest(&patterns[b]).total_cmp(&longest(&patterns[a])));
 
     let mut sky = vec![Span { y0: 0.0, y1: roll_width, x: 0.0 }];
@@ -125,7 +144,7 @@ pub fn nest(patterns: &[FlatPattern], roll_width: f64, gap: f64, rotation: Rotat
             }
             for s in &sky {
                 let y = s.y0.min(roll_width - wide); // the last stretch may start the piece lower
-                // The piece and its clearance on the +y side; pieces below keep theirs.
+                                                     // The piece and its clearance on the +y side; pieces below keep theirs.
                 let top = (y + wide + gap).min(roll_width);
                 let x = sky.iter().filter(|o| o.y1 > y && o.y0 < top).map(|o| o.x).fold(0.0, f64::max);
                 let cand = (x + along, x, y, t);

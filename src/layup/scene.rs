@@ -38,12 +38,12 @@
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
 //! ```
 use super::{parse_generators, read_points, unit_scale};
+use crate::export::flow::FlowFormat;
+use crate::export::map::Cavity;
 use crate::geometry::{Point, Vector};
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
 use crate::material::MaterialCard;
 use crate::mechanics::ContactMode;
-use crate::export::flow::FlowFormat;
-use crate::export::map::Cavity;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -243,18 +243,28 @@ impl Scene {
         let scale = unit_scale(&file.units).map_err(|m| invalid(format!("field `units`: {m}")))?;
         let base = path.parent().unwrap_or(Path::new("."));
         if file.ply.is_empty() {
-            return Err(invalid("no [[ply]] table: add at least one ply (name, origin, angle_deg or warp, spacing, grid)".into()));
+            return Err(invalid(
+                "no [[ply]] table: add at least one ply (name, origin, angle_deg or warp, spacing, grid)".into(),
+            ));
         }
         let v = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let reference = match file.reference {
             None => Vector::x(),
             Some(r) if r.iter().all(|x| x.is_finite()) && v(r).norm() > 0.0 => v(r).normalize(),
-            Some(r) => return Err(invalid(format!("field `reference`: must be a non-zero vector of three finite numbers, got {r:?}"))),
+            Some(r) => {
+                return Err(invalid(format!(
+                    "field `reference`: must be a non-zero vector of three finite numbers, got {r:?}"
+                )))
+            }
         };
         let stack_side = match file.stack_side.as_deref().unwrap_or("normal") {
             "normal" => StackSide::Normal,
             "opposite" => StackSide::Opposite,
-            other => return Err(invalid(format!("field `stack_side`: unknown side '{other}': use \"normal\" or \"opposite\""))),
+            other => {
+                return Err(invalid(format!(
+                    "field `stack_side`: unknown side '{other}': use \"normal\" or \"opposite\""
+                )))
+            }
         };
         let positive_length = |field: &str, x: Option<f64>| -> Result<Option<f64>, SceneError> {
             match x {
@@ -300,7 +310,10 @@ impl Scene {
                 };
                 let mesh = base.join(&e.mesh);
                 if !mesh.is_file() {
-                    return Err(at("mesh", format!("no flow mesh at {}: check the path (relative to the scene file)", mesh.display())));
+                    return Err(at(
+                        "mesh",
+                        format!("no flow mesh at {}: check the path (relative to the scene file)", mesh.display()),
+                    ));
                 }
                 Some(SceneExport { mesh, formats, cavity, permeability: e.permeability })
             }
@@ -344,7 +357,9 @@ impl Scene {
                 (None, Some(points), None) => {
                     Extent::Outline(points.iter().map(|a| Point::new(a[0], a[1], a[2]) * scale).collect())
                 }
-                (None, None, Some(f)) => Extent::Outline(read_points(&base.join(f), scale).map_err(|m| at("outline_file", m))?),
+                (None, None, Some(f)) => {
+                    Extent::Outline(read_points(&base.join(f), scale).map_err(|m| at("outline_file", m))?)
+                }
                 _ => return Err(at("grid", "give exactly one of grid, outline or outline_file".into())),
             };
             let generators = parse_generators(&p.generators, base, scale).map_err(|m| at("generators", m))?;
@@ -389,18 +404,25 @@ impl Scene {
                     let mode = match p.mode.as_deref().unwrap_or("pressed") {
                         "pressed" => ContactMode::Pressed,
                         "free" => ContactMode::Free,
-                        other => return Err(at("mode", format!("unknown mode '{other}': use \"pressed\" or \"free\""))),
+                        other => {
+                            return Err(at("mode", format!("unknown mode '{other}': use \"pressed\" or \"free\"")))
+                        }
                     };
                     Some(Refinement { material: m.card.clone(), material_path: m.path.clone(), mode })
                 }
-                other => return Err(at("method", format!("unknown method '{other}': use \"kinematic\" or \"mechanical\""))),
+                other => {
+                    return Err(at("method", format!("unknown method '{other}': use \"kinematic\" or \"mechanical\"")))
+                }
             };
             let max_shear = p.max_shear_deg.unwrap_or(DEFAULT_MAX_SHEAR_DEG);
             if !(max_shear > 0.0 && max_shear < 90.0) {
                 return Err(at("max_shear_deg", format!("must lie strictly between 0 and 90, got {max_shear}")));
             }
             if !(p.pre_shear_deg.abs() < 90.0) {
-                return Err(at("pre_shear_deg", format!("must lie strictly between -90 and 90, got {}", p.pre_shear_deg)));
+                return Err(at(
+                    "pre_shear_deg",
+                    format!("must lie strictly between -90 and 90, got {}", p.pre_shear_deg),
+                ));
             }
             let locking = p.locking_angle_deg.unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
             if !(locking > 0.0 && locking < 90.0) {
@@ -419,7 +441,15 @@ impl Scene {
                 generators,
                 max_shear: max_shear.to_radians(),
             };
-            plies.push(Ply { settings, orientation, material, thickness, refinement, locking_angle: locking.to_radians(), line });
+            plies.push(Ply {
+                settings,
+                orientation,
+                material,
+                thickness,
+                refinement,
+                locking_angle: locking.to_radians(),
+                line,
+            });
         }
         // A ply above another needs the thickness of the one below to know where it lies.
         if plies.len() > 1 {

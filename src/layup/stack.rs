@@ -95,7 +95,13 @@ pub fn ply_stats(net: &DrapeNet, locking_angle: f64, areal_mass: Option<f64>) ->
 /// The warp direction of `ply` with its seed at `origin` on `surface`: its warp or the scene's
 /// reference, projected onto the tangent plane there and turned by the ply angle about the
 /// normal on the stacking side.
-pub fn resolve_warp(ply: &Ply, origin: &Point, reference: &Vector, surface: &ToolSurface, side: StackSide) -> Result<Vector, String> {
+pub fn resolve_warp(
+    ply: &Ply,
+    origin: &Point,
+    reference: &Vector,
+    surface: &ToolSurface,
+    side: StackSide,
+) -> Result<Vector, String> {
     let sp = surface.closest_point(origin);
     let n = seed_normal(surface, &sp.point);
     let n = match side {
@@ -144,7 +150,11 @@ const SEED_CONTACT_REL: f64 = 1e-9;
 
 /// Drape every ply of `scene` on `tool` in stacking order. `on_ply(k, name)` is called before
 /// ply `k` starts (for progress display).
-pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usize, &str)) -> Result<Vec<PlyResult>, LayupError> {
+pub fn drape_layup(
+    scene: &Scene,
+    tool: &ToolSurface,
+    mut on_ply: impl FnMut(usize, &str),
+) -> Result<Vec<PlyResult>, LayupError> {
     let (dirs, clipped) = offset_directions(tool);
     let sign = match scene.stack_side {
         StackSide::Normal => 1.0,
@@ -163,8 +173,11 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
         let (offset_tool, offset) = if k == 0 {
             (None, OffsetReport::default())
         } else {
-            let (s, r) = offset_along(tool, &dirs, clipped, &signed)
-                .map_err(|source| LayupError::Offset { ply: name.clone(), line, source })?;
+            let (s, r) = offset_along(tool, &dirs, clipped, &signed).map_err(|source| LayupError::Offset {
+                ply: name.clone(),
+                line,
+                source,
+            })?;
             (Some(s), r)
         };
         let surface = offset_tool.as_ref().unwrap_or(tool);
@@ -185,13 +198,17 @@ pub fn drape_layup(scene: &Scene, tool: &ToolSurface, mut on_ply: impl FnMut(usi
         let warp = resolve_warp(ply, &settings.origin, &scene.reference, surface, scene.stack_side)
             .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
-        let mut net = drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
+        let mut net =
+            drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
         let mut refined = None;
         if let Some(r) = &ply.refinement {
             let t = Instant::now();
             let settings = RefineSettings { mode: r.mode, ..RefineSettings::default() };
-            let result = refine(&net, surface, &r.material, &settings)
-                .map_err(|source| LayupError::Refine { ply: name.clone(), line, source })?;
+            let result = refine(&net, surface, &r.material, &settings).map_err(|source| LayupError::Refine {
+                ply: name.clone(),
+                line,
+                source,
+            })?;
             let mut out = result.net.clone();
             annotate(&mut out, &net, &result, &r.material_path);
             out.timing.load_ms = net.timing.load_ms;

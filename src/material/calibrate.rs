@@ -16,8 +16,8 @@
 //! section picks the locking angle; a polynomial that comes out non-monotone is refitted with
 //! non-negative coefficients). The knit law is linear in C and beta at fixed alpha:
 //! variable projection (grid + golden section on alpha) then Levenberg-Marquardt on all three.
-use crate::numeric::golden_section_min;
 use super::card::{KnitParams, ShearLaw, KNIT_STRETCH_LIMIT};
+use crate::numeric::golden_section_min;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, SQRT_2};
 
@@ -95,12 +95,7 @@ impl FitReport {
         } else {
             0.0
         };
-        FitReport {
-            rms: (ss_res / n as f64).sqrt(),
-            r_squared,
-            max_abs_residual: max_abs,
-            points: n,
-        }
+        FitReport { rms: (ss_res / n as f64).sqrt(), r_squared, max_abs_residual: max_abs, points: n }
     }
 }
 
@@ -158,12 +153,7 @@ fn bias_extension_terms(d: f64, length: f64, width: f64) -> Option<[(f64, f64); 
 
 /// Bias-extension force (N) of a law at elongation `d`.
 pub fn bias_extension_force(law: &ShearLaw, d: f64, length: f64, width: f64) -> Option<f64> {
-    Some(
-        bias_extension_terms(d, length, width)?
-            .iter()
-            .map(|(g, w)| w * law.moment(*g))
-            .sum(),
-    )
+    Some(bias_extension_terms(d, length, width)?.iter().map(|(g, w)| w * law.moment(*g)).sum())
 }
 
 // ---- shear fits --------------------------------------------------------------------------------
@@ -178,10 +168,7 @@ struct Obs {
 fn check_points(data: &[(f64, f64)], what: &str) -> Result<(), FitError> {
     for (i, (x, y)) in data.iter().enumerate() {
         if !(x.is_finite() && y.is_finite()) {
-            return Err(FitError::Data(format!(
-                "{what} point {}: ({x}, {y}) is not a pair of finite numbers",
-                i + 1
-            )));
+            return Err(FitError::Data(format!("{what} point {}: ({x}, {y}) is not a pair of finite numbers", i + 1)));
         }
     }
     Ok(())
@@ -201,9 +188,7 @@ pub fn fit_shear_picture_frame(
     kind: ShearLawKind,
 ) -> Result<(ShearLaw, FitReport), FitError> {
     if !(side.is_finite() && side > 0.0) {
-        return Err(FitError::Data(format!(
-            "the frame side must be a positive length, got {side}"
-        )));
+        return Err(FitError::Data(format!("the frame side must be a positive length, got {side}")));
     }
     check_points(data, "picture-frame")?;
     let mut obs = Vec::with_capacity(data.len());
@@ -216,10 +201,7 @@ pub fn fit_shear_picture_frame(
                 (2.0 - SQRT_2) * side
             ))
         })?;
-        obs.push(Obs {
-            terms: vec![(g, 1.0)],
-            target: f / (side * side * dg),
-        });
+        obs.push(Obs { terms: vec![(g, 1.0)], target: f / (side * side * dg) });
     }
     fit_shear(&obs, kind)
 }
@@ -250,10 +232,7 @@ pub fn fit_shear_bias_extension(
                 (SQRT_2 - 1.0) * (length - width)
             ))
         })?;
-        obs.push(Obs {
-            terms: terms.to_vec(),
-            target: f,
-        });
+        obs.push(Obs { terms: terms.to_vec(), target: f });
     }
     fit_shear(&obs, kind)
 }
@@ -262,16 +241,12 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
     let n = obs.len();
     let targets: Vec<f64> = obs.iter().map(|o| o.target).collect();
     let predict = |law: &ShearLaw| -> Vec<f64> {
-        obs.iter()
-            .map(|o| o.terms.iter().map(|(g, w)| w * law.moment(*g)).sum())
-            .collect()
+        obs.iter().map(|o| o.terms.iter().map(|(g, w)| w * law.moment(*g)).sum()).collect()
     };
     let law = match kind {
         ShearLawKind::Polynomial { terms } => {
             if !(1..=MAX_POLYNOMIAL_TERMS).contains(&terms) {
-                return Err(FitError::Data(format!(
-                    "polynomial:{terms}: use 1 to {MAX_POLYNOMIAL_TERMS} terms"
-                )));
+                return Err(FitError::Data(format!("polynomial:{terms}: use 1 to {MAX_POLYNOMIAL_TERMS} terms")));
             }
             if n < terms {
                 return Err(FitError::Data(format!(
@@ -279,11 +254,7 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
                 )));
             }
             let cols: Vec<Vec<f64>> = (0..terms)
-                .map(|j| {
-                    obs.iter()
-                        .map(|o| o.terms.iter().map(|(g, w)| w * g.powi(2 * j as i32 + 1)).sum())
-                        .collect()
-                })
+                .map(|j| obs.iter().map(|o| o.terms.iter().map(|(g, w)| w * g.powi(2 * j as i32 + 1)).sum()).collect())
                 .collect();
             let (c, _) = lstsq(&cols, &targets).ok_or_else(|| {
                 FitError::Fit(format!(
@@ -296,9 +267,7 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
                 law
             } else {
                 // Not monotone: the best fit with every coefficient >= 0 (which is monotone).
-                ShearLaw::Polynomial {
-                    coefficients: nonnegative_lstsq(&cols, &targets).unwrap_or(vec![0.0; terms]),
-                }
+                ShearLaw::Polynomial { coefficients: nonnegative_lstsq(&cols, &targets).unwrap_or(vec![0.0; terms]) }
             }
         }
         ShearLawKind::TwoSlope => {
@@ -307,10 +276,7 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
                     "{n} points cannot determine g1, g2 and the locking angle: give more data"
                 )));
             }
-            let a_max = obs
-                .iter()
-                .flat_map(|o| o.terms.iter().map(|(g, _)| g.abs()))
-                .fold(0.0, f64::max);
+            let a_max = obs.iter().flat_map(|o| o.terms.iter().map(|(g, _)| g.abs())).fold(0.0, f64::max);
             if a_max <= 0.0 {
                 return Err(FitError::Data(
                     "all points are at zero shear: the data must reach beyond the locking angle".into(),
@@ -318,9 +284,7 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
             }
             let cols_at = |gl: f64| -> Vec<Vec<f64>> {
                 let col = |f: &dyn Fn(f64) -> f64| -> Vec<f64> {
-                    obs.iter()
-                        .map(|o| o.terms.iter().map(|(g, w)| w * g.signum() * f(g.abs())).sum())
-                        .collect()
+                    obs.iter().map(|o| o.terms.iter().map(|(g, w)| w * g.signum() * f(g.abs())).sum()).collect()
                 };
                 vec![col(&|a| a.min(gl)), col(&|a| (a - gl).max(0.0))]
             };
@@ -331,11 +295,7 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
             })?;
             let (p, _) =
                 lstsq(&cols_at(gl), &targets).ok_or_else(|| FitError::Fit("the two-slope fit is singular".into()))?;
-            ShearLaw::TwoSlope {
-                g1: p[0],
-                g2: p[1],
-                locking_angle_deg: gl.to_degrees(),
-            }
+            ShearLaw::TwoSlope { g1: p[0], g2: p[1], locking_angle_deg: gl.to_degrees() }
         }
     };
     law.check().map_err(|(_, m)| {
@@ -368,11 +328,7 @@ fn refine_min(grid: &[f64], f: impl Fn(f64) -> f64) -> Option<f64> {
     let (x, fx) = golden_section_min(&f, lo, hi, 200, 1e-15);
     // The best point seen: the bracket's interior points or the grid point.
     let cands = [(x, fx), (grid[k], *best)];
-    cands
-        .into_iter()
-        .filter(|c| c.1.is_finite())
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|c| c.0)
+    cands.into_iter().filter(|c| c.1.is_finite()).min_by(|a, b| a.1.total_cmp(&b.1)).map(|c| c.0)
 }
 
 /// Non-negative least squares for a few columns (at most [`MAX_POLYNOMIAL_TERMS`]): the optimum
@@ -405,10 +361,7 @@ fn lstsq(cols: &[Vec<f64>], b: &[f64]) -> Option<(Vec<f64>, f64)> {
     if n < m {
         return None;
     }
-    let norms: Vec<f64> = cols
-        .iter()
-        .map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
-        .collect();
+    let norms: Vec<f64> = cols.iter().map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt()).collect();
     if norms.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
         return None;
     }
@@ -444,10 +397,7 @@ pub fn knit_stress(p: &KnitParams, e: f64) -> f64 {
 /// The stiffening shape g(x) = 1/(1 - x)^2 - 1 - 2x = x^2 (3 - 2x)/(1 - x)^2 and dg/dx.
 fn knit_shape(x: f64) -> (f64, f64) {
     let q = 1.0 - x;
-    (
-        x * x * (3.0 - 2.0 * x) / (q * q),
-        2.0 * x * (3.0 - 3.0 * x + x * x) / (q * q * q),
-    )
+    (x * x * (3.0 - 2.0 * x) / (q * q), 2.0 * x * (3.0 - 3.0 * x + x * x) / (q * q * q))
 }
 
 /// Fit the knit law sigma(e) = C e + beta (1/(1 - alpha e)^2 - 1 - 2 alpha e) (seed 004,
@@ -466,9 +416,7 @@ pub fn fit_knit_uniaxial(data: &[(f64, f64)]) -> Result<(KnitParams, FitReport),
     check_points(data, "uniaxial")?;
     let n = data.len();
     if n < 3 {
-        return Err(FitError::Data(format!(
-            "{n} points cannot determine C, beta and alpha: give more data"
-        )));
+        return Err(FitError::Data(format!("{n} points cannot determine C, beta and alpha: give more data")));
     }
     let e_max = data.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
     if e_max <= 0.0 {
@@ -484,27 +432,10 @@ pub fn fit_knit_uniaxial(data: &[(f64, f64)]) -> Result<(KnitParams, FitReport),
     let linear_sse: f64 = data.iter().map(|(e, s)| (s - linear_c * e).powi(2)).sum();
     // At fixed alpha: C and beta by least squares (beta >= 0).
     let solve_at = |alpha: f64| -> (KnitParams, f64) {
-        let g: Vec<f64> = strain
-            .iter()
-            .map(|&e| if e > 0.0 { knit_shape(alpha * e).0 } else { 0.0 })
-            .collect();
+        let g: Vec<f64> = strain.iter().map(|&e| if e > 0.0 { knit_shape(alpha * e).0 } else { 0.0 }).collect();
         match lstsq(&[strain.clone(), g], &stress) {
-            Some((p, sse)) if p[1] >= 0.0 && p[0] > 0.0 => (
-                KnitParams {
-                    c: p[0],
-                    beta: p[1],
-                    alpha,
-                },
-                sse,
-            ),
-            _ => (
-                KnitParams {
-                    c: linear_c,
-                    beta: 0.0,
-                    alpha: 0.0,
-                },
-                linear_sse,
-            ),
+            Some((p, sse)) if p[1] >= 0.0 && p[0] > 0.0 => (KnitParams { c: p[0], beta: p[1], alpha }, sse),
+            _ => (KnitParams { c: linear_c, beta: 0.0, alpha: 0.0 }, linear_sse),
         }
     };
     // alpha = s / e_max with s in (0, KNIT_STRETCH_LIMIT]: uniform, then crowding towards the limit.
@@ -538,11 +469,7 @@ fn levenberg_marquardt(strain: &[f64], stress: &[f64], p0: KnitParams, sse0: f64
         if !(p.c > 0.0 && p.beta >= 0.0 && p.alpha >= 0.0 && p.alpha * e_max <= KNIT_STRETCH_LIMIT) {
             return None;
         }
-        let r: Vec<f64> = strain
-            .iter()
-            .zip(stress)
-            .map(|(&e, &s)| knit_stress(p, e) - s)
-            .collect();
+        let r: Vec<f64> = strain.iter().zip(stress).map(|(&e, &s)| knit_stress(p, e) - s).collect();
         let sse = r.iter().map(|x| x * x).sum();
         Some((r, sse))
     };
@@ -572,11 +499,7 @@ fn levenberg_marquardt(strain: &[f64], stress: &[f64], p0: KnitParams, sse0: f64
                 lambda *= 10.0;
                 continue;
             };
-            let q = KnitParams {
-                c: p.c + step[0],
-                beta: p.beta + step[1],
-                alpha: p.alpha + step[2],
-            };
+            let q = KnitParams { c: p.c + step[0], beta: p.beta + step[1], alpha: p.alpha + step[2] };
             match residuals(&q) {
                 Some((rq, sq)) if sq < sse => {
                     let rel = (sse - sq) / sse.max(1e-300);
@@ -627,12 +550,7 @@ pub fn parse_xy_csv(text: &str) -> Result<Vec<(f64, f64)>, String> {
             [Some(x), Some(y)] if x.is_finite() && y.is_finite() => out.push((*x, *y)),
             [Some(_), Some(_)] => return Err(format!("line {}: '{line}' holds a value that is not finite", i + 1)),
             [_, _] => {
-                let bad = fields
-                    .iter()
-                    .zip(&nums)
-                    .find(|(_, n)| n.is_none())
-                    .map(|(f, _)| *f)
-                    .unwrap_or("");
+                let bad = fields.iter().zip(&nums).find(|(_, n)| n.is_none()).map(|(f, _)| *f).unwrap_or("");
                 return Err(format!("line {}: '{bad}' is not a number (in '{line}')", i + 1));
             }
             _ => {
@@ -671,11 +589,7 @@ mod tests {
     fn coeffs(law: &ShearLaw) -> Vec<f64> {
         match law {
             ShearLaw::Polynomial { coefficients } => coefficients.clone(),
-            ShearLaw::TwoSlope {
-                g1,
-                g2,
-                locking_angle_deg,
-            } => vec![*g1, *g2, *locking_angle_deg],
+            ShearLaw::TwoSlope { g1, g2, locking_angle_deg } => vec![*g1, *g2, *locking_angle_deg],
             ShearLaw::Table(_) => unreachable!(),
         }
     }
@@ -707,10 +621,7 @@ mod tests {
         (1..=NPTS)
             .map(|i| {
                 let d = d_max * i as f64 / NPTS as f64;
-                (
-                    d,
-                    bias_extension_force(law, d, LEN, WID).unwrap() * (1.0 + amp * noise(i + 1000)),
-                )
+                (d, bias_extension_force(law, d, LEN, WID).unwrap() * (1.0 + amp * noise(i + 1000)))
             })
             .collect()
     }
@@ -718,9 +629,7 @@ mod tests {
     #[test]
     fn kinematics_agree_with_the_references() {
         // Picture frame: M = F (cos(g/2) - sin(g/2)) / (sqrt(2) L) [002 eq. 2].
-        let law = ShearLaw::Polynomial {
-            coefficients: vec![1.0, 3.0],
-        };
+        let law = ShearLaw::Polynomial { coefficients: vec![1.0, 3.0] };
         for d in [0.001, 0.01, 0.05] {
             let (g, dg) = picture_frame_angle(d, SIDE).unwrap();
             let f = picture_frame_force(&law, d, SIDE).unwrap();
@@ -749,18 +658,9 @@ mod tests {
 
     #[test]
     fn picture_frame_recovers_the_law() {
-        let poly = ShearLaw::Polynomial {
-            coefficients: vec![2.0, 5.0, 20.0],
-        };
-        let two = ShearLaw::TwoSlope {
-            g1: 3.0,
-            g2: 150.0,
-            locking_angle_deg: 37.3,
-        };
-        for (law, kind) in [
-            (&poly, ShearLawKind::Polynomial { terms: 3 }),
-            (&two, ShearLawKind::TwoSlope),
-        ] {
+        let poly = ShearLaw::Polynomial { coefficients: vec![2.0, 5.0, 20.0] };
+        let two = ShearLaw::TwoSlope { g1: 3.0, g2: 150.0, locking_angle_deg: 37.3 };
+        for (law, kind) in [(&poly, ShearLawKind::Polynomial { terms: 3 }), (&two, ShearLawKind::TwoSlope)] {
             let (fit, rep) = fit_shear_picture_frame(&pf_data(law, 0.0), SIDE, kind).unwrap();
             for (a, b) in coeffs(&fit).iter().zip(coeffs(law)) {
                 assert!(rel(*a, b) < 1e-6, "{fit:?} vs {law:?}");
@@ -776,18 +676,9 @@ mod tests {
 
     #[test]
     fn bias_extension_recovers_the_law() {
-        let poly = ShearLaw::Polynomial {
-            coefficients: vec![2.0, 5.0, 20.0],
-        };
-        let two = ShearLaw::TwoSlope {
-            g1: 3.0,
-            g2: 150.0,
-            locking_angle_deg: 37.3,
-        };
-        for (law, kind) in [
-            (&poly, ShearLawKind::Polynomial { terms: 3 }),
-            (&two, ShearLawKind::TwoSlope),
-        ] {
+        let poly = ShearLaw::Polynomial { coefficients: vec![2.0, 5.0, 20.0] };
+        let two = ShearLaw::TwoSlope { g1: 3.0, g2: 150.0, locking_angle_deg: 37.3 };
+        for (law, kind) in [(&poly, ShearLawKind::Polynomial { terms: 3 }), (&two, ShearLawKind::TwoSlope)] {
             let (fit, rep) = fit_shear_bias_extension(&be_data(law, 0.0), LEN, WID, kind).unwrap();
             for (a, b) in coeffs(&fit).iter().zip(coeffs(law)) {
                 assert!(rel(*a, b) < 1e-6, "{fit:?} vs {law:?}");
@@ -803,11 +694,7 @@ mod tests {
 
     #[test]
     fn knit_fit_recovers_the_law() {
-        let truth = KnitParams {
-            c: 500.0,
-            beta: 10.0,
-            alpha: 2.5,
-        };
+        let truth = KnitParams { c: 500.0, beta: 10.0, alpha: 2.5 };
         let data = |amp: f64| -> Vec<(f64, f64)> {
             (0..=100)
                 .map(|i| {
@@ -830,11 +717,7 @@ mod tests {
         assert!(rep.r_squared > 0.999);
         assert!(p.alpha * 0.38 <= KNIT_STRETCH_LIMIT);
         // Another parameter set: milder stiffening, data up to 94 % of 1/alpha.
-        let truth = KnitParams {
-            c: 165.0,
-            beta: 46.0,
-            alpha: 1.111,
-        };
+        let truth = KnitParams { c: 165.0, beta: 46.0, alpha: 1.111 };
         let pts: Vec<(f64, f64)> = (0..=60)
             .map(|i| {
                 let e = 0.85 * i as f64 / 60.0;
@@ -849,26 +732,16 @@ mod tests {
         // Linear data: beta = alpha = 0.
         let pts: Vec<(f64, f64)> = (0..=20).map(|i| (i as f64 * 0.01, 300.0 * i as f64 * 0.01)).collect();
         let (p, rep) = fit_knit_uniaxial(&pts).unwrap();
-        assert!(
-            rel(p.c, 300.0) < 1e-9 && p.beta.abs() < 1e-9 * 300.0 && rep.rms < 1e-9,
-            "{p:?}"
-        );
+        assert!(rel(p.c, 300.0) < 1e-9 && p.beta.abs() < 1e-9 * 300.0 && rep.rms < 1e-9, "{p:?}");
     }
 
     #[test]
     fn bad_data_is_refused() {
-        let two = ShearLaw::TwoSlope {
-            g1: 3.0,
-            g2: 150.0,
-            locking_angle_deg: 37.3,
-        };
+        let two = ShearLaw::TwoSlope { g1: 3.0, g2: 150.0, locking_angle_deg: 37.3 };
         let mut d = pf_data(&two, 0.0);
         d.push((0.2, 10.0)); // past the frame's travel (0.088 m)
         let e = fit_shear_picture_frame(&d, SIDE, ShearLawKind::TwoSlope).unwrap_err();
-        assert!(
-            matches!(e, FitError::Data(_)) && e.to_string().contains(&format!("point {}", NPTS + 1)),
-            "{e}"
-        );
+        assert!(matches!(e, FitError::Data(_)) && e.to_string().contains(&format!("point {}", NPTS + 1)), "{e}");
         assert!(fit_shear_bias_extension(&be_data(&two, 0.0), 0.1, 0.07, ShearLawKind::TwoSlope).is_err());
         let e = fit_shear_picture_frame(&[(0.01, 1.0)], SIDE, ShearLawKind::Polynomial { terms: 3 }).unwrap_err();
         assert!(e.to_string().contains("cannot determine"), "{e}");
@@ -876,10 +749,7 @@ mod tests {
         let (fit, rep) =
             fit_shear_picture_frame(&pf_data(&two, 0.0), SIDE, ShearLawKind::Polynomial { terms: 3 }).unwrap();
         let c = coeffs(&fit);
-        assert!(
-            c.iter().all(|x| *x >= 0.0) && c.contains(&0.0) && rep.r_squared > 0.9,
-            "{c:?} {rep:?}"
-        );
+        assert!(c.iter().all(|x| *x >= 0.0) && c.contains(&0.0) && rep.r_squared > 0.9, "{c:?} {rep:?}");
         // Falling data give no physical law.
         let falling: Vec<(f64, f64)> = (1..30).map(|i| (i as f64 * 0.002, -(i as f64))).collect();
         let e = fit_shear_picture_frame(&falling, SIDE, ShearLawKind::Polynomial { terms: 2 }).unwrap_err();
@@ -889,14 +759,8 @@ mod tests {
 
     #[test]
     fn law_kinds_parse() {
-        assert_eq!(
-            "polynomial:3".parse::<ShearLawKind>(),
-            Ok(ShearLawKind::Polynomial { terms: 3 })
-        );
-        assert_eq!(
-            "polynomial".parse::<ShearLawKind>(),
-            Ok(ShearLawKind::Polynomial { terms: 3 })
-        );
+        assert_eq!("polynomial:3".parse::<ShearLawKind>(), Ok(ShearLawKind::Polynomial { terms: 3 }));
+        assert_eq!("polynomial".parse::<ShearLawKind>(), Ok(ShearLawKind::Polynomial { terms: 3 }));
         assert_eq!("two-slope".parse::<ShearLawKind>(), Ok(ShearLawKind::TwoSlope));
         assert!("polynomial:0".parse::<ShearLawKind>().is_err());
         assert!("polynomial:x".parse::<ShearLawKind>().is_err());
@@ -906,10 +770,7 @@ mod tests {
     #[test]
     fn csv_reading() {
         let t = "\u{feff}displacement_m,force_N\n0.0, 0.0\n\n# comment\n0.001,1.5\n2e-3;3\n0.003\t4.5\n";
-        assert_eq!(
-            parse_xy_csv(t).unwrap(),
-            vec![(0.0, 0.0), (0.001, 1.5), (0.002, 3.0), (0.003, 4.5)]
-        );
+        assert_eq!(parse_xy_csv(t).unwrap(), vec![(0.0, 0.0), (0.001, 1.5), (0.002, 3.0), (0.003, 4.5)]);
         assert_eq!(parse_xy_csv("1,2\n3,4").unwrap(), vec![(1.0, 2.0), (3.0, 4.0)]);
         let e = parse_xy_csv("d,F\n1,2\n3,x\n").unwrap_err();
         assert!(e.starts_with("line 3:") && e.contains("'x' is not a number"), "{e}");

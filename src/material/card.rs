@@ -240,21 +240,13 @@ impl ShearLaw {
                 }
                 (w, m, k)
             }
-            ShearLaw::TwoSlope {
-                g1,
-                g2,
-                locking_angle_deg,
-            } => {
+            ShearLaw::TwoSlope { g1, g2, locking_angle_deg } => {
                 let gl = locking_angle_deg.to_radians();
                 if a <= gl {
                     (0.5 * g1 * a * a, g1 * a, *g1)
                 } else {
                     let t = a - gl;
-                    (
-                        0.5 * g1 * gl * gl + g1 * gl * t + 0.5 * g2 * t * t,
-                        g1 * gl + g2 * t,
-                        *g2,
-                    )
+                    (0.5 * g1 * gl * gl + g1 * gl * t + 0.5 * g2 * t * t, g1 * gl + g2 * t, *g2)
                 }
             }
             ShearLaw::Table(t) => t.eval_abs(a),
@@ -282,10 +274,7 @@ impl ShearLaw {
         match self {
             ShearLaw::Polynomial { coefficients } => {
                 if coefficients.is_empty() {
-                    return bad(
-                        "coefficients",
-                        "must list at least c1 (N/m): M = c1 g + c3 g^3 + ...".into(),
-                    );
+                    return bad("coefficients", "must list at least c1 (N/m): M = c1 g + c3 g^3 + ...".into());
                 }
                 if let Some(c) = coefficients.iter().find(|c| !c.is_finite()) {
                     return bad("coefficients", format!("must be finite numbers, got {c}"));
@@ -312,11 +301,7 @@ impl ShearLaw {
                 }
                 Ok(())
             }
-            ShearLaw::TwoSlope {
-                g1,
-                g2,
-                locking_angle_deg,
-            } => {
+            ShearLaw::TwoSlope { g1, g2, locking_angle_deg } => {
                 for (f, v) in [("g1", g1), ("g2", g2)] {
                     if !(v.is_finite() && *v > 0.0) {
                         return bad(f, format!("must be a positive shear rigidity in N/m per rad, got {v}"));
@@ -372,45 +357,28 @@ impl ShearTable {
         }
         for (i, a) in angles_deg.iter().enumerate() {
             if !(a.is_finite() && *a >= 0.0 && *a < 90.0) {
-                return bad(
-                    "angles_deg",
-                    format!("entry {} must lie in [0, 90) degrees, got {a}", i + 1),
-                );
+                return bad("angles_deg", format!("entry {} must lie in [0, 90) degrees, got {a}", i + 1));
             }
             if i > 0 && *a <= angles_deg[i - 1] {
                 return bad(
                     "angles_deg",
-                    format!(
-                        "must be strictly increasing; entry {} ({a}) follows {}",
-                        i + 1,
-                        angles_deg[i - 1]
-                    ),
+                    format!("must be strictly increasing; entry {} ({a}) follows {}", i + 1, angles_deg[i - 1]),
                 );
             }
         }
         for (i, m) in moments.iter().enumerate() {
             if !(m.is_finite() && *m >= 0.0) {
-                return bad(
-                    "moments",
-                    format!("entry {} must be a finite moment >= 0 (N/m), got {m}", i + 1),
-                );
+                return bad("moments", format!("entry {} must be a finite moment >= 0 (N/m), got {m}", i + 1));
             }
             if i > 0 && *m < moments[i - 1] {
                 return bad(
                     "moments",
-                    format!(
-                        "must be non-decreasing; entry {} ({m}) is below {}",
-                        i + 1,
-                        moments[i - 1]
-                    ),
+                    format!("must be non-decreasing; entry {} ({m}) is below {}", i + 1, moments[i - 1]),
                 );
             }
         }
         if angles_deg[0] == 0.0 && moments[0] != 0.0 {
-            return bad(
-                "moments",
-                format!("the moment at 0 deg must be 0 (shear is odd), got {}", moments[0]),
-            );
+            return bad("moments", format!("the moment at 0 deg must be 0 (shear is odd), got {}", moments[0]));
         }
         if moments[moments.len() - 1] <= 0.0 {
             return bad("moments", "the last moment must be positive".into());
@@ -458,14 +426,7 @@ impl ShearTable {
             // Exact integral of the cubic Hermite piece.
             w[k + 1] = w[k] + h[k] * (y[k] + y[k + 1]) / 2.0 + h[k] * h[k] * (d[k] - d[k + 1]) / 12.0;
         }
-        Ok(ShearTable {
-            angles_deg,
-            moments,
-            x,
-            y,
-            d,
-            w,
-        })
+        Ok(ShearTable { angles_deg, moments, x, y, d, w })
     }
 
     /// The angles as given, degrees.
@@ -505,10 +466,7 @@ impl MaterialCard {
     /// Read and check a card file.
     pub fn load(path: &Path) -> Result<Self, MaterialError> {
         let text = std::fs::read_to_string(path).map_err(|e| {
-            MaterialError::Invalid(format!(
-                "cannot read material card {}: {e}. Check the path.",
-                path.display()
-            ))
+            MaterialError::Invalid(format!("cannot read material card {}: {e}. Check the path.", path.display()))
         })?;
         Self::parse(&text, &path.display().to_string())
     }
@@ -517,10 +475,7 @@ impl MaterialCard {
     pub fn parse(text: &str, origin: &str) -> Result<Self, MaterialError> {
         let fail = |m: String| MaterialError::Invalid(format!("material card {origin}: {m}"));
         let raw: RawCard = toml::from_str(text).map_err(|e| fail(e.to_string().trim_end().to_string()))?;
-        let mut lines = Lines {
-            text,
-            map: HashMap::new(),
-        };
+        let mut lines = Lines { text, map: HashMap::new() };
         lines.note("name", raw.name.span());
         lines.note("areal_mass", raw.areal_mass.span());
         lines.note("thickness", raw.thickness.span());
@@ -562,10 +517,7 @@ impl MaterialCard {
                             .into(),
                     )),
                 };
-                TensionLaw::Linear {
-                    warp: rigidity(&t.warp, "warp")?,
-                    weft: rigidity(&t.weft, "weft")?,
-                }
+                TensionLaw::Linear { warp: rigidity(&t.warp, "warp")?, weft: rigidity(&t.weft, "weft")? }
             }
             "knit" => {
                 let knit = |lines: &mut Lines, d: &Spanned<RawDir>, fibre: &str| match d.get_ref() {
@@ -573,11 +525,7 @@ impl MaterialCard {
                         lines.note(&format!("tension.{fibre}.C"), k.c.span());
                         lines.note(&format!("tension.{fibre}.beta"), k.beta.span());
                         lines.note(&format!("tension.{fibre}.alpha"), k.alpha.span());
-                        Ok(KnitParams {
-                            c: *k.c.get_ref(),
-                            beta: *k.beta.get_ref(),
-                            alpha: *k.alpha.get_ref(),
-                        })
+                        Ok(KnitParams { c: *k.c.get_ref(), beta: *k.beta.get_ref(), alpha: *k.alpha.get_ref() })
                     }
                     RawDir::Rigidity(_) => Err((
                         format!("tension.{fibre}"),
@@ -592,17 +540,10 @@ impl MaterialCard {
                 }
             }
             other => {
-                return Err(at(
-                    &lines,
-                    "tension.law",
-                    format!("unknown law '{other}': use \"linear\" or \"knit\""),
-                ));
+                return Err(at(&lines, "tension.law", format!("unknown law '{other}': use \"linear\" or \"knit\"")));
             }
         };
-        let tension = Tension {
-            law,
-            compression_factor: t.compression_factor.map(|c| c.into_inner()).unwrap_or(1.0),
-        };
+        let tension = Tension { law, compression_factor: t.compression_factor.map(|c| c.into_inner()).unwrap_or(1.0) };
 
         // [shear]
         let s = raw.shear.into_inner();
@@ -611,10 +552,7 @@ impl MaterialCard {
             ("shear.coefficients", s.coefficients.as_ref().map(|v| v.span())),
             ("shear.g1", s.g1.as_ref().map(|v| v.span())),
             ("shear.g2", s.g2.as_ref().map(|v| v.span())),
-            (
-                "shear.locking_angle_deg",
-                s.locking_angle_deg.as_ref().map(|v| v.span()),
-            ),
+            ("shear.locking_angle_deg", s.locking_angle_deg.as_ref().map(|v| v.span())),
             ("shear.angles_deg", s.angles_deg.as_ref().map(|v| v.span())),
             ("shear.moments", s.moments.as_ref().map(|v| v.span())),
         ] {
@@ -655,10 +593,7 @@ impl MaterialCard {
             return Err(at(
                 &lines,
                 &format!("shear.{f}"),
-                format!(
-                    "does not belong to law = \"{shear_law}\", which takes {}",
-                    wanted.join(", ")
-                ),
+                format!("does not belong to law = \"{shear_law}\", which takes {}", wanted.join(", ")),
             ));
         }
         if let Some(f) = wanted.iter().find(|f| !given.contains(f)) {
@@ -669,9 +604,7 @@ impl MaterialCard {
             ));
         }
         let shear = match shear_law {
-            "polynomial" => ShearLaw::Polynomial {
-                coefficients: s.coefficients.unwrap().into_inner(),
-            },
+            "polynomial" => ShearLaw::Polynomial { coefficients: s.coefficients.unwrap().into_inner() },
             "two-slope" => ShearLaw::TwoSlope {
                 g1: s.g1.unwrap().into_inner(),
                 g2: s.g2.unwrap().into_inner(),
@@ -691,10 +624,7 @@ impl MaterialCard {
             source: raw.source,
             tension,
             shear,
-            bending: Bending {
-                warp: b.warp.into_inner(),
-                weft: b.weft.into_inner(),
-            },
+            bending: Bending { warp: b.warp.into_inner(), weft: b.weft.into_inner() },
             flow: raw.flow.map(|f| {
                 let f = f.into_inner();
                 FlowProperties { fibre_volume_fraction: f.fibre_volume_fraction, fibre_radius: f.fibre_radius }
@@ -844,19 +774,9 @@ impl MaterialCard {
                 s.push_str("law = \"polynomial\" # M = c1 g + c3 g^3 + ...\n");
                 let _ = writeln!(s, "coefficients = {}", list(coefficients));
             }
-            ShearLaw::TwoSlope {
-                g1,
-                g2,
-                locking_angle_deg,
-            } => {
+            ShearLaw::TwoSlope { g1, g2, locking_angle_deg } => {
                 s.push_str("law = \"two-slope\" # N/m per rad below / above the locking angle\n");
-                let _ = writeln!(
-                    s,
-                    "g1 = {}\ng2 = {}\nlocking_angle_deg = {}",
-                    f(*g1),
-                    f(*g2),
-                    f(*locking_angle_deg)
-                );
+                let _ = writeln!(s, "g1 = {}\ng2 = {}\nlocking_angle_deg = {}", f(*g1), f(*g2), f(*locking_angle_deg));
             }
             ShearLaw::Table(t) => {
                 s.push_str("law = \"table\" # monotone cubic through (0, 0) and these points\n");
@@ -1006,11 +926,7 @@ mod tests {
 
     fn all_cards() -> Vec<MaterialCard> {
         let mut v = Vec::new();
-        for t in [
-            LINEAR,
-            KNIT,
-            "law = \"linear\"\ncompression_factor = 0.05\nwarp = 3.0e5\nweft = 1.0e5",
-        ] {
+        for t in [LINEAR, KNIT, "law = \"linear\"\ncompression_factor = 0.05\nwarp = 3.0e5\nweft = 1.0e5"] {
             for s in [POLY, TWO, TABLE] {
                 v.push(parse(&card_with(t, s)).unwrap());
             }
@@ -1053,14 +969,8 @@ mod tests {
                     let h = 1e-5 * e.abs().max(1e-3).min((sing - e).abs());
                     let fd1 = fd(|x| t(x).0, e, h);
                     let fd2 = fd(|x| t(x).1, e, h);
-                    assert!(
-                        close(fd1, dw, 1e-6, 1e-12 * (1.0 + w.abs() / h)),
-                        "{fibre:?} e={e}: dW {fd1} vs {dw}"
-                    );
-                    assert!(
-                        close(fd2, d2w, 1e-6, 1e-12 * (1.0 + dw.abs() / h)),
-                        "{fibre:?} e={e}: d2W {fd2} vs {d2w}"
-                    );
+                    assert!(close(fd1, dw, 1e-6, 1e-12 * (1.0 + w.abs() / h)), "{fibre:?} e={e}: dW {fd1} vs {dw}");
+                    assert!(close(fd2, d2w, 1e-6, 1e-12 * (1.0 + dw.abs() / h)), "{fibre:?} e={e}: d2W {fd2} vs {d2w}");
                 }
                 assert_eq!(t(0.0), (0.0, 0.0, t(0.0).2));
             }
@@ -1088,16 +998,8 @@ mod tests {
                     continue;
                 }
                 let (w, m, k) = card.shear(g);
-                assert!(
-                    close(fd(|x| card.shear(x).0, g, h), m, 1e-7, 1e-9),
-                    "{} g={g}: M",
-                    card.shear.law_name()
-                );
-                assert!(
-                    close(fd(|x| card.shear(x).1, g, h), k, 1e-6, 1e-8),
-                    "{} g={g}: dM",
-                    card.shear.law_name()
-                );
+                assert!(close(fd(|x| card.shear(x).0, g, h), m, 1e-7, 1e-9), "{} g={g}: M", card.shear.law_name());
+                assert!(close(fd(|x| card.shear(x).1, g, h), k, 1e-6, 1e-8), "{} g={g}: dM", card.shear.law_name());
                 let (w2, m2, k2) = card.shear(-g);
                 assert!(close(w, w2, 1e-14, 0.0) && close(m, -m2, 1e-14, 0.0) && close(k, k2, 1e-14, 0.0));
                 assert!(w >= 0.0 && m * g >= 0.0);
@@ -1163,11 +1065,7 @@ mod tests {
         simpson *= hh / 3.0;
         assert!(close(card.shear(g_end).0, simpson, 1e-8, 0.0));
         // An explicit (0, 0) gives the same law.
-        let t0 = ShearTable::new(
-            vec![0.0, 10.0, 20.0, 30.0, 40.0, 50.0],
-            vec![0.0, 0.2, 0.5, 1.1, 3.0, 12.0],
-        )
-        .unwrap();
+        let t0 = ShearTable::new(vec![0.0, 10.0, 20.0, 30.0, 40.0, 50.0], vec![0.0, 0.2, 0.5, 1.1, 3.0, 12.0]).unwrap();
         for g in [0.1, 0.3, 0.7, 1.0] {
             assert_eq!(ShearLaw::Table(t0.clone()).eval(g), card.shear(g));
         }
@@ -1175,11 +1073,7 @@ mod tests {
 
     #[test]
     fn knit_law_matches_seed_004_and_its_integral() {
-        let k = KnitParams {
-            c: 500.0,
-            beta: 10.0,
-            alpha: 2.5,
-        };
+        let k = KnitParams { c: 500.0, beta: 10.0, alpha: 2.5 };
         for e in [0.01, 0.1, 0.2, 0.3, 0.39] {
             let x: f64 = 2.5 * e;
             let sigma = 500.0 * e + 10.0 * (1.0 / (1.0 - x).powi(2) - 1.0 - 2.0 * x);
@@ -1217,11 +1111,8 @@ mod tests {
 
     #[test]
     fn linear_tension_and_bending() {
-        let card = parse(&card_with(
-            "law = \"linear\"\ncompression_factor = 0.5\nwarp = 2.0e5\nweft = 1.0e5",
-            POLY,
-        ))
-        .unwrap();
+        let card =
+            parse(&card_with("law = \"linear\"\ncompression_factor = 0.5\nwarp = 2.0e5\nweft = 1.0e5", POLY)).unwrap();
         assert_eq!(card.tension(Fibre::Warp, 0.01), (0.5 * 2.0e5 * 1e-4, 2.0e3, 2.0e5));
         assert_eq!(card.tension(Fibre::Weft, -0.01), (0.5 * 0.5e5 * 1e-4, -0.5e3, 0.5e5));
         assert_eq!(card.bending(Fibre::Warp), 1.0e-7);
@@ -1229,13 +1120,7 @@ mod tests {
         // law defaults to linear and compression_factor to 1.
         let card = parse(&card_with("warp = 200000\nweft = 1.0e5", POLY)).unwrap();
         assert_eq!(card.tension.compression_factor, 1.0);
-        assert_eq!(
-            card.tension.law,
-            TensionLaw::Linear {
-                warp: 2.0e5,
-                weft: 1.0e5
-            }
-        );
+        assert_eq!(card.tension.law, TensionLaw::Linear { warp: 2.0e5, weft: 1.0e5 });
     }
 
     #[test]
@@ -1253,31 +1138,11 @@ mod tests {
     #[test]
     fn errors_name_the_line_and_field() {
         let cases: Vec<(String, &str, usize)> = vec![
-            (
-                card_with(LINEAR, POLY).replace("areal_mass = 0.3", "areal_mass = -0.3"),
-                "`areal_mass`",
-                2,
-            ),
-            (
-                card_with(LINEAR, POLY).replace("thickness = 5.0e-4", "thickness = 0"),
-                "`thickness`",
-                3,
-            ),
-            (
-                card_with(LINEAR, POLY).replace("warp = 2.0e5", "warp = -2.0e5"),
-                "`tension.warp`",
-                7,
-            ),
-            (
-                card_with(LINEAR, POLY).replace("weft = 2.0e-7", "weft = 0.0"),
-                "`bending.weft`",
-                16,
-            ),
-            (
-                card_with(LINEAR, TWO).replace("g2 = 200.0", "g2 = -1.0"),
-                "`shear.g2`",
-                13,
-            ),
+            (card_with(LINEAR, POLY).replace("areal_mass = 0.3", "areal_mass = -0.3"), "`areal_mass`", 2),
+            (card_with(LINEAR, POLY).replace("thickness = 5.0e-4", "thickness = 0"), "`thickness`", 3),
+            (card_with(LINEAR, POLY).replace("warp = 2.0e5", "warp = -2.0e5"), "`tension.warp`", 7),
+            (card_with(LINEAR, POLY).replace("weft = 2.0e-7", "weft = 0.0"), "`bending.weft`", 16),
+            (card_with(LINEAR, TWO).replace("g2 = 200.0", "g2 = -1.0"), "`shear.g2`", 13),
             (
                 card_with(LINEAR, TWO).replace("locking_angle_deg = 35.0", "locking_angle_deg = 95.0"),
                 "`shear.locking_angle_deg`",
@@ -1294,76 +1159,28 @@ mod tests {
                 "`shear.g1`",
                 13,
             ),
-            (
-                card_with(LINEAR, POLY).replace("coefficients", "g1"),
-                "expected f64",
-                12,
-            ),
-            (
-                card_with(LINEAR, TABLE).replace("1.1, 3.0", "3.1, 3.0"),
-                "non-decreasing",
-                13,
-            ),
-            (
-                card_with(LINEAR, TABLE).replace("40.0, 50.0", "40.0, 40.0"),
-                "strictly increasing",
-                12,
-            ),
-            (
-                card_with(LINEAR, TABLE).replace(", 12.0]", "]"),
-                "one moment per angle",
-                13,
-            ),
-            (
-                card_with(KNIT, POLY).replace("beta = 10.0", "beta = -10.0"),
-                "`tension.warp.beta`",
-                9,
-            ),
-            (
-                card_with(KNIT, POLY).replace("alpha = 2.5", "gamma = 2.5"),
-                "unknown field `gamma`",
-                10,
-            ),
-            (
-                card_with(KNIT, POLY).replace("law = \"knit\"", "law = \"linear\""),
-                "`tension.warp`",
-                7,
-            ),
-            (
-                card_with(LINEAR, POLY).replace("law = \"linear\"", "law = \"knit\""),
-                "`tension.warp`",
-                7,
-            ),
+            (card_with(LINEAR, POLY).replace("coefficients", "g1"), "expected f64", 12),
+            (card_with(LINEAR, TABLE).replace("1.1, 3.0", "3.1, 3.0"), "non-decreasing", 13),
+            (card_with(LINEAR, TABLE).replace("40.0, 50.0", "40.0, 40.0"), "strictly increasing", 12),
+            (card_with(LINEAR, TABLE).replace(", 12.0]", "]"), "one moment per angle", 13),
+            (card_with(KNIT, POLY).replace("beta = 10.0", "beta = -10.0"), "`tension.warp.beta`", 9),
+            (card_with(KNIT, POLY).replace("alpha = 2.5", "gamma = 2.5"), "unknown field `gamma`", 10),
+            (card_with(KNIT, POLY).replace("law = \"knit\"", "law = \"linear\""), "`tension.warp`", 7),
+            (card_with(LINEAR, POLY).replace("law = \"linear\"", "law = \"knit\""), "`tension.warp`", 7),
             (
                 card_with(LINEAR, POLY).replace("law = \"linear\"", "law = \"neo-hookean\""),
                 "unknown law 'neo-hookean'",
                 6,
             ),
-            (
-                card_with(LINEAR, POLY).replace("law = \"polynomial\"", "law = \"cubic\""),
-                "unknown law 'cubic'",
-                11,
-            ),
-            (
-                card_with(LINEAR, POLY).replace("thickness", "thicknes"),
-                "unknown field `thicknes`",
-                3,
-            ),
-            (
-                card_with(LINEAR, POLY).replace("areal_mass = 0.3", "areal_mass = \"heavy\""),
-                "areal_mass",
-                2,
-            ),
+            (card_with(LINEAR, POLY).replace("law = \"polynomial\"", "law = \"cubic\""), "unknown law 'cubic'", 11),
+            (card_with(LINEAR, POLY).replace("thickness", "thicknes"), "unknown field `thicknes`", 3),
+            (card_with(LINEAR, POLY).replace("areal_mass = 0.3", "areal_mass = \"heavy\""), "areal_mass", 2),
             (
                 card_with(LINEAR, POLY).replace("weft = 1.0e5", "weft = 1.0e5\ncompression_factor = 2.0"),
                 "`tension.compression_factor`",
                 9,
             ),
-            (
-                card_with(LINEAR, POLY).replace("[bending]\nwarp = 1.0e-7\n", "[bending]\n"),
-                "missing field `warp`",
-                14,
-            ),
+            (card_with(LINEAR, POLY).replace("[bending]\nwarp = 1.0e-7\n", "[bending]\n"), "missing field `warp`", 14),
         ];
         let mut wrong = Vec::new();
         for (text, needle, line) in cases {
@@ -1425,10 +1242,7 @@ mod tests {
     #[test]
     fn bundled_woven_cards_lock() {
         // (card, an angle below locking, an angle past it), degrees.
-        for (file, below, past) in [
-            ("glass-plain-weave.toml", 25.0f64, 40.0f64),
-            ("carbon-twill.toml", 25.0, 55.0),
-        ] {
+        for (file, below, past) in [("glass-plain-weave.toml", 25.0f64, 40.0f64), ("carbon-twill.toml", 25.0, 55.0)] {
             let card = MaterialCard::load(&materials_dir().join(file)).unwrap();
             // Steep rise: the tangent stiffness well past locking is far above the initial one.
             let k0 = card.shear(1e-3).2;

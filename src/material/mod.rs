@@ -7,4 +7,6 @@
 pub mod calibrate;
 pub mod card;
 
-pub use card::{Bending, Fibre, FlowProperties, KnitParams, MaterialCard, MaterialError, ShearLaw, ShearTable, Tension, TensionLaw};
+pub use card::{
+    Bending, Fibre, FlowProperties, KnitParams, MaterialCard, MaterialError, ShearLaw, ShearTable, Tension, TensionLaw,
+};

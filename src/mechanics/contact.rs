@@ -56,7 +56,8 @@ pub struct NodeBasis {
 }
 
 impl NodeBasis {
-    pub const FIXED: NodeBasis = NodeBasis { dofs: 0, basis: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
+    pub const FIXED: NodeBasis =
+        NodeBasis { dofs: 0, basis: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
 
     /// Free in all three directions.
     pub fn free() -> Self {
@@ -122,7 +123,8 @@ impl Freedom {
     /// along the edge, or stays put at a corner): the tool ends, and a pressed ply does not
     /// leave it.
     pub fn basis(&self, foot: Option<&Foot>, descent: &Vector) -> NodeBasis {
-        let foot = || foot.copied().unwrap_or(Foot { point: Point::origin(), normal: Vector::z(), open_edges: [None; 2] });
+        let foot =
+            || foot.copied().unwrap_or(Foot { point: Point::origin(), normal: Vector::z(), open_edges: [None; 2] });
         // The open edges the node is pushed over, as outward directions in the tangent plane.
         let held = |f: &Foot| -> Vec<Vector> {
             f.open_edges
@@ -186,7 +188,11 @@ pub fn contact_rows(tool: &dyn ContactSurface, x: &[Point], movable: &[bool], sp
             let Foot { point: foot, normal, .. } = tool.locate(p);
             // On the tool or outside: the tool's outward normal; a node found inside gets a row
             // that pushes it back out.
-            ((p - foot).norm() <= CONTACT_RANGE * spacing).then(|| ContactRow { node: k, normal, gap: normal.dot(&(p - foot)) })
+            ((p - foot).norm() <= CONTACT_RANGE * spacing).then(|| ContactRow {
+                node: k,
+                normal,
+                gap: normal.dot(&(p - foot)),
+            })
         })
         .collect()
 }

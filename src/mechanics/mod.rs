@@ -1,11 +1,11 @@
 //! The mechanical stage: an energy model on the drape net's warp/weft grid (fibre tension, shear
 //! with locking, bending, gravity) with tool contact, minimised by sequential convex subproblems
 //! solved with Clarabel.
-pub mod energy;
-pub mod sparse;
 pub mod contact;
+pub mod energy;
 pub mod refine;
 pub mod solver;
+pub mod sparse;
 pub mod virtual_tests;
 
 pub use contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};

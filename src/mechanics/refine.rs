@@ -203,7 +203,8 @@ pub fn refine<L: Laws + ?Sized>(
         })
         .collect();
     // The residual is measured against the kinematic net's forces as given (on the facets).
-    let facet_cons = Constraints { freedom: freedom.clone(), mode: settings.mode, tool: Some(tool), spacing: kinematic.spacing };
+    let facet_cons =
+        Constraints { freedom: freedom.clone(), mode: settings.mode, tool: Some(tool), spacing: kinematic.spacing };
     let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
@@ -215,7 +216,9 @@ pub fn refine<L: Laws + ?Sized>(
     }
     // Energies under the full load, for comparison with the result. The first step carries 1/S
     // of the load, so the full load does (S - 1) times more work.
-    let full_load = |objective: &NetObjective, x: &[Point]| objective.evaluate(x, false).energy - (settings.load_steps - 1) as f64 * objective.work(x);
+    let full_load = |objective: &NetObjective, x: &[Point]| {
+        objective.evaluate(x, false).energy - (settings.load_steps - 1) as f64 * objective.work(x)
+    };
     let energy_kinematic = full_load(&objective, &kinematic.positions);
     let energy_start = full_load(&objective, &x);
     for step in 1..=settings.load_steps {
@@ -247,7 +250,12 @@ pub fn cell_changes(before: &DrapeNet, after: &DrapeNet) -> Vec<Option<(f64, f64
     let mut out = Vec::with_capacity(before.num_cells());
     for i in 0..before.nu - 1 {
         for j in 0..before.nv - 1 {
-            let c = match (before.cell_shear(i, j), after.cell_shear(i, j), before.cell_frame(i, j), after.cell_frame(i, j)) {
+            let c = match (
+                before.cell_shear(i, j),
+                after.cell_shear(i, j),
+                before.cell_frame(i, j),
+                after.cell_frame(i, j),
+            ) {
                 (Some(g0), Some(g1), Some(f0), Some(f1)) => Some((g1 - g0, f0.warp.angle(&f1.warp))),
                 _ => None,
             };
@@ -262,10 +270,7 @@ pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, mat
     let changes = cell_changes(kinematic, &refined.net);
     let shear: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(g, _)| g.to_degrees())).collect();
     let angle: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(_, a)| a.to_degrees())).collect();
-    out.meta.insert(
-        "change_from_kinematic".into(),
-        serde_json::json!({"shear_deg": shear, "warp_angle_deg": angle}),
-    );
+    out.meta.insert("change_from_kinematic".into(), serde_json::json!({"shear_deg": shear, "warp_angle_deg": angle}));
     out.meta.insert("material".into(), serde_json::json!(material.display().to_string()));
     out.meta.insert(
         "solver".into(),
@@ -278,4 +283,3 @@ pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, mat
         }),
     );
 }
-

@@ -3,12 +3,12 @@
 //! Clarabel; the step is accepted if the energy falls as predicted, else the damping grows.
 use super::contact::{contact_rows, ContactMode, ContactRow, ContactSurface, Foot, Freedom, NodeBasis};
 use crate::geometry::{Point, Vector};
-use rayon::prelude::*;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT,
 };
 use nalgebra::Matrix3;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// The energy of a net and its derivatives, as the solver needs them.
@@ -175,7 +175,11 @@ impl Reduction {
                         continue;
                     }
                     // Upper triangle: row <= column.
-                    let (r, c, src) = if r <= c { (r, c, (a as u32, b as u32, p as u8, q as u8)) } else { (c, r, (a as u32, b as u32, p as u8, q as u8)) };
+                    let (r, c, src) = if r <= c {
+                        (r, c, (a as u32, b as u32, p as u8, q as u8))
+                    } else {
+                        (c, r, (a as u32, b as u32, p as u8, q as u8))
+                    };
                     columns[c].push((r, src));
                 }
             }
@@ -208,7 +212,9 @@ impl Reduction {
                 let blk = match cache {
                     Some((key, m)) if key == (a, b) => m,
                     _ => {
-                        let m = bases[a as usize].basis.transpose() * h.block(a as usize, b as usize) * bases[b as usize].basis;
+                        let m = bases[a as usize].basis.transpose()
+                            * h.block(a as usize, b as usize)
+                            * bases[b as usize].basis;
                         cache = Some(((a, b), m));
                         m
                     }
@@ -296,7 +302,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     // FORCE_NOISE fraction of the spacing through the model's mean stiffness.
     let mean_stiffness = {
         let h = reduction.values(eval.hessian.as_deref().expect("hessian requested"), &bases);
-        reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| h[k].abs()).sum::<f64>() / reduction.n.max(1) as f64
+        reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| h[k].abs()).sum::<f64>()
+            / reduction.n.max(1) as f64
     };
     let noise = FORCE_NOISE * mean_stiffness * cons.spacing * (reduction.n as f64).sqrt();
     let force_scale = settings.force_scale.unwrap_or_else(|| start_forces(&reduction, &eval, &bases)).max(noise);
@@ -475,7 +482,13 @@ fn quad(r: &Reduction, p: &[f64], y: &[f64]) -> f64 {
 
 /// Solve min 1/2 y^T P y + g^T y subject to the linearised contact rows, with Clarabel.
 /// Returns the step and Clarabel's iteration count, or None if it failed.
-fn solve_qp(r: &Reduction, pvals: &[f64], g: &[f64], rows: &[ContactRow], bases: &[NodeBasis]) -> Option<(Vec<f64>, u32)> {
+fn solve_qp(
+    r: &Reduction,
+    pvals: &[f64],
+    g: &[f64],
+    rows: &[ContactRow],
+    bases: &[NodeBasis],
+) -> Option<(Vec<f64>, u32)> {
     let p = CscMatrix::new(r.n, r.n, r.colptr.clone(), r.rowval.clone(), pvals.to_vec());
     // Contact: normal . (B_k y_k) + gap >= 0  ->  -normal^T B_k y_k + s = gap, s >= 0.
     let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); r.n];
@@ -518,7 +531,9 @@ fn solve_qp(r: &Reduction, pvals: &[f64], g: &[f64], rows: &[ContactRow], bases:
     let mut solver = DefaultSolver::new(&p, g, &a, &b, &cones, settings).ok()?;
     solver.solve();
     match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => Some((solver.solution.x.clone(), solver.solution.iterations)),
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            Some((solver.solution.x.clone(), solver.solution.iterations))
+        }
         _ => None,
     }
 }
@@ -581,7 +596,8 @@ mod tests {
         let targets = vec![Point::new(0.2, 0.1, -1.0), Point::new(-0.5, 0.3, -0.5), Point::new(0.1, 0.1, 2.0)];
         let obj = Springs { targets, k: 10.0 };
         let mut x = vec![Point::new(0.0, 0.0, 0.5), Point::new(0.0, 0.0, 0.3), Point::new(0.0, 0.0, 0.1)];
-        let cons = Constraints { freedom: vec![Freedom::Free; 3], mode: ContactMode::Free, tool: Some(&tool), spacing: 1.0 };
+        let cons =
+            Constraints { freedom: vec![Freedom::Free; 3], mode: ContactMode::Free, tool: Some(&tool), spacing: 1.0 };
         let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
         assert!(report.ok(), "{report:?}");
         assert!(x[0].z.abs() < 1e-6 && (x[0].x - 0.2).abs() < 1e-6, "{}", x[0]);
@@ -597,7 +613,8 @@ mod tests {
         let obj = Springs { targets: vec![target], k: 1.0 };
         let start = tool.closest_point(&Point::new(0.0, 0.0, 1.0));
         let mut x = vec![start.point];
-        let cons = Constraints { freedom: vec![Freedom::OnTool], mode: ContactMode::Pressed, tool: Some(&tool), spacing: 0.1 };
+        let cons =
+            Constraints { freedom: vec![Freedom::OnTool], mode: ContactMode::Pressed, tool: Some(&tool), spacing: 0.1 };
         let report = solve(&obj, &mut x, &cons, &SolverSettings::default());
         assert!(report.ok(), "{report:?}");
         assert!(tool.closest_point(&x[0]).distance < 1e-12);
@@ -613,7 +630,12 @@ mod tests {
         let target = Point::new(0.6, 0.0, 1.2);
         let obj = Springs { targets: vec![target], k: 1.0 };
         let mut x = vec![smooth.project(&Point::new(0.0, 0.0, 1.0)).point];
-        let cons = Constraints { freedom: vec![Freedom::OnTool], mode: ContactMode::Pressed, tool: Some(&smooth), spacing: 0.1 };
+        let cons = Constraints {
+            freedom: vec![Freedom::OnTool],
+            mode: ContactMode::Pressed,
+            tool: Some(&smooth),
+            spacing: 0.1,
+        };
         let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
         assert!(report.ok(), "{report:?}");
         let s = smooth.project(&x[0]);
@@ -638,7 +660,12 @@ mod tests {
         let targets = vec![Point::new(1.5, 0.3, 0.0), Point::new(1.4, 1.6, 0.0)];
         let obj = Springs { targets, k: 1.0 };
         let mut x = vec![Point::new(0.2, 0.0, 0.0), Point::new(0.5, 0.5, 0.0)];
-        let cons = Constraints { freedom: vec![Freedom::OnTool; 2], mode: ContactMode::Pressed, tool: Some(&tool), spacing: 0.1 };
+        let cons = Constraints {
+            freedom: vec![Freedom::OnTool; 2],
+            mode: ContactMode::Pressed,
+            tool: Some(&tool),
+            spacing: 0.1,
+        };
         let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
         assert_eq!(report.outcome, Outcome::Converged, "{report:?}");
         assert!((x[0] - Point::new(1.0, 0.3, 0.0)).norm() < 1e-9, "{}", x[0]);

@@ -363,7 +363,15 @@ pub fn picture_frame_observed<L: Laws + ?Sized>(
     }
     // d gamma / d d = 1 / (side sin(phi/2)).
     let shear_rate = move |d: f64| 1.0 / (side * cs(d).1);
-    let rig = Rig { grid, reference, freedom, held, place: Box::new(place), rate: Box::new(rate), shear_rate: Box::new(shear_rate) };
+    let rig = Rig {
+        grid,
+        reference,
+        freedom,
+        held,
+        place: Box::new(place),
+        rate: Box::new(rate),
+        shear_rate: Box::new(shear_rate),
+    };
     Ok(run_rig(laws, rig, dmax, spec.steps, (side, side, h), notes, observe))
 }
 
@@ -464,7 +472,8 @@ pub fn bias_extension_observed<L: Laws + ?Sized>(
     let reference: Vec<Point> = (0..n * n).map(|q| pos(q / nv, q % nv)).collect();
     let x_end = 2.0 * p as f64 * a;
     let half = k as f64 * a;
-    let mut active: Vec<bool> = reference.iter().map(|q| q.x >= -a - tol && q.x <= x_end + a + tol && q.y.abs() <= half + tol).collect();
+    let mut active: Vec<bool> =
+        reference.iter().map(|q| q.x >= -a - tol && q.x <= x_end + a + tol && q.y.abs() <= half + tol).collect();
     // Nodes that are a corner of no complete cell take no part (no energy would hold them).
     let mut used = vec![false; n * n];
     for i in 0..n - 1 {
@@ -508,7 +517,15 @@ pub fn bias_extension_observed<L: Laws + ?Sized>(
         let c = (d_net + d) / (sqrt2 * d_net);
         sqrt2 / (d_net * (1.0 - c * c).max(0.0).sqrt())
     };
-    let rig = Rig { grid, reference, freedom, held, place: Box::new(place), rate: Box::new(rate), shear_rate: Box::new(shear_rate) };
+    let rig = Rig {
+        grid,
+        reference,
+        freedom,
+        held,
+        place: Box::new(place),
+        rate: Box::new(rate),
+        shear_rate: Box::new(shear_rate),
+    };
     Ok(run_rig(laws, rig, dmax, spec.steps, (x_end, 2.0 * half, h), notes, observe))
 }
 
@@ -526,7 +543,8 @@ fn run_rig<L: Laws + ?Sized>(
     observe: &mut dyn FnMut(&ShearState),
 ) -> ShearTest {
     let objective = NetObjective::new(rig.grid.clone(), laws, Vector::zeros());
-    let cons = Constraints { freedom: rig.freedom.clone(), mode: ContactMode::None, tool: None, spacing: rig.grid.spacing };
+    let cons =
+        Constraints { freedom: rig.freedom.clone(), mode: ContactMode::None, tool: None, spacing: rig.grid.spacing };
     let settings = SolverSettings::default().max_iterations(300).tolerance(SHEAR_TEST_TOLERANCE);
     let free: Vec<usize> = (0..rig.freedom.len()).filter(|&q| rig.freedom[q].dofs() > 0).collect();
     let mut x = rig.reference.clone();
@@ -545,8 +563,10 @@ fn run_rig<L: Laws + ?Sized>(
         let nominal = (target - d) * (rig.shear_rate)(target);
         let parts = (nominal / SHEAR_TEST_MAX_SHEAR_INCREMENT).ceil().clamp(1.0, 10_000.0) as usize;
         let start = d;
-        let mut pending: Vec<(f64, usize)> =
-            (1..=parts).rev().map(|p| (if p == parts { target } else { start + (target - start) * p as f64 / parts as f64 }, 0)).collect();
+        let mut pending: Vec<(f64, usize)> = (1..=parts)
+            .rev()
+            .map(|p| (if p == parts { target } else { start + (target - start) * p as f64 / parts as f64 }, 0))
+            .collect();
         while let Some((to, depth)) = pending.pop() {
             let before = x.clone();
             if let Some((inc, dd)) = &last {
@@ -583,7 +603,14 @@ fn run_rig<L: Laws + ?Sized>(
         force.push(fx);
         completed = step;
         at_step.copy_from_slice(&x);
-        observe(&ShearState { step, displacement: d, force: fx, grid: &rig.grid, reference: &rig.reference, nodes: &x });
+        observe(&ShearState {
+            step,
+            displacement: d,
+            force: fx,
+            grid: &rig.grid,
+            reference: &rig.reference,
+            nodes: &x,
+        });
     }
     ShearTest {
         grid: rig.grid,

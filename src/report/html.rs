@@ -25,11 +25,19 @@ fn num(x: Option<f64>, digits: usize) -> String {
 /// Facts about a net worth showing next to its pictures.
 pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
     let mut f = vec![
-        ("grid".to_string(), format!("{} × {} nodes, origin node ({}, {})", net.nu, net.nv, net.origin_node.0, net.origin_node.1)),
+        (
+            "grid".to_string(),
+            format!("{} × {} nodes, origin node ({}, {})", net.nu, net.nv, net.origin_node.0, net.origin_node.1),
+        ),
         ("fibre spacing".to_string(), format!("{:.2} mm", net.spacing * 1e3)),
     ];
     let placed = net.status.iter().filter(|s| **s == crate::kinematic::NodeStatus::Placed).count();
-    let failed: Vec<String> = net.status_counts().into_iter().filter(|(s, _)| s.name() != "placed").map(|(s, n)| format!("{n} {}", s.name())).collect();
+    let failed: Vec<String> = net
+        .status_counts()
+        .into_iter()
+        .filter(|(s, _)| s.name() != "placed")
+        .map(|(s, n)| format!("{n} {}", s.name()))
+        .collect();
     let mut nodes = format!("{placed} of {} placed", net.status.len());
     if !failed.is_empty() {
         nodes += &format!(" ({})", failed.join(", "));
@@ -46,8 +54,14 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
             f.push(("solver outcome".to_string(), o));
         }
     }
-    if let Some(a) = net.meta.get("change_from_kinematic").and_then(|c| c.get("warp_angle_deg")).and_then(|a| a.as_array()) {
-        let max = a.iter().filter_map(|v| v.as_f64()).filter(|v| v.is_finite()).fold(None, |m: Option<f64>, v| Some(m.map_or(v.abs(), |m| m.max(v.abs()))));
+    if let Some(a) =
+        net.meta.get("change_from_kinematic").and_then(|c| c.get("warp_angle_deg")).and_then(|a| a.as_array())
+    {
+        let max = a
+            .iter()
+            .filter_map(|v| v.as_f64())
+            .filter(|v| v.is_finite())
+            .fold(None, |m: Option<f64>, v| Some(m.map_or(v.abs(), |m| m.max(v.abs()))));
         if let Some(m) = max {
             f.push(("largest warp direction change".to_string(), format!("{m:.2}°")));
         }
@@ -107,7 +121,12 @@ pub(crate) fn page(p: &Page) -> String {
                     let _ = writeln!(h, "<h3>{}</h3>\n<div class=\"pattern\">{svg}</div>", escape(name));
                 }
                 Err(link) => {
-                    let _ = writeln!(h, "<h3>{0}</h3>\n<p><a href=\"{1}\">{0}</a> (too large to show inline)</p>", escape(name), escape(link));
+                    let _ = writeln!(
+                        h,
+                        "<h3>{0}</h3>\n<p><a href=\"{1}\">{0}</a> (too large to show inline)</p>",
+                        escape(name),
+                        escape(link)
+                    );
                 }
             }
         }
@@ -122,7 +141,10 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
         "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
     );
     for r in rows {
-        let material = r.material.as_deref().map(|m| std::path::Path::new(m).file_stem().map_or(m.to_string(), |s| s.to_string_lossy().into_owned()));
+        let material = r
+            .material
+            .as_deref()
+            .map(|m| std::path::Path::new(m).file_stem().map_or(m.to_string(), |s| s.to_string_lossy().into_owned()));
         let _ = writeln!(
             h,
             "<tr class=\"ply\"><td class=\"t\"><a href=\"#ply-{0}\">{0}</a></td><td class=\"t\">{1}</td><td>{2}</td><td class=\"t\">{3}</td><td>{4}</td><td>{5}</td><td>{6}</td><td>{7}</td><td>{8}</td><td>{9}</td><td>{10}</td></tr>",
@@ -144,7 +166,8 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
 
 fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
     let name = escape(&ply.name);
-    let _ = writeln!(h, "<h2 id=\"ply-{name}\">Ply {name} <span class=\"small\">({})</span></h2>", method_name(ply.method));
+    let _ =
+        writeln!(h, "<h2 id=\"ply-{name}\">Ply {name} <span class=\"small\">({})</span></h2>", method_name(ply.method));
     let _ = writeln!(h, "<dl>");
     let summary = [
         ("complete cells".to_string(), ply.cells.to_string()),

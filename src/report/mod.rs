@@ -158,10 +158,9 @@ pub fn read_layup(dir: &Path) -> Result<Option<Layup>, ReportError> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(ReportError::Layup { path, message: format!("cannot read it: {e}") }),
     };
-    serde_json::from_slice(&bytes).map(Some).map_err(|e| ReportError::Layup {
-        path,
-        message: format!("line {}, column {}: {e}", e.line(), e.column()),
-    })
+    serde_json::from_slice(&bytes)
+        .map(Some)
+        .map_err(|e| ReportError::Layup { path, message: format!("line {}, column {}: {e}", e.line(), e.column()) })
 }
 
 /// Per-cell statistics of a net (degrees, m^2).
@@ -232,15 +231,18 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
 /// among [`TOOL_SCALES`], those under which the most nodes lie inside the scaled tool's bounding
 /// box (grown by 5% of its diagonal), the one whose box size is closest to the net's.
 fn guess_scale(tool: &RawTool, net: &DrapeNet) -> f64 {
-    let placed: Vec<&Point> = net.positions.iter().zip(&net.status).filter(|(_, s)| **s == crate::kinematic::NodeStatus::Placed).map(|(p, _)| p).collect();
+    let placed: Vec<&Point> = net
+        .positions
+        .iter()
+        .zip(&net.status)
+        .filter(|(_, s)| **s == crate::kinematic::NodeStatus::Placed)
+        .map(|(p, _)| p)
+        .collect();
     let tool_diag = (tool.hi - tool.lo).norm();
     let net_diag = crate::geometry::surface::bounding_diagonal(&placed.iter().map(|p| **p).collect::<Vec<_>>());
     let inside = |s: f64| {
         let grow = 0.05 * s * tool_diag;
-        placed
-            .iter()
-            .filter(|p| (0..3).all(|k| p[k] >= s * tool.lo[k] - grow && p[k] <= s * tool.hi[k] + grow))
-            .count()
+        placed.iter().filter(|p| (0..3).all(|k| p[k] >= s * tool.lo[k] - grow && p[k] <= s * tool.hi[k] + grow)).count()
     };
     let counts: Vec<usize> = TOOL_SCALES.iter().map(|&s| inside(s)).collect();
     let most = counts.iter().copied().max().unwrap_or(0);
@@ -311,7 +313,12 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                     order.push(r.name.clone());
                 }
             } else {
-                notes.push(format!("{LAYUP_FILE} lists ply '{}' but {} has no {}{NET_SUFFIX}: not drawn.", r.name, dir.display(), r.name));
+                notes.push(format!(
+                    "{LAYUP_FILE} lists ply '{}' but {} has no {}{NET_SUFFIX}: not drawn.",
+                    r.name,
+                    dir.display(),
+                    r.name
+                ));
             }
         }
     }
@@ -325,7 +332,11 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for stem in order {
         let net = nets.remove(&stem).expect("ordered from the map's keys");
         let given = layup.as_ref().and_then(|l| l.plies.iter().find(|r| r.name == stem)).cloned();
-        let locking_deg = given.as_ref().and_then(|r| r.locking_angle_deg).filter(|a| a.is_finite() && *a > 0.0).unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
+        let locking_deg = given
+            .as_ref()
+            .and_then(|r| r.locking_angle_deg)
+            .filter(|a| a.is_finite() && *a > 0.0)
+            .unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
         let (_, st) = shear_by_cell(&net, locking_deg);
         let row = given.unwrap_or_else(|| LayupRow {
             name: stem.clone(),
@@ -340,12 +351,23 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
             draped_area_m2: Some(st.area),
             offset_m: None,
         });
-        let recorded = net.meta.get("tool").and_then(|t| t.as_str()).map(str::to_string).or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
+        let recorded = net
+            .meta
+            .get("tool")
+            .and_then(|t| t.as_str())
+            .map(str::to_string)
+            .or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
         let (tool, tool_note) = match recorded {
             None => (None, Some("the net records no tool file: drawn without the tool".to_string())),
             Some(t) => match locate_tool(&t, dir) {
                 Some(p) => (Some(p), None),
-                None => (None, Some(format!("tool {t} not found (looked relative to the current folder and to {}): drawn without the tool", dir.display()))),
+                None => (
+                    None,
+                    Some(format!(
+                        "tool {t} not found (looked relative to the current folder and to {}): drawn without the tool",
+                        dir.display()
+                    )),
+                ),
             },
         };
         inputs.push(PlyInput { stem, net, locking_deg, row, tool, tool_note });
@@ -370,8 +392,10 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     }
     bar.set_message("drawing");
 
-    let reports: Vec<Result<PlyReport, ReportError>> =
-        inputs.par_iter().map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), out, &bar)).collect();
+    let reports: Vec<Result<PlyReport, ReportError>> = inputs
+        .par_iter()
+        .map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), out, &bar))
+        .collect();
     let mut plies = Vec::new();
     for r in reports {
         plies.push(r?);
@@ -384,9 +408,8 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     // Flat patterns: every *.svg of the run folder.
     let mut patterns = Vec::new();
     // A report written into DIR itself leaves its own pictures there: those are not patterns.
-    let own_picture = |name: &str| {
-        PICTURES.iter().any(|kind| inputs.iter().any(|i| name == format!("{}-{kind}.svg", i.stem)))
-    };
+    let own_picture =
+        |name: &str| PICTURES.iter().any(|kind| inputs.iter().any(|i| name == format!("{}-{kind}.svg", i.stem)));
     for p in entries.iter().filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg")) && p.is_file()) {
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         if own_picture(&name) {
@@ -445,7 +468,12 @@ mod tests {
 
     #[test]
     fn tool_scale_is_the_one_that_fits_the_net() {
-        let tool = |k: f64| RawTool { vertices: vec![], triangles: vec![], lo: Point::new(-k, -k, 0.0), hi: Point::new(k, k, k) };
+        let tool = |k: f64| RawTool {
+            vertices: vec![],
+            triangles: vec![],
+            lo: Point::new(-k, -k, 0.0),
+            hi: Point::new(k, k, k),
+        };
         let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
         for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
             net.positions[k] = Point::new(p.0, p.1, 0.09);
@@ -464,7 +492,12 @@ pub(crate) fn method_name(m: Method) -> &'static str {
 }
 
 /// Draw one ply's pictures into `out`.
-fn draw_ply(input: &PlyInput, tool: Option<&Result<RawTool, String>>, out: &Path, bar: &ProgressBar) -> Result<PlyReport, ReportError> {
+fn draw_ply(
+    input: &PlyInput,
+    tool: Option<&Result<RawTool, String>>,
+    out: &Path,
+    bar: &ProgressBar,
+) -> Result<PlyReport, ReportError> {
     let net = &input.net;
     let (values, st) = shear_by_cell(net, input.locking_deg);
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
@@ -496,7 +529,8 @@ fn draw_ply(input: &PlyInput, tool: Option<&Result<RawTool, String>>, out: &Path
     ];
     let mut map = render::layout_map(net, &values, layer.as_ref(), limit);
     map.title = format!("Ply {}: shear angle ({kind})", input.stem);
-    map.subtitle = format!("{} cells, view along the mean ply normal tilted {VIEW_TILT_DEG:.0}°; {tool_text}", st.cells);
+    map.subtitle =
+        format!("{} cells, view along the mean ply normal tilted {VIEW_TILT_DEG:.0}°; {tool_text}", st.cells);
     map.bar_label = "shear angle (deg)".into();
     map.marks = lock_marks.clone();
     let mut files = Vec::new();
@@ -518,7 +552,12 @@ fn draw_ply(input: &PlyInput, tool: Option<&Result<RawTool, String>>, out: &Path
         x_label: "shear angle γ (deg)".into(),
         marks: lock_marks,
     };
-    write_pair(&name("histogram"), |r| render::draw_histogram(r, &hist), |r| render::draw_histogram(r, &hist), &mut files)?;
+    write_pair(
+        &name("histogram"),
+        |r| render::draw_histogram(r, &hist),
+        |r| render::draw_histogram(r, &hist),
+        &mut files,
+    )?;
     bar.inc(1);
 
     if net.method == Method::Mechanical {
@@ -553,14 +592,16 @@ fn draw_ply(input: &PlyInput, tool: Option<&Result<RawTool, String>>, out: &Path
 /// The per-cell shear change (degrees) a mechanical net records in meta
 /// "change_from_kinematic"."shear_deg".
 fn change_values(net: &DrapeNet) -> Result<Vec<Option<f64>>, String> {
-    let arr = net
-        .meta
-        .get("change_from_kinematic")
-        .and_then(|c| c.get("shear_deg"))
-        .and_then(|s| s.as_array())
-        .ok_or("the net has no \"change_from_kinematic\".\"shear_deg\" (written by `drape refine` and `drape run`)")?;
+    let arr =
+        net.meta.get("change_from_kinematic").and_then(|c| c.get("shear_deg")).and_then(|s| s.as_array()).ok_or(
+            "the net has no \"change_from_kinematic\".\"shear_deg\" (written by `drape refine` and `drape run`)",
+        )?;
     if arr.len() != net.num_cells() {
-        return Err(format!("\"change_from_kinematic\".\"shear_deg\" has {} entries but the net has {} cells", arr.len(), net.num_cells()));
+        return Err(format!(
+            "\"change_from_kinematic\".\"shear_deg\" has {} entries but the net has {} cells",
+            arr.len(),
+            net.num_cells()
+        ));
     }
     Ok(arr.iter().map(|v| v.as_f64().filter(|x| x.is_finite())).collect())
 }
@@ -568,8 +609,12 @@ fn change_values(net: &DrapeNet) -> Result<Vec<Option<f64>>, String> {
 /// Render a picture to `<base>.png` and `<base>.svg`, atomically, and record the paths.
 fn write_pair(
     base: &Path,
-    png: impl Fn(&plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>) -> render::DrawResult,
-    svg: impl Fn(&plotters::drawing::DrawingArea<plotters::prelude::SVGBackend, plotters::coord::Shift>) -> render::DrawResult,
+    png: impl Fn(
+        &plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>,
+    ) -> render::DrawResult,
+    svg: impl Fn(
+        &plotters::drawing::DrawingArea<plotters::prelude::SVGBackend, plotters::coord::Shift>,
+    ) -> render::DrawResult,
     files: &mut Vec<PathBuf>,
 ) -> Result<(), ReportError> {
     let with_ext = |ext: &str| {

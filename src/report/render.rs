@@ -293,8 +293,12 @@ pub fn draw_map<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pic: &MapPict
     root.draw(&Text::new(pic.subtitle.clone(), (20, 44), font(14.0).color(&RGBColor(90, 90, 90)))).map_err(de)?;
     if pic.cells.is_empty() {
         let style = font(20.0).color(&BLACK).pos(Pos::new(HPos::Center, VPos::Center));
-        root.draw(&Text::new("no complete cells to draw", (((WIDTH - BAR_COLUMN_PX) / 2) as i32, (HEIGHT / 2) as i32), style))
-            .map_err(de)?;
+        root.draw(&Text::new(
+            "no complete cells to draw",
+            (((WIDTH - BAR_COLUMN_PX) / 2) as i32, (HEIGHT / 2) as i32),
+            style,
+        ))
+        .map_err(de)?;
     }
     if let Some((x, y, len, label)) = &pic.scale_bar {
         root.draw(&Rectangle::new([(*x, *y - 3), (*x + *len, *y + 3)], BLACK.filled())).map_err(de)?;
@@ -306,7 +310,12 @@ pub fn draw_map<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pic: &MapPict
 
 /// The colour bar in the right column: the diverging map from -limit to +limit with ticks, a
 /// label and marked lines (the locking angle).
-fn draw_colour_bar<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, limit: f64, label: &str, marks: &[Mark]) -> DrawResult {
+fn draw_colour_bar<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    limit: f64,
+    label: &str,
+    marks: &[Mark],
+) -> DrawResult {
     let (_, column) = root.split_horizontally(WIDTH - BAR_COLUMN_PX);
     let mut chart = ChartBuilder::on(&column)
         .margin_top(TITLE_PX + 10)
@@ -337,7 +346,9 @@ fn draw_colour_bar<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, limit: f64
         }))
         .map_err(de)?;
     for m in marks {
-        chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, m.value), (1.0, m.value)], BLACK.stroke_width(2)))).map_err(de)?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(vec![(0.0, m.value), (1.0, m.value)], BLACK.stroke_width(2))))
+            .map_err(de)?;
         let (x, y) = chart.backend_coord(&(1.0, m.value));
         let style = font(13.0).color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center));
         root.draw(&Text::new(m.label.clone(), (x + 6, y), style)).map_err(de)?;
@@ -417,12 +428,21 @@ pub fn draw_histogram<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pic: &H
         }))
         .map_err(de)?;
     for m in &pic.marks {
-        chart.draw_series(std::iter::once(PathElement::new(vec![(m.value, 0.0), (m.value, ymax)], BLACK.stroke_width(2)))).map_err(de)?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(m.value, 0.0), (m.value, ymax)],
+                BLACK.stroke_width(2),
+            )))
+            .map_err(de)?;
         // Labels sit inside the band between the marks, next to their line.
         let (hpos, dx) = if m.value < 0.0 { (HPos::Left, 6) } else { (HPos::Right, -6) };
         let (x, y) = chart.backend_coord(&(m.value, ymax));
-        root.draw(&Text::new(m.label.clone(), (x + dx, y + 12), font(14.0).color(&BLACK).pos(Pos::new(hpos, VPos::Center))))
-            .map_err(de)?;
+        root.draw(&Text::new(
+            m.label.clone(),
+            (x + dx, y + 12),
+            font(14.0).color(&BLACK).pos(Pos::new(hpos, VPos::Center)),
+        ))
+        .map_err(de)?;
     }
     let (x0, y) = chart.backend_coord(&(-pic.limit, ymax));
     let (x1, _) = chart.backend_coord(&(pic.limit, ymax));

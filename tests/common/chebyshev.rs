@@ -95,9 +95,7 @@ impl Segment {
 
     fn eval_derivative(&self, s: f64) -> f64 {
         let t = s - self.center;
-        (1..ORDER)
-            .rev()
-            .fold(0.0, |acc, n| acc * t + n as f64 * self.coeffs[n])
+        (1..ORDER).rev().fold(0.0, |acc, n| acc * t + n as f64 * self.coeffs[n])
     }
 }
 
@@ -167,8 +165,8 @@ fn integrate(sign: f64, s_end: f64) -> (Vec<Segment>, Stop) {
             h = h.min(s_c.abs());
         }
         loop {
-            let tail = coeffs[ORDER - 1].abs() * h.powi(ORDER as i32 - 1)
-                + coeffs[ORDER - 2].abs() * h.powi(ORDER as i32 - 2);
+            let tail =
+                coeffs[ORDER - 1].abs() * h.powi(ORDER as i32 - 1) + coeffs[ORDER - 2].abs() * h.powi(ORDER as i32 - 2);
             if tail <= TAIL_TOL {
                 break;
             }
@@ -239,10 +237,7 @@ impl SphereChebyshev {
             radius.is_finite() && radius > 0.0,
             "SphereChebyshev: radius must be positive and finite, got {radius}"
         );
-        assert!(
-            z_max.is_finite() && z_max > 0.0,
-            "SphereChebyshev: z_max must be positive and finite, got {z_max}"
-        );
+        assert!(z_max.is_finite() && z_max > 0.0, "SphereChebyshev: z_max must be positive and finite, got {z_max}");
         let curvature = 1.0 / (radius * radius);
         let s_max = curvature * z_max;
         let (positive, stop_pos) = integrate(1.0, s_max);

@@ -96,9 +96,7 @@ fn rhs(lambda: f64, sigma: f64, y: &[f64; 4]) -> [f64; 4] {
 /// One classical RK4 step of size `dt` from `(sigma, y)`.
 #[inline]
 fn rk4_step(lambda: f64, sigma: f64, y: &[f64; 4], dt: f64) -> [f64; 4] {
-    let add = |a: &[f64; 4], k: &[f64; 4], c: f64| {
-        [a[0] + c * k[0], a[1] + c * k[1], a[2] + c * k[2], a[3] + c * k[3]]
-    };
+    let add = |a: &[f64; 4], k: &[f64; 4], c: f64| [a[0] + c * k[0], a[1] + c * k[1], a[2] + c * k[2], a[3] + c * k[3]];
     let k1 = rhs(lambda, sigma, y);
     let k2 = rhs(lambda, sigma + 0.5 * dt, &add(y, &k1, 0.5 * dt));
     let k3 = rhs(lambda, sigma + 0.5 * dt, &add(y, &k2, 0.5 * dt));
@@ -136,9 +134,7 @@ fn tip_residual(lambda: f64, k: f64, steps: usize) -> f64 {
 }
 
 fn is_physical(grid: &[[f64; 4]]) -> bool {
-    grid.iter().all(|y| {
-        y[0] >= -PHYSICAL_SLACK && y[0] <= FRAC_PI_2 + PHYSICAL_SLACK && y[1] >= -PHYSICAL_SLACK
-    })
+    grid.iter().all(|y| y[0] >= -PHYSICAL_SLACK && y[0] <= FRAC_PI_2 + PHYSICAL_SLACK && y[1] >= -PHYSICAL_SLACK)
 }
 
 /// Solves the heavy elastica with [`DEFAULT_STEPS`] RK4 steps.
@@ -154,38 +150,20 @@ pub fn heavy_elastica_with_steps(b: f64, w: f64, length: f64, steps: usize) -> E
     assert!(b > 0.0 && w >= 0.0 && length > 0.0, "need B > 0, w >= 0, L > 0");
     assert!(steps >= 16, "too few steps");
     let lambda = w * length.powi(3) / b;
-    let k = if lambda == 0.0 {
-        0.0
-    } else {
-        shoot_root(lambda, steps)
-    };
+    let k = if lambda == 0.0 { 0.0 } else { shoot_root(lambda, steps) };
     let grid = shoot(lambda, k, steps, true);
     let h = 1.0 / steps as f64;
     let s = (0..=steps).map(|i| i as f64 * h * length).collect();
     let theta = grid.iter().map(|y| y[0]).collect();
     let x = grid.iter().map(|y| y[2] * length).collect();
     let z = grid.iter().map(|y| y[3] * length).collect();
-    Elastica {
-        s,
-        theta,
-        x,
-        z,
-        b,
-        w,
-        length,
-        lambda,
-        root_curvature: k / length,
-        grid,
-        h,
-    }
+    Elastica { s, theta, x, z, b, w, length, lambda, root_curvature: k / length, grid, h }
 }
 
 /// Finds `k = θ_σ(0)` with `θ_σ(1) = 0` and a physical shape.
 fn shoot_root(lambda: f64, steps: usize) -> f64 {
     let k_max = 0.5 * lambda;
-    let ks: Vec<f64> = (0..=SCAN_INTERVALS)
-        .map(|i| k_max * i as f64 / SCAN_INTERVALS as f64)
-        .collect();
+    let ks: Vec<f64> = (0..=SCAN_INTERVALS).map(|i| k_max * i as f64 / SCAN_INTERVALS as f64).collect();
     let fs: Vec<f64> = ks.iter().map(|&k| tip_residual(lambda, k, steps)).collect();
     let mut roots = Vec::new();
     for i in 0..SCAN_INTERVALS {
@@ -223,10 +201,7 @@ fn shoot_root(lambda: f64, steps: usize) -> f64 {
     }
     roots.sort_by(f64::total_cmp);
     roots.dedup_by(|a, b| (*a - *b).abs() <= 2.0 * BISECTION_REL_WIDTH * a.abs().max(1.0));
-    let physical: Vec<f64> = roots
-        .into_iter()
-        .filter(|&k| is_physical(&shoot(lambda, k, steps, true)))
-        .collect();
+    let physical: Vec<f64> = roots.into_iter().filter(|&k| is_physical(&shoot(lambda, k, steps, true))).collect();
     assert!(
         physical.len() == 1,
         "heavy elastica, lambda = {lambda}: expected one physical shooting root, got {physical:?}"

@@ -75,13 +75,8 @@ pub fn half_angle_factor(gamma: f64) -> f64 {
 /// Shear energy per unit area `W(γ) = ∫_0^γ m(t) dt` (N/m · rad = J/m²), by composite 5-point
 /// Gauss-Legendre quadrature (exact for polynomial laws up to degree 9).
 pub fn shear_energy_density(gamma: f64, m: &dyn Fn(f64) -> f64) -> f64 {
-    const X: [f64; 5] = [
-        -0.906_179_845_938_664,
-        -0.538_469_310_105_683,
-        0.0,
-        0.538_469_310_105_683,
-        0.906_179_845_938_664,
-    ];
+    const X: [f64; 5] =
+        [-0.906_179_845_938_664, -0.538_469_310_105_683, 0.0, 0.538_469_310_105_683, 0.906_179_845_938_664];
     const WT: [f64; 5] = [
         0.236_926_885_056_189_1,
         0.478_628_670_499_366_5,
@@ -141,10 +136,7 @@ pub fn pf_moment_from_force(force: f64, d: f64, side: f64) -> f64 {
 // ------------------------------------------------------------------------------------------
 
 fn be_d(length: f64, width: f64) -> f64 {
-    assert!(
-        length >= 2.0 * width && width > 0.0,
-        "bias extension needs L >= 2W > 0 (L = {length}, W = {width})"
-    );
+    assert!(length >= 2.0 * width && width > 0.0, "bias extension needs L >= 2W > 0 (L = {length}, W = {width})");
     length - width
 }
 
@@ -201,6 +193,5 @@ pub fn be_energy(d: f64, length: f64, width: f64, m: &dyn Fn(f64) -> f64) -> f64
 pub fn be_moment_from_force(force: f64, d: f64, length: f64, width: f64, m_half: f64) -> f64 {
     let dd = be_d(length, width);
     let gc = be_shear(d, length, width);
-    force * dd * half_angle_factor(gc) / (width * (2.0 * dd - width))
-        - width / (2.0 * dd - width) * m_half
+    force * dd * half_angle_factor(gc) / (width * (2.0 * dd - width)) - width / (2.0 * dd - width) * m_half
 }

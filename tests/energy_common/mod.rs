@@ -99,7 +99,8 @@ pub fn gravity_only<'a>(grid: &Grid, m: &'a TestLaws, g: Vector) -> Model<'a> {
 }
 /// Every term but gravity.
 pub fn internal<'a>(grid: &Grid, m: &'a TestLaws) -> Model<'a> {
-    let terms: Vec<Box<dyn EnergyTerm + 'a>> = vec![Box::new(Stretch::new(m)), Box::new(Shear::new(m)), Box::new(Bending::new(m))];
+    let terms: Vec<Box<dyn EnergyTerm + 'a>> =
+        vec![Box::new(Stretch::new(m)), Box::new(Shear::new(m)), Box::new(Bending::new(m))];
     Model::with_terms(grid.clone(), terms)
 }
 /// Every term, with gravity.

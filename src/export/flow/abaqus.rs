@@ -75,7 +75,12 @@ fn write_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Result<
         let (cov, unc) = (ids(true), ids(false));
         elset(w, &tag, &cov)?;
         if !unc.is_empty() {
-            writeln!(w, "** {} element(s) not covered by ply '{}': no orientation", unc.len(), ply.ply.replace(['\n', '\r'], " "))?;
+            writeln!(
+                w,
+                "** {} element(s) not covered by ply '{}': no orientation",
+                unc.len(),
+                ply.ply.replace(['\n', '\r'], " ")
+            )?;
             elset(w, &format!("{tag}_UNCOVERED"), &unc)?;
         }
         writeln!(w, "*DISTRIBUTION, NAME={tag}_DIR, LOCATION=ELEMENT, TABLE={TABLE}")?;

@@ -20,7 +20,9 @@ mod vtu;
 
 pub use abaqus::ply_tag as abaqus_ply_tag;
 pub use csv::FLOW_CSV_HEADER;
-pub use rtmsim::{RtmsimRegion, DIRECTION_BIN_DEG, MAX_RTMSIM_SETS, PERM_LOG10_BIN, POROSITY_BIN, RATIO_BIN, THICKNESS_BIN_REL};
+pub use rtmsim::{
+    RtmsimRegion, DIRECTION_BIN_DEG, MAX_RTMSIM_SETS, PERM_LOG10_BIN, POROSITY_BIN, RATIO_BIN, THICKNESS_BIN_REL,
+};
 
 use super::flowmesh::FlowMesh;
 use super::map::{ElementFibres, LayupMap};
@@ -42,8 +44,14 @@ pub enum FlowFormat {
 
 impl FlowFormat {
     /// All formats.
-    pub const ALL: [FlowFormat; 6] =
-        [FlowFormat::Vtu, FlowFormat::Nastran, FlowFormat::Abaqus, FlowFormat::OptiStruct, FlowFormat::Rtmsim, FlowFormat::Csv];
+    pub const ALL: [FlowFormat; 6] = [
+        FlowFormat::Vtu,
+        FlowFormat::Nastran,
+        FlowFormat::Abaqus,
+        FlowFormat::OptiStruct,
+        FlowFormat::Rtmsim,
+        FlowFormat::Csv,
+    ];
 
     /// Name on the command line.
     pub fn name(self) -> &'static str {
@@ -83,7 +91,12 @@ impl std::str::FromStr for FlowFormat {
 
 /// Write `map` on `mesh` in `format` to `out` (and, for formats that need more than one file,
 /// beside it, see the module table). Returns the files written, in a fixed order.
-pub fn write_flow(mesh: &FlowMesh, map: &LayupMap, format: FlowFormat, out: &Path) -> Result<Vec<PathBuf>, ExportError> {
+pub fn write_flow(
+    mesh: &FlowMesh,
+    map: &LayupMap,
+    format: FlowFormat,
+    out: &Path,
+) -> Result<Vec<PathBuf>, ExportError> {
     check(mesh, map, format.name())?;
     match format {
         FlowFormat::Vtu => vtu::write(mesh, map, out).map(|()| vec![out.to_path_buf()]),

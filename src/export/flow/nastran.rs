@@ -48,7 +48,12 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<
     let uncovered: Vec<u64> =
         mesh.elements.iter().zip(&ply.elements).filter(|(_, f)| f.is_none()).map(|(e, _)| e.id).collect();
     if !uncovered.is_empty() {
-        writeln!(w, "$ {} element(s) not covered by ply '{}' (PID {PID_UNCOVERED}, no THETA):", uncovered.len(), ply.ply)?;
+        writeln!(
+            w,
+            "$ {} element(s) not covered by ply '{}' (PID {PID_UNCOVERED}, no THETA):",
+            uncovered.len(),
+            ply.ply
+        )?;
         for chunk in uncovered.chunks(10) {
             let ids: Vec<String> = chunk.iter().map(u64::to_string).collect();
             writeln!(w, "$   {}", ids.join(" "))?;

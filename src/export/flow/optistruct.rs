@@ -28,7 +28,10 @@ pub(super) fn write(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), E
         if let Some(f) = ply.elements.iter().flatten().find(|f| !(f.nominal_thickness > 0.0)) {
             return Err(ExportError::FlowInvalid {
                 format: "optistruct",
-                reason: format!("ply '{}' has nominal thickness {} (the thinning factor needs a positive one)", ply.ply, f.nominal_thickness),
+                reason: format!(
+                    "ply '{}' has nominal thickness {} (the thinning factor needs a positive one)",
+                    ply.ply, f.nominal_thickness
+                ),
             });
         }
     }
@@ -68,9 +71,8 @@ impl Angles {
                 }
             })
             .collect();
-        let element = (0..n)
-            .map(|e| (0..map.plies.len()).find_map(|k| nominal(k, e).map(|a| wrap(a - ply[k]))))
-            .collect();
+        let element =
+            (0..n).map(|e| (0..map.plies.len()).find_map(|k| nominal(k, e).map(|a| wrap(a - ply[k])))).collect();
         Angles { element, ply }
     }
 
@@ -89,7 +91,10 @@ fn pad8(fields: &mut Vec<String>) {
 fn write_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, angles: &Angles, w: &mut W) -> io::Result<()> {
     writeln!(w, "$ drape: ply-based composite data on flow mesh {}", mesh.path.display())?;
     writeln!(w, "$ fibre angle = element THETA + PLY THETA + DRAPE THETA (deg, from edge G1->G2).")?;
-    writeln!(w, "$ Add MAT8 {MID}, PCOMPP {PID_COVERED} and a STACK of the plies; PID {PID_UNCOVERED}: elements no ply covers.")?;
+    writeln!(
+        w,
+        "$ Add MAT8 {MID}, PCOMPP {PID_COVERED} and a STACK of the plies; PID {PID_UNCOVERED}: elements no ply covers."
+    )?;
     writeln!(w, "BEGIN BULK")?;
     write_grids(mesh, w)?;
     for (e, el) in mesh.elements.iter().enumerate() {
@@ -118,11 +123,24 @@ fn write_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, angles: &Angles, w: &mut 
         for &e in &covered {
             let f = ply.elements[e].as_ref().expect("covered");
             let thinning = f.thickness / t0;
-            drape.extend(["ELEM".to_string(), mesh.elements[e].id.to_string(), real(thinning), real(deg(angles.drape(k, e, f.theta)))]);
+            drape.extend([
+                "ELEM".to_string(),
+                mesh.elements[e].id.to_string(),
+                real(thinning),
+                real(deg(angles.drape(k, e, f.theta))),
+            ]);
             pad8(&mut drape);
         }
         large(w, "DRAPE", &drape)?;
-        let mut card = vec![id.to_string(), MID.to_string(), real(t0), real(deg(angles.ply[k])), String::new(), String::new(), id.to_string()];
+        let mut card = vec![
+            id.to_string(),
+            MID.to_string(),
+            real(t0),
+            real(deg(angles.ply[k])),
+            String::new(),
+            String::new(),
+            id.to_string(),
+        ];
         pad8(&mut card);
         card.push(id.to_string());
         large(w, "PLY", &card)?;

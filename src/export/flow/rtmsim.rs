@@ -123,7 +123,8 @@ fn cells(mesh: &FlowMesh, map: &LayupMap) -> Result<(Vec<Cell>, Vec<u64>), Expor
                 el.id
             )));
         };
-        let vf = map.mean_vf[e].ok_or_else(|| invalid(format!("element {} is covered but has no mean fibre volume fraction", el.id)))?;
+        let vf = map.mean_vf[e]
+            .ok_or_else(|| invalid(format!("element {} is covered but has no mean fibre volume fraction", el.id)))?;
         let thickness = map.thickness[e];
         let (k1, k2, dir) = principal(&k, n, u);
         if !(thickness > 0.0 && k1 > 0.0 && k2 > 0.0 && (0.0..1.0).contains(&vf)) {
@@ -183,7 +184,10 @@ pub(super) fn write(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Rtmsi
         return Err(invalid("no ply covers any element of the flow mesh: nothing to simulate".into()));
     }
     if let Some(el) = mesh.elements.iter().find(|e| e.id > MAX_ID) {
-        return Err(invalid(format!("element id {} does not fit RTMsim's 8-character fields; renumber the mesh", el.id)));
+        return Err(invalid(format!(
+            "element id {} does not fit RTMsim's 8-character fields; renumber the mesh",
+            el.id
+        )));
     }
     if let Some(id) = mesh.node_ids.iter().find(|&&id| id > MAX_ID) {
         return Err(invalid(format!("node id {id} does not fit RTMsim's 8-character fields; renumber the mesh")));
@@ -268,7 +272,12 @@ fn write_mesh<W: Write>(
     w: &mut W,
 ) -> io::Result<()> {
     writeln!(w, "$$ drape: RTMsim mesh of flow mesh {}", mesh.path.display())?;
-    writeln!(w, "$$ {} region(s): main preform + {} SET(s); quads split in two CTRIA3", regions.len(), regions.len() - 1)?;
+    writeln!(
+        w,
+        "$$ {} region(s): main preform + {} SET(s); quads split in two CTRIA3",
+        regions.len(),
+        regions.len() - 1
+    )?;
     for id in uncovered.chunks(10) {
         let s: Vec<String> = id.iter().map(u64::to_string).collect();
         writeln!(w, "$$ UNCOVERED {}", s.join(" "))?;
@@ -285,7 +294,11 @@ fn write_mesh<W: Write>(
             ElementShape::Quad4 => {
                 let d13 = (mesh.nodes[g[2]] - mesh.nodes[g[0]]).norm();
                 let d24 = (mesh.nodes[g[3]] - mesh.nodes[g[1]]).norm();
-                let (a, b) = if d13 <= d24 { ([g[0], g[1], g[2]], [g[0], g[2], g[3]]) } else { ([g[0], g[1], g[3]], [g[1], g[2], g[3]]) };
+                let (a, b) = if d13 <= d24 {
+                    ([g[0], g[1], g[2]], [g[0], g[2], g[3]])
+                } else {
+                    ([g[0], g[1], g[3]], [g[1], g[2], g[3]])
+                };
                 next_id += 1;
                 tris.push((el.id, region_of[c.e], a));
                 tris.push((next_id, region_of[c.e], b));

@@ -28,7 +28,9 @@ fn xml_escape(s: &str) -> String {
 fn write_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Result<()> {
     let n = mesh.elements.len();
     w.write_all(b"<?xml version=\"1.0\"?>\n")?;
-    w.write_all(b"<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n")?;
+    w.write_all(
+        b"<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n",
+    )?;
     writeln!(w, "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{n}\">", mesh.nodes.len())?;
     w.write_all(b"<CellData>\n")?;
     data_array(w, "Int64", "element_id", 1, mesh.elements.iter().map(|e| e.id))?;
@@ -41,7 +43,8 @@ fn write_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Result<
         };
         data_array(w, "Float64", &format!("{p}warp"), 3, vec3(|f| [f.warp.x, f.warp.y, f.warp.z]))?;
         data_array(w, "Float64", &format!("{p}weft"), 3, vec3(|f| [f.weft.x, f.weft.y, f.weft.z]))?;
-        let scalar = |pick: fn(&crate::export::map::ElementFibres) -> f64| els.iter().map(move |f| f.as_ref().map_or(0.0, pick));
+        let scalar =
+            |pick: fn(&crate::export::map::ElementFibres) -> f64| els.iter().map(move |f| f.as_ref().map_or(0.0, pick));
         data_array(w, "Float64", &format!("{p}shear_deg"), 1, scalar(|f| f.shear.to_degrees()))?;
         data_array(w, "Float64", &format!("{p}thickness"), 1, scalar(|f| f.thickness))?;
         data_array(w, "Float64", &format!("{p}vf"), 1, scalar(|f| f.vf))?;

@@ -51,7 +51,8 @@ struct Keyword {
 impl Keyword {
     fn parse(text: &str) -> Keyword {
         let mut parts = text[1..].split(',');
-        let name = parts.next().unwrap_or("").chars().filter(|c| !c.is_whitespace()).collect::<String>().to_ascii_uppercase();
+        let name =
+            parts.next().unwrap_or("").chars().filter(|c| !c.is_whitespace()).collect::<String>().to_ascii_uppercase();
         let params = parts
             .filter(|p| !p.trim().is_empty())
             .map(|p| {
@@ -91,11 +92,20 @@ fn load(b: &mut Builder, file: usize, depth: usize, out: &mut Vec<Line>) -> Resu
                     return Err(b.syntax(loc, "*INCLUDE needs INPUT=file"));
                 };
                 if depth >= MAX_INCLUDE_DEPTH {
-                    return Err(b.syntax(loc, format!("*INCLUDE nested more than {MAX_INCLUDE_DEPTH} deep: is a file including itself?")));
+                    return Err(b.syntax(
+                        loc,
+                        format!("*INCLUDE nested more than {MAX_INCLUDE_DEPTH} deep: is a file including itself?"),
+                    ));
                 }
                 let target: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default().join(input);
                 if !target.is_file() {
-                    return Err(b.syntax(loc, format!("*INCLUDE file {} does not exist (paths are relative to the including deck)", target.display())));
+                    return Err(b.syntax(
+                        loc,
+                        format!(
+                            "*INCLUDE file {} does not exist (paths are relative to the including deck)",
+                            target.display()
+                        ),
+                    ));
                 }
                 b.files.push(target);
                 let f = b.files.len() - 1;
@@ -188,14 +198,23 @@ fn parse(b: &mut Builder, lines: &[Line]) -> Result<Deck, FlowMeshError> {
                 "INSTANCE" => {
                     let name = kw.param("NAME").unwrap_or("").to_string();
                     let p = kw.param("PART").map(str::to_ascii_uppercase);
-                    deck.instances.push(Instance { name, part: p, own: Container::default(), translation: None, rotation: None, loc });
+                    deck.instances.push(Instance {
+                        name,
+                        part: p,
+                        own: Container::default(),
+                        translation: None,
+                        rotation: None,
+                        loc,
+                    });
                     instance = Some(deck.instances.len() - 1);
                     mode = Mode::InstanceData { seen: 0 };
                 }
                 "ENDINSTANCE" => instance = None,
                 "NODE" => {
                     if kw.param("INPUT").is_some() {
-                        return Err(b.syntax(loc, "*NODE, INPUT= is not supported: put the nodes in the deck or use *INCLUDE"));
+                        return Err(
+                            b.syntax(loc, "*NODE, INPUT= is not supported: put the nodes in the deck or use *INCLUDE")
+                        );
                     }
                     let cylindrical = match kw.param("SYSTEM").map(str::to_ascii_uppercase).as_deref() {
                         None | Some("R") => false,
@@ -206,9 +225,13 @@ fn parse(b: &mut Builder, lines: &[Line]) -> Result<Deck, FlowMeshError> {
                 }
                 "ELEMENT" => {
                     if kw.param("INPUT").is_some() {
-                        return Err(b.syntax(loc, "*ELEMENT, INPUT= is not supported: put the elements in the deck or use *INCLUDE"));
+                        return Err(b.syntax(
+                            loc,
+                            "*ELEMENT, INPUT= is not supported: put the elements in the deck or use *INCLUDE",
+                        ));
                     }
-                    let kind = kw.param("TYPE").ok_or_else(|| b.syntax(loc, "*ELEMENT needs TYPE="))?.to_ascii_uppercase();
+                    let kind =
+                        kw.param("TYPE").ok_or_else(|| b.syntax(loc, "*ELEMENT needs TYPE="))?.to_ascii_uppercase();
                     let property = match kw.param("ELSET") {
                         Some(s) if !s.is_empty() => {
                             let n = elsets.len() as u64 + 1;
@@ -276,7 +299,10 @@ fn parse(b: &mut Builder, lines: &[Line]) -> Result<Deck, FlowMeshError> {
             },
             Mode::InstanceData { seen } => {
                 let e = entries(&text);
-                let v: Vec<f64> = e.iter().map(|s| if s.is_empty() { Ok(0.0) } else { real(b, s, loc, "instance placement") }).collect::<Result<_, _>>()?;
+                let v: Vec<f64> = e
+                    .iter()
+                    .map(|s| if s.is_empty() { Ok(0.0) } else { real(b, s, loc, "instance placement") })
+                    .collect::<Result<_, _>>()?;
                 let inst = &mut deck.instances[instance.expect("instance data only inside *INSTANCE")];
                 match (*seen, v.len()) {
                     (0, 3) => inst.translation = Some([v[0], v[1], v[2]]),
@@ -325,7 +351,12 @@ fn place(b: &mut Builder, deck: Deck) -> Result<(), FlowMeshError> {
     }
     for inst in &instances {
         let contents = match &inst.part {
-            Some(p) => parts.get(p).ok_or_else(|| b.syntax(inst.loc, format!("*INSTANCE {} refers to part {p}, which the deck does not define", inst.name)))?,
+            Some(p) => parts.get(p).ok_or_else(|| {
+                b.syntax(
+                    inst.loc,
+                    format!("*INSTANCE {} refers to part {p}, which the deck does not define", inst.name),
+                )
+            })?,
             None => &inst.own,
         };
         let axis = match inst.rotation {
@@ -333,7 +364,9 @@ fn place(b: &mut Builder, deck: Deck) -> Result<(), FlowMeshError> {
                 let a = Vector3::new(r[0], r[1], r[2]);
                 let d = Vector3::new(r[3], r[4], r[5]) - a;
                 if d.norm() == 0.0 {
-                    return Err(b.syntax(inst.loc, format!("*INSTANCE {}: rotation axis points a and b coincide", inst.name)));
+                    return Err(
+                        b.syntax(inst.loc, format!("*INSTANCE {}: rotation axis points a and b coincide", inst.name))
+                    );
                 }
                 Some((a, d.normalize(), r[6].to_radians()))
             }
@@ -356,7 +389,12 @@ fn place(b: &mut Builder, deck: Deck) -> Result<(), FlowMeshError> {
 
 /// Add a container's nodes (moved by `f`) and elements; ids repeated across parts or instances
 /// are reported with what to do.
-fn add(b: &mut Builder, c: &Container, f: Option<&dyn Fn([f64; 3]) -> [f64; 3]>, what: &str) -> Result<(), FlowMeshError> {
+fn add(
+    b: &mut Builder,
+    c: &Container,
+    f: Option<&dyn Fn([f64; 3]) -> [f64; 3]>,
+    what: &str,
+) -> Result<(), FlowMeshError> {
     const HINT: &str = "node and element ids must be unique over the placed parts; a part instanced more than once (or parts numbered from 1 each) repeats ids: write a flattened deck (Abaqus/CAE: Model > Edit Attributes > check 'Do not use parts and assemblies in input files')";
     for &(id, x, loc) in &c.nodes {
         if let Some(&(_, first)) = b.node_index.get(&id) {

@@ -49,7 +49,9 @@ pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                 format_seen = true;
                 c.skip_to(&b, &end, loc)?;
             }
-            _ if !format_seen => return Err(b.syntax(loc, "the file must start with $MeshFormat: is this a Gmsh .msh file?")),
+            _ if !format_seen => {
+                return Err(b.syntax(loc, "the file must start with $MeshFormat: is this a Gmsh .msh file?"))
+            }
             "Entities" => {
                 let (no, l) = c.need(&b, "the entity counts")?;
                 let counts = ints(&b, l, no, 4)?;
@@ -61,7 +63,10 @@ pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                         let at = if dim == 0 { 4 } else { 7 };
                         let get = |k: usize| -> Result<i64, FlowMeshError> {
                             t.get(k).and_then(|s| s.parse().ok()).ok_or_else(|| {
-                                b.syntax(Loc { file: 0, line: no }, format!("entity line: field {} is missing or not an integer", k + 1))
+                                b.syntax(
+                                    Loc { file: 0, line: no },
+                                    format!("entity line: field {} is missing or not an integer", k + 1),
+                                )
                             })
                         };
                         let tag = get(0)?;
@@ -91,11 +96,15 @@ pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                         let mut t = l.split_whitespace();
                         for (i, xi) in x.iter_mut().enumerate() {
                             let s = t.next().ok_or_else(|| b.syntax(loc, format!("node {tag}: needs x y z")))?;
-                            *xi = s.parse().map_err(|_| b.syntax(loc, format!("node {tag}: coordinate {}: '{s}' is not a number", i + 1)))?;
+                            *xi = s.parse().map_err(|_| {
+                                b.syntax(loc, format!("node {tag}: coordinate {}: '{s}' is not a number", i + 1))
+                            })?;
                         }
                         let extra = if parametric != 0 { dim.max(0) as usize } else { 0 };
                         if t.count() != extra {
-                            return Err(b.syntax(loc, format!("node {tag}: expected {} numbers on the line", 3 + extra)));
+                            return Err(
+                                b.syntax(loc, format!("node {tag}: expected {} numbers on the line", 3 + extra))
+                            );
                         }
                         b.add_node(tag, x, loc)?;
                     }
@@ -123,7 +132,10 @@ pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                         };
                         let v = ints(&b, l, no, 1 + k)?;
                         if v.len() != 1 + k {
-                            return Err(b.syntax(Loc { file: 0, line: no }, format!("element {}: expected {} node tags", v[0], k)));
+                            return Err(b.syntax(
+                                Loc { file: 0, line: no },
+                                format!("element {}: expected {} node tags", v[0], k),
+                            ));
                         }
                         let nodes: Vec<u64> = v[1..].iter().map(|&x| x as u64).collect();
                         b.add_element(v[0] as u64, &nodes, property, Loc { file: 0, line: no })?;
@@ -135,7 +147,10 @@ pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
         }
     }
     if !format_seen {
-        return Err(FlowMeshError::Invalid { path: path.into(), message: "no $MeshFormat section: is this a Gmsh .msh file?".into() });
+        return Err(FlowMeshError::Invalid {
+            path: path.into(),
+            message: "no $MeshFormat section: is this a Gmsh .msh file?".into(),
+        });
     }
     b.finish("Gmsh types 2 (triangle) and 3 (quadrangle)")
 }
@@ -162,7 +177,9 @@ impl<'a> Lines<'a> {
     /// Next line, or an error saying the file ended while reading `what`.
     fn need(&mut self, b: &Builder, what: &str) -> Result<(usize, &'a str), FlowMeshError> {
         let n = self.lines.len();
-        self.next_line().ok_or_else(|| b.syntax(Loc { file: 0, line: n }, format!("file ends while reading {what}: is it truncated?")))
+        self.next_line().ok_or_else(|| {
+            b.syntax(Loc { file: 0, line: n }, format!("file ends while reading {what}: is it truncated?"))
+        })
     }
 
     /// Skip to the line `end` (e.g. `$EndNodes`).
@@ -293,7 +310,9 @@ fn read_binary(mut b: Builder, bytes: &[u8], start: usize) -> Result<FlowMesh, F
     let path = b.files[0].clone();
     let bad = |pos: usize, what: &str| FlowMeshError::Invalid {
         path: path.clone(),
-        message: format!("binary .msh at byte {pos}: {what}; the file may be truncated or not little-endian: re-save as 4.1 ASCII"),
+        message: format!(
+            "binary .msh at byte {pos}: {what}; the file may be truncated or not little-endian: re-save as 4.1 ASCII"
+        ),
     };
     let mut r = Bin { bytes, pos: start };
     if r.i32() != Some(1) {
@@ -303,7 +322,9 @@ fn read_binary(mut b: Builder, bytes: &[u8], start: usize) -> Result<FlowMesh, F
     let mut physical: HashMap<(i64, i64), u64> = HashMap::new();
     while let Some(l) = r.line() {
         let pos = r.pos;
-        let Some(section) = l.strip_prefix('$') else { return Err(bad(pos, &format!("expected a section, found '{l}'"))) };
+        let Some(section) = l.strip_prefix('$') else {
+            return Err(bad(pos, &format!("expected a section, found '{l}'")));
+        };
         let end = format!("$End{section}");
         let e = |what: &str| bad(pos, &format!("${section}: {what}"));
         match section {
@@ -361,9 +382,13 @@ fn read_binary(mut b: Builder, bytes: &[u8], start: usize) -> Result<FlowMesh, F
                 for _ in 0..blocks {
                     let (dim, tag, kind) = (r.i32(), r.i32(), r.i32());
                     let (Some(dim), Some(tag), Some(kind)) = (dim, tag, kind) else { return Err(e("block header")) };
-                    let k = nodes_of_type(kind).ok_or_else(|| e(&format!("element type {kind} is not known: re-save as 4.1 ASCII")))?;
+                    let k = nodes_of_type(kind)
+                        .ok_or_else(|| e(&format!("element type {kind} is not known: re-save as 4.1 ASCII")))?;
                     let n = r.count(8 * (k + 1)).ok_or_else(|| e("block size"))?;
-                    let property = physical.get(&(i64::from(dim), i64::from(tag))).copied().unwrap_or(u64::from(tag.unsigned_abs()));
+                    let property = physical
+                        .get(&(i64::from(dim), i64::from(tag)))
+                        .copied()
+                        .unwrap_or(u64::from(tag.unsigned_abs()));
                     let mut v = [0u64; 4];
                     for _ in 0..n {
                         let id = r.u64().ok_or_else(|| e("element"))?;
@@ -389,7 +414,9 @@ fn read_binary(mut b: Builder, bytes: &[u8], start: usize) -> Result<FlowMesh, F
 /// Binary data has no line numbers (the builder's errors carry line 0): drop the line.
 fn no_line(e: FlowMeshError) -> FlowMeshError {
     match e {
-        FlowMeshError::Syntax { path, line: 0, message } => FlowMeshError::Invalid { path, message: format!("binary data: {message}") },
+        FlowMeshError::Syntax { path, line: 0, message } => {
+            FlowMeshError::Invalid { path, message: format!("binary data: {message}") }
+        }
         e => e,
     }
 }

@@ -26,7 +26,9 @@ pub use obj::read_obj;
 pub enum FlowMeshError {
     #[error("cannot read flow mesh {path}: {source}. Check the path.")]
     Io { path: PathBuf, source: std::io::Error },
-    #[error("flow mesh {path}: unknown file type: use .bdf/.nas/.dat/.fem (Nastran), .inp (Abaqus), .obj or .msh (Gmsh 4)")]
+    #[error(
+        "flow mesh {path}: unknown file type: use .bdf/.nas/.dat/.fem (Nastran), .inp (Abaqus), .obj or .msh (Gmsh 4)"
+    )]
     UnknownFormat { path: PathBuf },
     #[error("flow mesh {path} line {line}: {message}")]
     Syntax { path: PathBuf, line: usize, message: String },
@@ -250,14 +252,21 @@ impl Builder {
         if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
             return Err(self.syntax(
                 loc,
-                format!("node {id} has a non-finite coordinate ({}, {}, {}) (after scaling by {}): fix the coordinate", xyz[0], xyz[1], xyz[2], self.scale),
+                format!(
+                    "node {id} has a non-finite coordinate ({}, {}, {}) (after scaling by {}): fix the coordinate",
+                    xyz[0], xyz[1], xyz[2], self.scale
+                ),
             ));
         }
         let k = self.mesh.nodes.len();
         if let Some(&(_, first)) = self.node_index.get(&id) {
             return Err(self.syntax(
                 loc,
-                format!("node id {id} is defined twice (first in {} line {}): node ids must be unique", self.files[first.file].display(), first.line),
+                format!(
+                    "node id {id} is defined twice (first in {} line {}): node ids must be unique",
+                    self.files[first.file].display(),
+                    first.line
+                ),
             ));
         }
         self.node_index.insert(id, (k, loc));
@@ -277,7 +286,11 @@ impl Builder {
         if let Some(first) = self.element_loc.insert(id, loc) {
             return Err(self.syntax(
                 loc,
-                format!("element id {id} is used twice (first in {} line {}): element ids must be unique", self.files[first.file].display(), first.line),
+                format!(
+                    "element id {id} is used twice (first in {} line {}): element ids must be unique",
+                    self.files[first.file].display(),
+                    first.line
+                ),
             ));
         }
         let mut n = [0u64; 4];
@@ -303,7 +316,10 @@ impl Builder {
                 match self.node_index.get(&g) {
                     Some(&(k, _)) => nodes.push(k),
                     None => {
-                        return Err(self.syntax(p.loc, format!("element {} refers to node {g}, which the file does not define", p.id)))
+                        return Err(self.syntax(
+                            p.loc,
+                            format!("element {} refers to node {g}, which the file does not define", p.id),
+                        ))
                     }
                 }
             }

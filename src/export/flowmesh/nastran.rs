@@ -182,7 +182,14 @@ fn cols(line: &[u8], a: usize, b: usize) -> &[u8] {
 impl Reader {
     /// Read the lines of one file (`file` indexes `b.files`). `top`: the main file, where
     /// `BEGIN BULK` is looked for. Returns `true` when ENDDATA was met.
-    fn read_file(&mut self, b: &mut Builder, bytes: &[u8], file: usize, top: bool, depth: usize) -> Result<bool, FlowMeshError> {
+    fn read_file(
+        &mut self,
+        b: &mut Builder,
+        bytes: &[u8],
+        file: usize,
+        top: bool,
+        depth: usize,
+    ) -> Result<bool, FlowMeshError> {
         let mut lines: Vec<&[u8]> = bytes.split(|&c| c == b'\n').collect();
         let mut first_line = 0;
         if top {
@@ -211,11 +218,8 @@ impl Reader {
                 line = &expanded;
             }
             let free = line.contains(&b',');
-            let first = if free {
-                trim(line.split(|&c| c == b',').next().unwrap_or(b""))
-            } else {
-                trim(cols(line, 0, 8))
-            };
+            let first =
+                if free { trim(line.split(|&c| c == b',').next().unwrap_or(b"")) } else { trim(cols(line, 0, 8)) };
             let is_cont = first.is_empty() || first[0] == b'+' || first[0] == b'*';
             if !is_cont {
                 let starts = |w: &[u8]| first.len() >= w.len() && first[..w.len()].eq_ignore_ascii_case(w);
@@ -237,7 +241,10 @@ impl Reader {
                 self.card.name.extend(name.iter().map(|c| c.to_ascii_uppercase() as char));
                 self.card.loc = Some(loc);
             } else if self.card.loc.is_none() {
-                return Err(b.syntax(loc, "continuation line with no card before it: start the card with its name (GRID, CQUAD4, ...)"));
+                return Err(b.syntax(
+                    loc,
+                    "continuation line with no card before it: start the card with its name (GRID, CQUAD4, ...)",
+                ));
             }
             let large = first.ends_with(b"*") || first.starts_with(b"*");
             let width = if large { 4 } else { 8 };
@@ -276,10 +283,17 @@ impl Reader {
         let text = String::from_utf8_lossy(line);
         let name = match (text.find('\''), text.rfind('\'')) {
             (Some(a), Some(z)) if z > a + 1 => text[a + 1..z].trim().to_string(),
-            _ => return Err(b.syntax(loc, "INCLUDE needs the file name in single quotes on the same line: INCLUDE 'file.bdf'")),
+            _ => {
+                return Err(
+                    b.syntax(loc, "INCLUDE needs the file name in single quotes on the same line: INCLUDE 'file.bdf'")
+                )
+            }
         };
         if depth >= MAX_INCLUDE_DEPTH {
-            return Err(b.syntax(loc, format!("INCLUDE nested more than {MAX_INCLUDE_DEPTH} deep: is a file including itself?")));
+            return Err(b.syntax(
+                loc,
+                format!("INCLUDE nested more than {MAX_INCLUDE_DEPTH} deep: is a file including itself?"),
+            ));
         }
         let base = b.files[loc.file].parent().map(Path::to_path_buf).unwrap_or_default();
         let target: PathBuf = base.join(&name);
@@ -321,7 +335,8 @@ impl Reader {
             if f.is_empty() {
                 return Ok(0.0);
             }
-            parse_nastran_real(f).ok_or_else(|| b.syntax(loc, format!("{name} field {what}: '{f}' is not a Nastran real number")))
+            parse_nastran_real(f)
+                .ok_or_else(|| b.syntax(loc, format!("{name} field {what}: '{f}' is not a Nastran real number")))
         };
         let id = |k: usize, what: &str| -> Result<u64, FlowMeshError> {
             int(k, what)?.ok_or_else(|| b.syntax(loc, format!("{name}: field {what} is blank; it is required")))
@@ -356,7 +371,9 @@ impl Reader {
                 };
                 let cord = Cord { kind, rid, a: p(2, "A")?, b: p(5, "B")?, c: p(8, "C")?, loc };
                 if cid == 0 {
-                    return Err(b.syntax(loc, format!("{name} defines CID 0, which is the basic system: use another id")));
+                    return Err(
+                        b.syntax(loc, format!("{name} defines CID 0, which is the basic system: use another id"))
+                    );
                 }
                 if self.cords.insert(cid, cord).is_some() || self.other_cords.contains_key(&cid) {
                     return Err(b.syntax(loc, format!("coordinate system {cid} is defined twice: ids must be unique")));

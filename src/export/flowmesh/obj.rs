@@ -36,7 +36,9 @@ pub fn read_obj(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                 let mut x = [0.0; 3];
                 for (i, xi) in x.iter_mut().enumerate() {
                     let t = tok.next().ok_or_else(|| b.syntax(loc, "vertex line needs three coordinates: v x y z"))?;
-                    *xi = t.parse().map_err(|_| b.syntax(loc, format!("vertex coordinate {}: '{t}' is not a number", i + 1)))?;
+                    *xi = t
+                        .parse()
+                        .map_err(|_| b.syntax(loc, format!("vertex coordinate {}: '{t}' is not a number", i + 1)))?;
                 }
                 nverts += 1;
                 b.add_node(nverts, x, loc)?;
@@ -45,13 +47,18 @@ pub fn read_obj(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                 let mut corners: Vec<u64> = Vec::with_capacity(4);
                 for t in tok {
                     let v = t.split('/').next().unwrap_or("");
-                    let i: i64 = v.parse().map_err(|_| b.syntax(loc, format!("face corner '{t}' does not start with a vertex number")))?;
+                    let i: i64 = v
+                        .parse()
+                        .map_err(|_| b.syntax(loc, format!("face corner '{t}' does not start with a vertex number")))?;
                     let n = if i > 0 {
                         i as u64
                     } else if i < 0 && i.unsigned_abs() <= nverts {
                         nverts + 1 - i.unsigned_abs()
                     } else {
-                        return Err(b.syntax(loc, format!("face corner {i} does not name a vertex read so far ({nverts} vertices)")));
+                        return Err(b.syntax(
+                            loc,
+                            format!("face corner {i} does not name a vertex read so far ({nverts} vertices)"),
+                        ));
                     };
                     corners.push(n);
                 }

@@ -127,7 +127,11 @@ impl Grid {
     /// Whether cell (i, j) exists and is complete (out-of-range indices: false).
     fn cell_on(&self, i: isize, j: isize) -> f64 {
         let inside = i >= 0 && j >= 0 && (i as usize) + 1 < self.nu && (j as usize) + 1 < self.nv;
-        if inside && self.cell_active(i as usize, j as usize) { 1.0 } else { 0.0 }
+        if inside && self.cell_active(i as usize, j as usize) {
+            1.0
+        } else {
+            0.0
+        }
     }
     /// Share of the tributary width d carried by the warp segment (i, j)-(i+1, j): half for each
     /// complete cell beside it, so edge fibres of the fabric carry d/2 and the widths of all
@@ -309,8 +313,12 @@ impl<'a> Model<'a> {
     /// Stretch, shear, bending and gravity (`gravity` in m/s^2, e.g. (0, 0, -9.81)).
     pub fn new<L: Laws + ?Sized>(grid: Grid, material: &'a L, gravity: Vector) -> Self {
         let g = Gravity::new(&grid, material.areal_mass(), gravity);
-        let terms: Vec<Box<dyn EnergyTerm + 'a>> =
-            vec![Box::new(Stretch::new(material)), Box::new(Shear::new(material)), Box::new(Bending::new(material)), Box::new(g)];
+        let terms: Vec<Box<dyn EnergyTerm + 'a>> = vec![
+            Box::new(Stretch::new(material)),
+            Box::new(Shear::new(material)),
+            Box::new(Bending::new(material)),
+            Box::new(g),
+        ];
         Self::with_terms(grid, terms)
     }
     /// A model with the given terms (e.g. a subset, or extra penalty terms).
@@ -414,8 +422,12 @@ impl<'a> Model<'a> {
                 if let Some(g) = g.as_deref_mut() {
                     g.fill(Vector::zeros());
                 }
-                let hess =
-                    v.map(|(values, offset)| HessSink { pattern, values, offset, kind: want.expect("Hessian buffer without a kind") });
+                let hess = v.map(|(values, offset)| HessSink {
+                    pattern,
+                    values,
+                    offset,
+                    kind: want.expect("Hessian buffer without a kind"),
+                });
                 let mut sink = Sink { rows: rows.clone(), nodes, energy: 0.0, grad: g, hess };
                 let mut e = vec![0.0; nterms];
                 // Elements by groups of GROUP base rows (aligned on the whole grid, so that each
