@@ -1,7 +1,7 @@
 //! Self-tests of the sphere Chebyshev-net oracle in `tests/common/chebyshev.rs`.
 //! Run with `--nocapture` to see the reference numbers.
 
-mod common;
+use crate::common;
 
 use common::chebyshev::{collapse_s, SphereChebyshev, COLLAPSE_S};
 

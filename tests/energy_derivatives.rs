@@ -2,7 +2,7 @@
 //! against finite differences of the gradient, Convex Hessians positive semidefinite; on randomly
 //! perturbed 5 x 4 grids at zero, moderate and large (+-60 deg) shear, with and without inactive
 //! nodes.
-mod energy_common;
+use crate::energy_common;
 use drape::geometry::{Point, Vector};
 use drape::kinematic::net::{DrapeNet, NodeStatus};
 use drape::material::Fibre;

@@ -1,6 +1,6 @@
 //! The energy on large grids: bit-identical results for any thread count and strip size, and
 //! directional finite-difference checks across strip boundaries; the solver adapter.
-mod energy_common;
+use crate::energy_common;
 use drape::geometry::{Point, Vector};
 use drape::mechanics::energy::{Evaluation, Grid, HessianKind, Model};
 use drape::mechanics::refine::NetObjective;

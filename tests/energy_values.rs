@@ -1,6 +1,6 @@
 //! Energy terms: known values (reference state, uniform shear and stretch, a cylinder, gravity)
 //! and invariance under rigid motions.
-mod energy_common;
+use crate::energy_common;
 use drape::geometry::{Point, Vector};
 use drape::material::Fibre;
 use drape::mechanics::energy::{Grid, HessianKind, Laws};

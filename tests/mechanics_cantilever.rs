@@ -1,6 +1,6 @@
 //! The cantilever strip of seed 000 (Table 1 fabric, 5 cm, own weight) against the heavy
 //! elastica (REFERENCES.md §2), warp and weft, with 21 nodes.
-mod common;
+use crate::common;
 
 use common::elastica::heavy_elastica;
 use drape::material::{Fibre, MaterialCard};

@@ -2,7 +2,7 @@
 //! `tests/common/shear_frames.rs` (picture frame and bias extension).
 //! Run with `--nocapture` to see the reference numbers.
 
-mod common;
+use crate::common;
 
 use common::elastica::{heavy_elastica, heavy_elastica_with_steps, Elastica};
 use common::shear_frames::{

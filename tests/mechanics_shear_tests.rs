@@ -16,7 +16,7 @@
 //!   shearing more near the A apexes and less in the middle (about +-4 deg at 40 deg, the same
 //!   on finer nets: a property of the model, not of the mesh). Zone means stay within a degree
 //!   and the energy is below the ideal state's, as a minimum must be.
-mod common;
+use crate::common;
 
 use common::shear_frames::{
     be_displacement, be_force, be_shear, half_angle_factor, pf_displacement, pf_force, pf_shear, shear_energy_density,

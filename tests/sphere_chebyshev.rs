@@ -1,5 +1,5 @@
 //! The kinematic net on a hemisphere against the Chebyshev-net solution (REFERENCES.md §1).
-mod common;
+use crate::common;
 
 use common::chebyshev::SphereChebyshev;
 use drape::geometry::shapes;

@@ -1,0 +1,29 @@
+//! The integration tests, built as one test binary (`autotests = false` in Cargo.toml): each file
+//! of this folder is a module here, so the suite links the library once instead of once per file.
+//! A new test file needs a `mod` line below.
+mod common;
+mod energy_common;
+
+mod chebyshev_reference;
+mod cli;
+mod developable;
+mod energy_derivatives;
+mod energy_parallel;
+mod energy_sparse;
+mod energy_values;
+mod export_readback;
+mod flat_patterns;
+mod flow_export;
+mod flow_writers;
+mod flowmesh_readers;
+mod layup;
+mod material_cli;
+mod mechanics_cantilever;
+mod mechanics_properties;
+mod mechanics_references;
+mod mechanics_refine;
+mod mechanics_shear_tests;
+mod net_properties;
+mod offset_bladelike;
+mod report;
+mod sphere_chebyshev;
