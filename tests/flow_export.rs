@@ -5,7 +5,7 @@
 //! reader's own geometry), and their angle equals the ply's shear at that place (sampled on the
 //! net by the test).
 use assert_cmd::Command;
-use drape::export::map::NetSampler;
+use drape::kinematic::sampler::NetSampler;
 use drape::export::read_net;
 use drape::geometry::{Point, Vector};
 use drape::kinematic::DrapeNet;

@@ -2,21 +2,12 @@
 //! ply projected into the element's plane, the shear angle, the thickness and fibre volume
 //! fraction change and, on request, a permeability tensor (REFERENCES.md §5).
 use super::flowmesh::FlowMesh;
-use crate::geometry::surface::closest_point_on_triangle;
-use crate::geometry::{Point, Vector};
+use crate::geometry::Vector;
+use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
+pub use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP, VF_MAX_HEX};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
-use std::collections::HashMap;
-
-/// What happens to a sheared ply's thickness (REFERENCES.md §5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Cavity {
-    /// Closed mould, cavity thickness fixed: t = t0, Vf = Vf0 / cos(gamma).
-    Fixed,
-    /// Free thickness: t = t0 / cos(gamma), Vf = Vf0.
-    Free,
-}
 
 /// The fibres of one ply in one flow element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,53 +62,6 @@ pub struct LayupMap {
     /// Laminate permeability per element (thickness-weighted mean of the plies' tensors), `None`
     /// where no ply covers it or permeability was not asked for.
     pub permeability: Vec<Option<Matrix3<f64>>>,
-}
-
-/// Gebart's constant c for the axial permeability of a hexagonal fibre packing (Gebart 1992).
-const GEBART_C_HEX: f64 = 57.0;
-/// Largest fibre volume fraction of a hexagonal packing, pi / (2 sqrt 3): fibres touch.
-pub const VF_MAX_HEX: f64 = 0.906_899_682_117_108_9;
-/// Fibre volume fractions are capped just below the packing limit (the fabric would have locked
-/// long before; the cap keeps the permeability model finite); the commands count the elements
-/// that reach it.
-pub const VF_CAP: f64 = VF_MAX_HEX - 1e-6;
-/// A centroid whose closest point on the net lies further than this (times the net spacing) from
-/// it along the net's tangent plane is off the net's edge: the element is not covered.
-const EDGE_TOLERANCE_REL: f64 = 1e-6;
-/// Half-cells with less area than this (times d^2) are left out of the net's search mesh.
-const MIN_TRIANGLE_AREA_REL: f64 = 1e-12;
-
-/// Permeability model asked for with the mapping (REFERENCES.md §5): Gebart's (1992) axial and
-/// transverse permeabilities of a hexagonal fibre packing, K_par = 8 r^2 / c (1 - Vf)^3 / Vf^2 and
-/// K_perp = 16 / (9 pi sqrt 6) (sqrt(Vf_max / Vf) - 1)^(5/2) r^2, mixed over the ply's two fibre
-/// directions: K = K_par A + K_perp (P - A) + K_perp n n^T with A = (w w^T + f f^T) / 2 and
-/// P = I - n n^T. An unsheared balanced ply is isotropic in its plane; a sheared one has its
-/// principal directions on the bisectors of warp and weft, the larger along the acute bisector.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PermeabilityModel {
-    /// Fibre radius, metres (carbon about 3.5e-6, glass about 8e-6).
-    pub fibre_radius: f64,
-}
-
-impl PermeabilityModel {
-    /// Axial and transverse permeabilities (m^2) at fibre volume fraction `vf`.
-    pub fn principal(&self, vf: f64) -> (f64, f64) {
-        let r2 = self.fibre_radius * self.fibre_radius;
-        let vf = vf.clamp(1e-6, VF_CAP);
-        let k_par = 8.0 * r2 / GEBART_C_HEX * (1.0 - vf).powi(3) / (vf * vf);
-        let c1 = 16.0 / (9.0 * std::f64::consts::PI * 6f64.sqrt());
-        let k_perp = c1 * ((VF_MAX_HEX / vf).sqrt() - 1.0).powf(2.5) * r2;
-        (k_par, k_perp)
-    }
-
-    /// The tensor of a ply with in-plane unit fibre directions `warp`, `weft` and normal `normal`.
-    pub fn tensor(&self, vf: f64, warp: &Vector, weft: &Vector, normal: &Vector) -> Matrix3<f64> {
-        let (k_par, k_perp) = self.principal(vf);
-        let a = (warp * warp.transpose() + weft * weft.transpose()) * 0.5;
-        let nn = normal * normal.transpose();
-        let p = Matrix3::identity() - nn;
-        a * k_par + (p - a) * k_perp + nn * k_perp
-    }
 }
 
 /// Fibre volume fraction assumed when a ply has no material card with a `[flow]` section (the
@@ -199,184 +143,6 @@ pub enum MapError {
     Settings { ply: String, message: String },
 }
 
-/// Where a point lands on a net: the cell, the bilinear parameters in it, the closest point and
-/// the fibre tangents there.
-#[derive(Debug, Clone, Copy)]
-pub struct NetSample {
-    /// Cell (i, j) of the net.
-    pub cell: (usize, usize),
-    /// Bilinear parameters in the cell, along the warp (`s`) and the weft (`t`), in [0, 1].
-    pub s: f64,
-    pub t: f64,
-    /// The closest point of the net.
-    pub point: Point,
-    /// Warp and weft tangents of the bilinear cell patch there (not normalised).
-    pub warp: Vector,
-    pub weft: Vector,
-    /// Unit normal warp x weft.
-    pub normal: Vector,
-    /// Signed distance from the net to the query point along `normal`.
-    pub normal_distance: f64,
-    /// How far (metres, in the cell's parameters times d) the query point lies beyond the net's
-    /// edge: 0 over the net.
-    pub beyond_edge: f64,
-}
-
-impl NetSample {
-    /// Shear of the patch here, radians.
-    pub fn shear(&self) -> f64 {
-        crate::kinematic::net::corner_shear(&self.warp, &self.weft)
-    }
-}
-
-/// A net as triangles (two per complete cell) in a uniform hash grid of cell size 2d, for
-/// closest-point queries near the net. (Our own grid rather than a BVH: nets are regular, their
-/// triangles all about d in size, and collapsed or coincident cells of a locked net must not
-/// upset the search structure.)
-pub struct NetSampler<'a> {
-    net: &'a DrapeNet,
-    /// Triangle corners by node index, and the cell (i, j) and half (0: corners 00-10-11,
-    /// 1: corners 00-11-01) of each triangle.
-    triangles: Vec<([usize; 3], (usize, usize, u8))>,
-    grid: HashMap<[i64; 3], Vec<u32>>,
-    bin: f64,
-}
-
-impl<'a> NetSampler<'a> {
-    /// `None` when the net has no complete cell.
-    pub fn new(net: &'a DrapeNet) -> Option<Self> {
-        let bin = 2.0 * net.spacing;
-        let key = |p: &Point| [(p.x / bin).floor() as i64, (p.y / bin).floor() as i64, (p.z / bin).floor() as i64];
-        let min_area = MIN_TRIANGLE_AREA_REL * net.spacing * net.spacing;
-        let mut triangles = Vec::new();
-        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        for i in 0..net.nu.saturating_sub(1) {
-            for j in 0..net.nv.saturating_sub(1) {
-                if net.cell_corners(i, j).is_none() {
-                    continue;
-                }
-                let c = [net.index(i, j), net.index(i + 1, j), net.index(i + 1, j + 1), net.index(i, j + 1)];
-                for (half, tri) in [(0u8, [c[0], c[1], c[2]]), (1, [c[0], c[2], c[3]])] {
-                    let [a, b, d] = tri.map(|k| net.positions[k]);
-                    // Collapsed halves (a folded or locked cell) carry no area to find.
-                    if (b - a).cross(&(d - a)).norm() <= min_area {
-                        continue;
-                    }
-                    let lo = key(&Point::from(a.coords.inf(&b.coords).inf(&d.coords)));
-                    let hi = key(&Point::from(a.coords.sup(&b.coords).sup(&d.coords)));
-                    for x in lo[0]..=hi[0] {
-                        for y in lo[1]..=hi[1] {
-                            for z in lo[2]..=hi[2] {
-                                grid.entry([x, y, z]).or_default().push(triangles.len() as u32);
-                            }
-                        }
-                    }
-                    triangles.push((tri, (i, j, half)));
-                }
-            }
-        }
-        (!triangles.is_empty()).then_some(NetSampler { net, triangles, grid, bin })
-    }
-
-    /// The net at its closest point to `p`, if the net comes within `radius` of `p`.
-    pub fn nearest_within(&self, p: &Point, radius: f64) -> Option<NetSample> {
-        let net = self.net;
-        let lo = ((p.coords - Vector::repeat(radius)) / self.bin).map(f64::floor);
-        let hi = ((p.coords + Vector::repeat(radius)) / self.bin).map(f64::floor);
-        let mut best: Option<(f64, u32, Point)> = None;
-        for x in lo.x as i64..=hi.x as i64 {
-            for y in lo.y as i64..=hi.y as i64 {
-                for z in lo.z as i64..=hi.z as i64 {
-                    for &t in self.grid.get(&[x, y, z]).map_or(&[][..], Vec::as_slice) {
-                        let [a, b, c] = self.triangles[t as usize].0.map(|k| net.positions[k]);
-                        let q = closest_point_on_triangle(p, &a, &b, &c);
-                        let d2 = (q - p).norm_squared();
-                        // Ties go to the lower triangle number, so the answer does not depend on
-                        // the order the grid lists them in.
-                        if best.is_none_or(|(bd, bt, _)| d2 < bd || (d2 == bd && t < bt)) {
-                            best = Some((d2, t, q));
-                        }
-                    }
-                }
-            }
-        }
-        let (d2, t, x) = best?;
-        if d2 > radius * radius {
-            return None;
-        }
-        let ([k0, k1, k2], (i, j, half)) = self.triangles[t as usize];
-        // Parameters of p's projection onto the triangle's plane, not clamped: a point over the
-        // net lies inside its cell up to the kink between neighbouring facets; one beyond the
-        // net's edge lies outside a cell that has no neighbour on that side.
-        let l = barycentric(p, &net.positions[k0], &net.positions[k1], &net.positions[k2]);
-        let (s, t) = if half == 0 { (l[1] + l[2], l[2]) } else { (l[1], l[1] + l[2]) };
-        let complete = |a: isize, b: isize| {
-            a >= 0
-                && b >= 0
-                && (a as usize) + 1 < net.nu
-                && (b as usize) + 1 < net.nv
-                && net.cell_corners(a as usize, b as usize).is_some()
-        };
-        let (ci, cj) = (i as isize, j as isize);
-        let di = if s < 0.0 {
-            -1
-        } else if s > 1.0 {
-            1
-        } else {
-            0
-        };
-        let dj = if t < 0.0 {
-            -1
-        } else if t > 1.0 {
-            1
-        } else {
-            0
-        };
-        let over_s = if s < 0.0 { -s } else { (s - 1.0).max(0.0) };
-        let over_t = if t < 0.0 { -t } else { (t - 1.0).max(0.0) };
-        let mut beyond = 0.0f64;
-        if di != 0 && !complete(ci + di, cj) {
-            beyond = beyond.max(over_s);
-        }
-        if dj != 0 && !complete(ci, cj + dj) {
-            beyond = beyond.max(over_t);
-        }
-        if di != 0 && dj != 0 && !complete(ci + di, cj + dj) {
-            beyond = beyond.max(over_s.min(over_t));
-        }
-        let beyond_edge = beyond * net.spacing;
-        let (s, t) = (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
-        let q = |a: usize, b: usize| net.positions[net.index(a, b)];
-        let (p00, p10, p11, p01) = (q(i, j), q(i + 1, j), q(i + 1, j + 1), q(i, j + 1));
-        let warp = (p10 - p00) * (1.0 - t) + (p11 - p01) * t;
-        let weft = (p01 - p00) * (1.0 - s) + (p11 - p10) * s;
-        let normal = warp.cross(&weft).normalize();
-        let normal_distance = (p - x).dot(&normal);
-        Some(NetSample { cell: (i, j), s, t, point: x, warp, weft, normal, normal_distance, beyond_edge })
-    }
-
-    /// The net under `p`, or `None` when `p` lies beyond the net's edge or further than
-    /// `max_distance` from it along the normal.
-    pub fn cover(&self, p: &Point, max_distance: f64) -> Option<NetSample> {
-        let edge = EDGE_TOLERANCE_REL * self.net.spacing;
-        let h = self.nearest_within(p, max_distance + edge)?;
-        (h.beyond_edge <= edge && h.normal_distance.abs() <= max_distance).then_some(h)
-    }
-}
-
-fn barycentric(p: &Point, a: &Point, b: &Point, c: &Point) -> [f64; 3] {
-    let (e1, e2, w) = (b - a, c - a, p - a);
-    let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-    let den = d11 * d22 - d12 * d12;
-    if den <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let (x, y) = (w.dot(&e1), w.dot(&e2));
-    let l1 = (d22 * x - d12 * y) / den;
-    let l2 = (d11 * y - d12 * x) / den;
-    [1.0 - l1 - l2, l1, l2]
-}
-
 /// Signed angle from `from` to `to` about `axis` (all in one plane), radians in (-pi, pi].
 fn signed_angle(from: &Vector, to: &Vector, axis: &Vector) -> f64 {
     axis.dot(&from.cross(to)).atan2(from.dot(to))
@@ -425,11 +191,7 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
             let theta = signed_angle(&reference, &warp, &normal);
             let angle_change =
                 in_plane(&settings.nominal_warp, &normal).map_or(0.0, |n| signed_angle(&n, &warp, &normal));
-            let cos = shear.cos().max(f64::MIN_POSITIVE);
-            let (thickness, vf) = match settings.cavity {
-                Cavity::Fixed => (settings.thickness, (settings.vf / cos).min(VF_CAP)),
-                Cavity::Free => (settings.thickness / cos, settings.vf),
-            };
+            let (thickness, vf) = settings.cavity.sheared(settings.thickness, settings.vf, shear);
             let permeability = settings.permeability.map(|m| m.tensor(vf, &warp, &weft, &normal));
             Ok(Some(ElementFibres {
                 warp,
@@ -484,6 +246,7 @@ mod tests {
     use super::*;
     use crate::export::flowmesh::{ElementShape, FlowElement};
     use crate::geometry::shapes;
+    use crate::geometry::Point;
     use crate::kinematic::{drape, KinematicSettings};
 
     /// Angles agree to this (radians): exact geometry on a plate, rounding only.

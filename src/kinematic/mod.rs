@@ -5,6 +5,7 @@ pub mod fishnet;
 pub mod generators;
 pub mod net;
 pub mod outline;
+pub mod sampler;
 
 pub use fishnet::{drape, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};

@@ -2,11 +2,12 @@
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
 use super::scene::{Orientation, Ply, Scene, StackSide};
-use crate::export::map::NetSampler;
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
 use crate::geometry::{ObjError, Point, ToolSurface, Vector};
 use crate::kinematic::fishnet::DrapeError;
+use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, NodeStatus};
+use crate::material::flow::sheared_thickness;
 use crate::mechanics::refine::{annotate, refine, RefineError, RefineSettings, Refined};
 use std::time::Instant;
 
@@ -251,7 +252,7 @@ fn add_ply_thickness(stack: &mut [f64], under: &[Point], net: &DrapeNet, t0: f64
     let reach = t0.max(net.spacing);
     for (v, p) in under.iter().enumerate() {
         if let Some(hit) = sampler.cover(p, reach) {
-            stack[v] += t0 / hit.shear().cos().max(f64::MIN_POSITIVE);
+            stack[v] += sheared_thickness(t0, hit.shear());
         }
     }
 }

@@ -656,10 +656,10 @@ impl MaterialCard {
         positive("thickness", self.thickness, "m")?;
         if let Some(f) = &self.flow {
             let vf = f.fibre_volume_fraction;
-            if !(vf > 0.0 && vf < crate::export::map::VF_MAX_HEX) {
+            if !(vf > 0.0 && vf < super::flow::VF_MAX_HEX) {
                 return Err((
                     "flow.fibre_volume_fraction".into(),
-                    format!("must lie between 0 and {:.4} (fibres touching), got {vf}", crate::export::map::VF_MAX_HEX),
+                    format!("must lie between 0 and {:.4} (fibres touching), got {vf}", super::flow::VF_MAX_HEX),
                 ));
             }
             positive("flow.fibre_radius", f.fibre_radius, "m")?;

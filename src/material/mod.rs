@@ -6,6 +6,7 @@
 //! Bundled cards live in `materials/` at the crate root.
 pub mod calibrate;
 pub mod card;
+pub mod flow;
 
 pub use card::{
     Bending, Fibre, FlowProperties, KnitParams, MaterialCard, MaterialError, ShearLaw, ShearTable, Tension, TensionLaw,
