@@ -2,13 +2,13 @@
 //! meshes of 20k and 200k triangles (elements per second), offsetting a 200k-triangle tool, and
 //! unfolding the net into its flat pattern. Run: `cargo bench --bench layup`.
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use drape::export::flowmesh::{ElementShape, FlowElement, FlowMesh};
-use drape::export::map::{map_net, Cavity, PermeabilityModel, PlyMapSettings};
 use drape::geometry::offset::offset_surface;
 use drape::geometry::shapes::{self, TriangleMesh};
 use drape::geometry::{Point, Vector};
 use drape::kinematic::{drape, KinematicSettings};
 use drape::layup::flat::flat_pattern;
+use drape::mapping::{map_net, Cavity, PermeabilityModel, PlyMapSettings};
+use drape::mapping::{ElementShape, FlowElement, FlowMesh};
 use std::f64::consts::FRAC_PI_2;
 
 fn flow_mesh(m: &TriangleMesh) -> FlowMesh {

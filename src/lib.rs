@@ -4,10 +4,11 @@
 //! kinematic fishnet mapper ([`kinematic::drape`]) into a [`kinematic::DrapeNet`], the one grid
 //! type that every later stage reads; [`export`] writes it out.
 pub mod cli;
-pub mod export;
 pub mod geometry;
+pub mod io;
 pub mod kinematic;
 pub mod layup;
+pub mod mapping;
 pub mod material;
 pub mod mechanics;
 pub mod numeric;

@@ -4,8 +4,8 @@
 //!
 //! Needs `python3` with meshio (`python3 -m pip install meshio`; .ci/run installs it). Set
 //! DRAPE_SKIP_PYTHON=1 to skip the Python part (the Rust-side checks still run).
-use drape::export::{read_net, write_net, Format, CSV_HEADER};
 use drape::geometry::{Point, Vector};
+use drape::io::{read_net, write_net, Format, CSV_HEADER};
 use drape::kinematic::{DrapeNet, NodeStatus};
 use serde_json::Value;
 use std::collections::BTreeSet;

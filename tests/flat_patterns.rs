@@ -5,10 +5,10 @@
 //! exactly the number of complete cells times d^2. The DXF and SVG are read back by
 //! tools/pattern_readback.py (ezdxf and xml.etree; `python3 -m pip install -r
 //! tools/requirements.txt`); DRAPE_SKIP_PYTHON=1 skips that part.
-use drape::export::pattern::{
-    dxf_layer_names, svg_ids, write_cutting_plan, write_dxf, write_pattern_svg, write_svg, PatternError,
-};
 use drape::geometry::{shapes, Point, ToolSurface, Vector};
+use drape::io::drawing::{write_cutting_plan, PatternError};
+use drape::io::dxf::{dxf_layer_names, write_dxf};
+use drape::io::svg::{svg_ids, write_pattern_svg, write_svg};
 use drape::kinematic::{drape, DrapeNet, Extent, KinematicSettings, NodeStatus};
 use drape::layup::flat::{flat_pattern, flat_pattern_with_margin, shoelace_area, FlatError, FlatPattern, Region};
 use drape::layup::nest::{nest, Nesting, Rotation};

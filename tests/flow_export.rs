@@ -5,9 +5,9 @@
 //! reader's own geometry), and their angle equals the ply's shear at that place (sampled on the
 //! net by the test).
 use assert_cmd::Command;
-use drape::kinematic::sampler::NetSampler;
-use drape::export::read_net;
 use drape::geometry::{Point, Vector};
+use drape::io::read_net;
+use drape::kinematic::sampler::NetSampler;
 use drape::kinematic::DrapeNet;
 use serde_json::Value;
 use std::path::{Path, PathBuf};

@@ -7,11 +7,13 @@
 //!
 //! Needs `python3` with meshio, numpy and pyNastran (tools/requirements.txt). Set
 //! DRAPE_SKIP_PYTHON=1 to skip the Python part (the Rust-side checks still run).
-use drape::export::flow::{write_flow, write_rtmsim, FlowFormat, FLOW_CSV_HEADER, MAX_RTMSIM_SETS};
-use drape::export::flowmesh::{ElementShape, FlowElement, FlowMesh};
-use drape::export::map::{ElementFibres, LayupMap, PlyMap};
-use drape::export::ExportError;
 use drape::geometry::{Point, Vector};
+use drape::io::csv::FLOW_CSV_HEADER;
+use drape::io::flow::{write_flow, write_rtmsim, FlowFormat};
+use drape::io::rtmsim::MAX_RTMSIM_SETS;
+use drape::io::ExportError;
+use drape::mapping::{ElementFibres, LayupMap, PlyMap};
+use drape::mapping::{ElementShape, FlowElement, FlowMesh};
 use nalgebra::Matrix3;
 use serde_json::Value;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -348,7 +350,7 @@ fn abaqus_distributions() {
     assert_eq!(eids, want);
     assert_eq!(s["tables"]["DRAPE_DIRECTIONS"], serde_json::json!(["COORD3D", "COORD3D"]));
     for (k, ply) in map.plies.iter().enumerate() {
-        let tag = drape::export::flow::abaqus_ply_tag(k, &ply.ply);
+        let tag = drape::io::abaqus::ply_tag(k, &ply.ply);
         let d = &s["distributions"][&format!("{tag}_DIR")];
         assert_eq!(d["location"], "ELEMENT");
         assert_eq!(d["table"], "DRAPE_DIRECTIONS");
@@ -522,7 +524,7 @@ fn rtmsim_mesh_sets_and_parameters() {
             // Porosity of the element within the region's bin unless its group was merged.
             if report.merged_elements == 0 {
                 let por = 1.0 - map.mean_vf[e].unwrap();
-                assert!((por - params[r][1]).abs() <= drape::export::flow::POROSITY_BIN, "porosity");
+                assert!((por - params[r][1]).abs() <= drape::io::rtmsim::POROSITY_BIN, "porosity");
             }
         }
         assert!(

@@ -11,7 +11,8 @@
 //! Real data: if /work/shared/data/bladelike/ (or $DRAPE_BLADELIKE_DIR) exists, the Abaqus decks
 //! there are read and their counts checked against a plain scan of the text; otherwise the test
 //! prints "skipped" and passes.
-use drape::export::flowmesh::{read_flow_mesh, ElementShape, FlowMesh, FlowMeshError};
+use drape::io::{read_flow_mesh, FlowMeshError};
+use drape::mapping::{ElementShape, FlowMesh};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -2,8 +2,8 @@
 //! hemisphere plus a mechanical copy carrying a known per-cell change; the PNGs are decoded and
 //! must hold the colours of the cells' shear (and of the change), the tool's greys, text; the
 //! SVGs must hold the cells; the page must show every picture and one table row per ply.
-use drape::export::{write_net, Format};
 use drape::geometry::{shapes, Point, Vector};
+use drape::io::{write_net, Format};
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, Method};
 use drape::report::{
     bin_shares, bin_width, change_limit, colour_limit, shear_colour, tool_greys, write_report, ReportError, HEIGHT,

@@ -6,7 +6,7 @@
 //! drape calibrate knit --data CSV --direction warp|weft --card BASE.toml --out NEW.toml
 //! ```
 use super::{compute, input, Failure};
-use crate::export::write_atomic;
+use crate::io::write_atomic;
 use crate::layup::unit_scale;
 use crate::material::calibrate::{
     fit_knit_uniaxial, fit_shear_bias_extension, fit_shear_picture_frame, parse_xy_csv, FitError, FitReport,

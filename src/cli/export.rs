@@ -1,11 +1,11 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
 use super::{compute, input, Failure};
-use crate::export::flow::{write_flow, FlowFormat};
-use crate::export::flowmesh::read_flow_mesh;
-use crate::export::map::{map_net, Cavity, LayupMap, PermeabilityModel, PlyMapSettings};
-use crate::export::read_net;
+use crate::io::flow::{write_flow, FlowFormat};
+use crate::io::read_flow_mesh;
+use crate::io::read_net;
 use crate::layup::unit_scale;
+use crate::mapping::{map_net, Cavity, LayupMap, PermeabilityModel, PlyMapSettings};
 use crate::material::MaterialCard;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -125,7 +125,7 @@ pub(crate) fn coverage_line(map: &LayupMap, k: usize) -> String {
     let covered: Vec<f64> = ply.elements.iter().flatten().map(|f| f.shear.abs().to_degrees()).collect();
     let max = covered.iter().cloned().fold(0.0, f64::max);
     let mean = if covered.is_empty() { 0.0 } else { covered.iter().sum::<f64>() / covered.len() as f64 };
-    let capped = ply.elements.iter().flatten().filter(|f| f.vf >= crate::export::map::VF_CAP).count();
+    let capped = ply.elements.iter().flatten().filter(|f| f.vf >= crate::mapping::VF_CAP).count();
     let mut line = format!(
         "  ply {}: covers {} of {} elements; |shear| max {max:.2} deg, mean {mean:.2} deg",
         ply.ply,
@@ -135,7 +135,7 @@ pub(crate) fn coverage_line(map: &LayupMap, k: usize) -> String {
     if capped > 0 {
         line += &format!(
             "; Vf0 / cos(shear) passes the fibre packing limit in {capped} elements: Vf written as {:.4} there (the fabric locks before that)",
-            crate::export::map::VF_CAP
+            crate::mapping::VF_CAP
         );
     }
     line

@@ -1,8 +1,8 @@
 //! `drape kinematic`: one ply from command-line arguments.
 use super::summary::summary;
 use super::{compute, input, parse_pair, parse_vec3, Failure};
-use crate::export::{write_net, Format};
 use crate::geometry::{Point, ToolSurface, Vector};
+use crate::io::{write_net, Format};
 use crate::kinematic::fishnet::check_settings;
 use crate::kinematic::{drape, Extent, KinematicSettings};
 use crate::layup::{parse_generators, read_points, scene::DEFAULT_LOCKING_ANGLE_DEG, unit_scale};

@@ -2,8 +2,8 @@
 use super::kinematic::print_tool_report;
 use super::summary::summary;
 use super::{compute, input, parse_vec3, Failure};
-use crate::export::{read_net, write_net, Format};
 use crate::geometry::Vector;
+use crate::io::{read_net, write_net, Format};
 use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
 use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};

@@ -1,6 +1,6 @@
 //! `drape report DIR`: pictures and an HTML page of a run's output folder.
 use super::{compute, input, Failure};
-use crate::export::ExportError;
+use crate::io::ExportError;
 use crate::report::{write_report, ReportError};
 use clap::Args;
 use std::path::PathBuf;

@@ -15,7 +15,7 @@
 //! cell shear, null for incomplete cells), `"steps"` (requested, completed), `"converged"`,
 //! `"iterations"`, `"notes"` (adjustments made to the request).
 use super::{compute, input, Failure};
-use crate::export::write_atomic;
+use crate::io::write_atomic;
 use crate::material::{Fibre, MaterialCard};
 use crate::mechanics::virtual_tests::{
     bias_extension, cantilever, picture_frame, BiasExtension, PictureFrame, ShearTest,

@@ -72,7 +72,7 @@ pub fn load_tool(path: &Path, scale: f64) -> Result<ToolSurface, String> {
     if is_obj {
         return ToolSurface::from_obj_scaled(path, scale).map_err(|e: ObjError| e.to_string());
     }
-    let mesh = crate::export::flowmesh::read_flow_mesh(path, scale).map_err(|e| e.to_string())?;
+    let mesh = crate::io::read_flow_mesh(path, scale).map_err(|e| e.to_string())?;
     // Only the nodes the elements use: decks carry reference nodes (rigid bodies) that are not
     // part of the surface.
     let mut index = vec![u32::MAX; mesh.nodes.len()];

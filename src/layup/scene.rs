@@ -38,10 +38,10 @@
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
 //! ```
 use super::{parse_generators, read_points, unit_scale};
-use crate::export::flow::FlowFormat;
-use crate::export::map::Cavity;
 use crate::geometry::{Point, Vector};
+use crate::io::flow::FlowFormat;
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
+use crate::mapping::Cavity;
 use crate::material::MaterialCard;
 use crate::mechanics::ContactMode;
 use serde::Deserialize;

@@ -6,7 +6,7 @@ use std::fmt::Write;
 
 /// Escape text for HTML element content and attribute values.
 pub fn escape(s: &str) -> String {
-    crate::export::xml_escape(s)
+    crate::io::xml::xml_escape(s)
 }
 
 /// An SVG document without its XML declaration and DOCTYPE, ready to inline in HTML.

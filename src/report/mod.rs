@@ -20,9 +20,9 @@ mod view;
 pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL_TRIANGLE_LIMIT, WIDTH};
 pub use view::{change_limit, colour_limit, shear_colour, View, VIEW_TILT_DEG};
 
-use crate::export::{read_net, write_atomic, ExportError};
 use crate::geometry::obj::read_obj;
 use crate::geometry::Point;
+use crate::io::{read_net, write_atomic, ExportError};
 use crate::kinematic::{DrapeNet, Method};
 use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

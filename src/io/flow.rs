@@ -11,25 +11,10 @@
 //!
 //! Everything is checked before the first file is opened (map sizes against the mesh, finite
 //! values), so a bad map writes nothing; each file is written with [`write_atomic`].
-mod abaqus;
-mod csv;
-mod nastran;
-mod optistruct;
-mod rtmsim;
-mod vtu;
-
-pub use abaqus::ply_tag as abaqus_ply_tag;
-pub use csv::FLOW_CSV_HEADER;
-pub use rtmsim::{
-    RtmsimRegion, DIRECTION_BIN_DEG, MAX_RTMSIM_SETS, PERM_LOG10_BIN, POROSITY_BIN, RATIO_BIN, THICKNESS_BIN_REL,
-};
-
-use super::flowmesh::FlowMesh;
-use super::map::{ElementFibres, LayupMap};
-use super::ExportError;
+use super::rtmsim::RtmsimRegion;
+use super::{abaqus, csv, nastran, optistruct, rtmsim, vtk, ExportError};
+use crate::mapping::{ElementFibres, FlowMesh, LayupMap};
 use std::path::{Path, PathBuf};
-
-pub(crate) use super::write_atomic;
 
 /// A format of fibre data on a flow mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -99,12 +84,12 @@ pub fn write_flow(
 ) -> Result<Vec<PathBuf>, ExportError> {
     check(mesh, map, format.name())?;
     match format {
-        FlowFormat::Vtu => vtu::write(mesh, map, out).map(|()| vec![out.to_path_buf()]),
-        FlowFormat::Nastran => nastran::write(mesh, map, out),
-        FlowFormat::Abaqus => abaqus::write(mesh, map, out).map(|()| vec![out.to_path_buf()]),
-        FlowFormat::OptiStruct => optistruct::write(mesh, map, out).map(|()| vec![out.to_path_buf()]),
-        FlowFormat::Rtmsim => rtmsim::write(mesh, map, out).map(|r| r.files),
-        FlowFormat::Csv => csv::write(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::Vtu => vtk::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::Nastran => nastran::write_flow(mesh, map, out),
+        FlowFormat::Abaqus => abaqus::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::OptiStruct => optistruct::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::Rtmsim => rtmsim::write_flow(mesh, map, out).map(|r| r.files),
+        FlowFormat::Csv => csv::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
     }
 }
 
@@ -129,7 +114,7 @@ pub struct RtmsimReport {
 /// [`write_flow`] for RTMsim, returning the grouping report as well.
 pub fn write_rtmsim(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<RtmsimReport, ExportError> {
     check(mesh, map, FlowFormat::Rtmsim.name())?;
-    rtmsim::write(mesh, map, out)
+    rtmsim::write_flow(mesh, map, out)
 }
 
 /// Sizes, names and finiteness of everything the writers read.
@@ -227,13 +212,13 @@ fn check_fibres(f: &ElementFibres, format: &'static str, ply: &str, id: u64) -> 
 }
 
 /// `DIR/STEM<suffix>` beside `out`.
-fn sibling(out: &Path, suffix: &str) -> PathBuf {
+pub(crate) fn sibling(out: &Path, suffix: &str) -> PathBuf {
     let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     out.with_file_name(format!("{stem}{suffix}"))
 }
 
 /// A ply name as part of a file name: refused if it could leave the directory.
-fn file_tag(format: &'static str, ply: &str) -> Result<String, ExportError> {
+pub(crate) fn file_tag(format: &'static str, ply: &str) -> Result<String, ExportError> {
     if ply == "." || ply == ".." || ply.chars().any(|c| matches!(c, '/' | '\\' | '\0') || c.is_control()) {
         return Err(ExportError::FlowInvalid {
             format,
@@ -244,7 +229,7 @@ fn file_tag(format: &'static str, ply: &str) -> Result<String, ExportError> {
 }
 
 /// Degrees in (-180, 180] of an angle in radians (the map gives (-pi, pi]).
-fn deg(rad: f64) -> f64 {
+pub(crate) fn deg(rad: f64) -> f64 {
     let d = rad.to_degrees();
     if d <= -180.0 {
         d + 360.0
@@ -256,7 +241,7 @@ fn deg(rad: f64) -> f64 {
 }
 
 /// Angle (radians, in (-pi, pi]) wrapped.
-fn wrap(a: f64) -> f64 {
+pub(crate) fn wrap(a: f64) -> f64 {
     let two_pi = std::f64::consts::TAU;
     let mut r = a.rem_euclid(two_pi);
     if r > std::f64::consts::PI {
@@ -265,101 +250,9 @@ fn wrap(a: f64) -> f64 {
     r
 }
 
-/// The text of `x` that fits in `width` characters and reads back closest to `x`: plain
-/// decimals (leading zero dropped, ".0123") or the Nastran exponent form without `E`
-/// ("1.2345-7", "-2.5+12"), which Nastran, OptiStruct, pyNastran and RTMsim all accept.
-/// `{:?}` (exact) is used whenever it fits. Always contains a decimal point, so it is never
-/// read as an integer. `None` only for a non-finite `x` (checked earlier).
-pub(crate) fn fit_real(x: f64, width: usize) -> Option<String> {
-    if !x.is_finite() {
-        return None;
-    }
-    if x == 0.0 {
-        return Some("0.0".into());
-    }
-    let exact = nastran_style(&format!("{x:?}"));
-    if exact.len() <= width {
-        return Some(exact);
-    }
-    let mut best: Option<(f64, String)> = None;
-    let mut consider = |s: String| {
-        if s.len() <= width {
-            if let Some(v) = read_nastran_real(&s) {
-                let err = (v - x).abs();
-                if best.as_ref().is_none_or(|(e, _)| err < *e) {
-                    best = Some((err, s));
-                }
-            }
-        }
-    };
-    for p in (0..=17).rev() {
-        let s = format!("{x:.p$}");
-        let s = if p == 0 { format!("{s}.") } else { s };
-        let s = s.replacen("0.", ".", if s.starts_with("0.") || s.starts_with("-0.") { 1 } else { 0 });
-        if s.len() <= width {
-            consider(s);
-            break;
-        }
-    }
-    for p in (0..=16).rev() {
-        let s = nastran_style(&format!("{x:.p$e}"));
-        let compact = s.replacen('e', "", 1);
-        if compact.len() <= width {
-            consider(compact);
-            break;
-        }
-    }
-    best.map(|(_, s)| s)
-}
-
-/// Rust float text to a Nastran-readable one: a decimal point in the mantissa and a signed
-/// exponent ("1e-7" -> "1.e-7", "1e16" -> "1.e+16").
-fn nastran_style(s: &str) -> String {
-    let (mant, exp) = match s.split_once('e') {
-        Some((m, e)) => (m, Some(e)),
-        None => (s, None),
-    };
-    let mant = if mant.contains('.') { mant.to_string() } else { format!("{mant}.") };
-    match exp {
-        None => mant,
-        Some(e) if e.starts_with('-') || e.starts_with('+') => format!("{mant}e{e}"),
-        Some(e) => format!("{mant}e+{e}"),
-    }
-}
-
-/// Parse a Nastran real ("1.5", ".5", "1.5e-3", "1.5E+3", "1.5-3", "-.5+2").
-pub(crate) fn read_nastran_real(s: &str) -> Option<f64> {
-    let t = s.trim().to_ascii_lowercase().replace('d', "e");
-    if let Ok(v) = t.parse::<f64>() {
-        return Some(v);
-    }
-    // Implicit exponent: the last sign that is not the first character.
-    let k = t.rfind(['+', '-']).filter(|&k| k > 0 && !t[..k].ends_with('e'))?;
-    format!("{}e{}", &t[..k], &t[k..]).parse().ok()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fit_real_fits_and_reads_back() {
-        for &x in &[0.1, -0.1234567891234, 1.0e-7, -3.0e-12, 123456.789, 1.0e20, 0.0, 179.99999999999997, -2.5e-300] {
-            for width in [8, 16] {
-                let s = fit_real(x, width).unwrap();
-                assert!(s.len() <= width && s.contains('.'), "{x} -> {s}");
-                let back = read_nastran_real(&s).unwrap();
-                let rel = if x == 0.0 { back.abs() } else { ((back - x) / x).abs() };
-                let tol = if width == 8 { 1e-3 } else { 1e-9 };
-                assert!(rel <= tol, "{x} -> {s} -> {back}");
-            }
-        }
-        assert_eq!(fit_real(0.5, 8).unwrap(), "0.5");
-        assert_eq!(fit_real(-1.0e-7, 8).unwrap(), "-1.e-7");
-        assert_eq!(read_nastran_real("1.5-3"), Some(1.5e-3));
-        assert_eq!(read_nastran_real("-.5+2"), Some(-50.0));
-        assert!(fit_real(f64::NAN, 8).is_none());
-    }
 
     #[test]
     fn angles() {

@@ -1,4 +1,4 @@
-//! Nastran bulk data: GRID, CTRIA3/CTRIAR and CQUAD4/CQUADR, with CORD2R/CORD2C/CORD2S for
+//! Reading Nastran bulk data: GRID, CTRIA3/CTRIAR and CQUAD4/CQUADR, with CORD2R/CORD2C/CORD2S for
 //! grids given in a local system (CP).
 //!
 //! Accepted layouts, mixed freely line by line:
@@ -21,7 +21,9 @@
 //! is 0. An element's blank PID is its EID (Nastran's default). Cards starting with `C` that are
 //! not shells (CTRIA6, CQUAD8, CHEXA, CBAR, CONM2, ...) are counted and skipped; other cards
 //! (PSHELL, MAT1, PCOMP, ...) are ignored.
-use super::{read_bytes, Builder, FlowMesh, FlowMeshError, Loc};
+use super::parse_real;
+use crate::io::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
+use crate::mapping::FlowMesh;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -31,7 +33,7 @@ const MAX_INCLUDE_DEPTH: usize = 32;
 const MAX_CORD_DEPTH: usize = 64;
 
 /// Read a Nastran bulk data file (see the module documentation for what is accepted).
-pub fn read_nastran(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
+pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
     let mut b = Builder::new(path, scale)?;
     let mut r = Reader { card: Card::default(), grids: Vec::new(), cords: HashMap::new(), other_cords: HashMap::new() };
     let bytes = read_bytes(path)?;
@@ -39,42 +41,6 @@ pub fn read_nastran(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> 
     r.flush(&mut b)?;
     r.place_grids(&mut b)?;
     b.finish("CTRIA3, CTRIAR, CQUAD4, CQUADR")
-}
-
-/// Parse a Nastran real: `1.5`, `1.5E-3`, `1.5D-3`, `1.5-3` (= 1.5e-3), `-.5+2` (= -50), `7.`.
-/// Returns `None` for a blank or malformed field. Infinite results (overflow) are returned as
-/// they are: the caller refuses them with the line number.
-pub fn parse_nastran_real(field: &str) -> Option<f64> {
-    let t = field.trim();
-    if t.is_empty() || t.len() > 64 {
-        return None;
-    }
-    let mut buf = [0u8; 66];
-    let mut n = 0;
-    let mut has_exp = false;
-    for (k, &c) in t.as_bytes().iter().enumerate() {
-        let c = match c {
-            b'd' | b'D' | b'e' | b'E' => {
-                has_exp = true;
-                b'E'
-            }
-            _ => c,
-        };
-        // A sign after the mantissa without a letter is Nastran's exponent shorthand.
-        if (c == b'+' || c == b'-') && k > 0 && !has_exp {
-            buf[n] = b'E';
-            n += 1;
-            has_exp = true;
-        }
-        buf[n] = c;
-        n += 1;
-    }
-    let s = std::str::from_utf8(&buf[..n]).ok()?;
-    // Reject words Rust would accept ("inf", "nan"): a Nastran real is digits, '.', signs, E.
-    if !s.bytes().all(|c| c.is_ascii_digit() || matches!(c, b'.' | b'+' | b'-' | b'E')) {
-        return None;
-    }
-    s.parse().ok()
 }
 
 /// One logical card: its name and the data fields of all its lines, as byte ranges into `buf`.
@@ -335,7 +301,7 @@ impl Reader {
             if f.is_empty() {
                 return Ok(0.0);
             }
-            parse_nastran_real(f)
+            parse_real(f)
                 .ok_or_else(|| b.syntax(loc, format!("{name} field {what}: '{f}' is not a Nastran real number")))
         };
         let id = |k: usize, what: &str| -> Result<u64, FlowMeshError> {
@@ -476,50 +442,5 @@ impl Frame {
         };
         let p = self.origin + self.axes[0] * l[0] + self.axes[1] * l[1] + self.axes[2] * l[2];
         [p.x, p.y, p.z]
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::parse_nastran_real as r;
-
-    #[test]
-    fn plain_reals() {
-        assert_eq!(r("1.5"), Some(1.5));
-        assert_eq!(r(" 7. "), Some(7.0));
-        assert_eq!(r(".5"), Some(0.5));
-        assert_eq!(r("-3"), Some(-3.0));
-        assert_eq!(r("1.5E-3"), Some(1.5e-3));
-        assert_eq!(r("1.5e+3"), Some(1.5e3));
-    }
-
-    #[test]
-    fn exponent_without_letter() {
-        assert_eq!(r("1.-3"), Some(1e-3));
-        assert_eq!(r("-.5+2"), Some(-50.0));
-        assert_eq!(r("+2.5-1"), Some(0.25));
-        assert_eq!(r("-1.25+0"), Some(-1.25));
-    }
-
-    #[test]
-    fn fortran_d_exponent() {
-        assert_eq!(r("1.5D-3"), Some(1.5e-3));
-        assert_eq!(r("2.d2"), Some(200.0));
-    }
-
-    #[test]
-    fn malformed_and_blank() {
-        assert_eq!(r(""), None);
-        assert_eq!(r("   "), None);
-        assert_eq!(r("abc"), None);
-        assert_eq!(r("inf"), None);
-        assert_eq!(r("nan"), None);
-        assert_eq!(r("1.2.3"), None);
-        assert_eq!(r("1.5E"), None);
-    }
-
-    #[test]
-    fn overflow_is_infinite_not_an_error_here() {
-        assert_eq!(r("1.+999"), Some(f64::INFINITY));
     }
 }

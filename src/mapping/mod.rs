@@ -1,11 +1,13 @@
 //! Mapping a draped net onto a resin-flow mesh: for every flow element, the warp and weft of each
 //! ply projected into the element's plane, the shear angle, the thickness and fibre volume
 //! fraction change and, on request, a permeability tensor (REFERENCES.md §5).
-use super::flowmesh::FlowMesh;
+pub mod mesh;
+
 use crate::geometry::Vector;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
 pub use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP, VF_MAX_HEX};
+pub use mesh::{ElementShape, FlowElement, FlowMesh};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
@@ -244,7 +246,6 @@ impl LayupMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::export::flowmesh::{ElementShape, FlowElement};
     use crate::geometry::shapes;
     use crate::geometry::Point;
     use crate::kinematic::{drape, KinematicSettings};

@@ -1,4 +1,4 @@
-//! Nastran bulk data (MSC / NX / pyNastran) with the material orientation angle THETA of each
+//! Writing Nastran bulk data (MSC / NX / pyNastran) with the material orientation angle THETA of each
 //! element: GRID, CTRIA3 and CQUAD4 in large-field fixed format (16-character fields; reals
 //! take at most 15 characters so a blank always separates neighbours, which keeps 10 or more
 //! significant digits: THETA to better than 1e-8 degree).
@@ -11,20 +11,19 @@
 //! elements covered by the ply have PID 1, the others PID 2 and no THETA (the field is left
 //! blank, and a comment lists them); define PSHELL/PCOMP 1 and 2 yourself. The executive and
 //! case control sections are empty (`CEND`, `BEGIN BULK`, ..., `ENDDATA`).
-use super::{deg, file_tag, fit_real, sibling, write_atomic, ExportError, FlowMesh, LayupMap};
-use crate::export::flowmesh::ElementShape;
-use crate::export::map::PlyMap;
+use super::{large, real};
+use crate::io::flow::{deg, file_tag, sibling};
+use crate::io::{write_atomic, ExportError};
+use crate::mapping::{ElementShape, FlowElement, FlowMesh, LayupMap, PlyMap};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 /// Property id of the elements the ply covers.
-pub(super) const PID_COVERED: u64 = 1;
+pub(crate) const PID_COVERED: u64 = 1;
 /// Property id of the elements the ply does not cover.
-pub(super) const PID_UNCOVERED: u64 = 2;
-/// Width of a large field.
-pub(super) const LARGE: usize = 16;
+pub(crate) const PID_UNCOVERED: u64 = 2;
 
-pub(super) fn write(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Vec<PathBuf>, ExportError> {
+pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Vec<PathBuf>, ExportError> {
     let ext = out.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
     let targets: Vec<(PathBuf, &PlyMap)> = if map.layup {
         let mut v = Vec::new();
@@ -72,7 +71,7 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<
 }
 
 /// Every node as a large-field GRID*.
-pub(super) fn write_grids<W: Write>(mesh: &FlowMesh, w: &mut W) -> io::Result<()> {
+pub(crate) fn write_grids<W: Write>(mesh: &FlowMesh, w: &mut W) -> io::Result<()> {
     for (p, id) in mesh.nodes.iter().zip(&mesh.node_ids) {
         large(w, "GRID", &[id.to_string(), String::new(), real(p.x), real(p.y), real(p.z)])?;
     }
@@ -80,9 +79,9 @@ pub(super) fn write_grids<W: Write>(mesh: &FlowMesh, w: &mut W) -> io::Result<()
 }
 
 /// One CTRIA3*/CQUAD4* with property `pid` and material angle `theta` (blank if `None`).
-pub(super) fn write_element<W: Write>(
+pub(crate) fn write_element<W: Write>(
     mesh: &FlowMesh,
-    el: &crate::export::flowmesh::FlowElement,
+    el: &FlowElement,
     pid: u64,
     theta: Option<String>,
     w: &mut W,
@@ -95,29 +94,4 @@ pub(super) fn write_element<W: Write>(
     fields.extend(el.nodes.iter().map(|&k| mesh.node_ids[k].to_string()));
     fields.push(theta.unwrap_or_default());
     large(w, name, &fields)
-}
-
-/// A real in a large field (checked finite before writing).
-pub(super) fn real(x: f64) -> String {
-    // One character short of the field: a blank always separates neighbouring numbers.
-    fit_real(x, LARGE - 1).expect("values are checked finite before writing")
-}
-
-/// One entry in large-field fixed format: `fields` are the entry's fields 2, 3, ... in
-/// small-field numbering (8 per logical line); they go 4 per physical line, the first line
-/// starting `NAME*`, continuation lines `*`.
-pub(super) fn large<W: Write>(w: &mut W, name: &str, fields: &[String]) -> io::Result<()> {
-    let n_lines = fields.len().div_ceil(4).max(1);
-    for line in 0..n_lines {
-        let head = if line == 0 { format!("{name}*") } else { "*".to_string() };
-        write!(w, "{head:<8}")?;
-        let chunk = &fields[(4 * line).min(fields.len())..(4 * line + 4).min(fields.len())];
-        let mut text = String::new();
-        for f in chunk {
-            debug_assert!(f.len() <= LARGE, "field {f:?} too long");
-            text.push_str(&format!("{f:<16}"));
-        }
-        writeln!(w, "{}", text.trim_end())?;
-    }
-    Ok(())
 }

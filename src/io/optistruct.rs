@@ -15,15 +15,18 @@
 //! * PLY: ID k, MID 1, T = the ply's nominal thickness, DID k, ESID k (SET k, ELEM LIST).
 //!
 //! Not written (yours to add): MAT8 1, the PCOMPP 1 property and the STACK ordering the plies.
-use super::nastran::{large, real, write_element, write_grids, PID_COVERED, PID_UNCOVERED};
-use super::{deg, wrap, write_atomic, ExportError, FlowMesh, LayupMap};
+use super::flow::{deg, wrap};
+use super::nastran::write::{write_element, write_grids, PID_COVERED, PID_UNCOVERED};
+use super::nastran::{large, real};
+use super::{write_atomic, ExportError};
+use crate::mapping::{FlowMesh, LayupMap};
 use std::io::{self, Write};
 use std::path::Path;
 
 /// Material id the PLY entries reference.
 pub const MID: u64 = 1;
 
-pub(super) fn write(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
+pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
     for ply in &map.plies {
         if let Some(f) = ply.elements.iter().flatten().find(|f| !(f.nominal_thickness > 0.0)) {
             return Err(ExportError::FlowInvalid {

@@ -1,41 +1,8 @@
-//! Writers for draped nets: the JSON contract, VTU (ParaView) and CSV; and [`read_net`] for the
-//! JSON. Every file is written atomically ([`write_atomic`]) after the net has been checked, so a
-//! net that would need NaN or infinity in a file is refused and nothing partial is left behind.
-mod atomic;
-mod check;
-pub mod csv;
-mod error;
-pub mod flow;
-pub mod flowmesh;
-pub mod json;
-pub mod map;
-pub mod pattern;
-pub mod vtu;
-
-pub use atomic::write_atomic;
-pub use csv::{write_csv, CSV_HEADER};
-pub use error::ExportError;
-pub use json::{read_net, write_json};
-pub use vtu::write_vtu;
-
+//! The files a draped net is written to: `<ply>.drape.json` (the contract), `<ply>.vtu` and
+//! `<ply>.cells.csv`, chosen by [`Format`] and written by [`write_net`].
+use super::{check, csv::write_csv, net_json::write_json, vtk::write_vtu, ExportError};
 use crate::kinematic::DrapeNet;
 use std::path::{Path, PathBuf};
-
-/// Text escaped for XML (SVG, VTU) and HTML content and attribute values.
-pub fn xml_escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
 
 /// An output format of a net.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

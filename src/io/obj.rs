@@ -5,11 +5,15 @@
 //! order (from 1), which is the face number as long as no polygon was split. Groups, objects,
 //! materials and smoothing (`g`, `o`, `usemtl`, `s`) are ignored: every property is 0. A line
 //! ending in `\` continues on the next.
-use super::{read_bytes, Builder, FlowMesh, FlowMeshError, Loc};
+use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
+use crate::mapping::FlowMesh;
 use std::path::Path;
 
+/// OBJ as a shell-mesh format.
+pub const FORMAT: super::MeshFormat = super::MeshFormat { name: "OBJ", extensions: &["obj"], read };
+
 /// Read an OBJ file (see the module documentation).
-pub fn read_obj(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
+pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
     let mut b = Builder::new(path, scale)?;
     let bytes = read_bytes(path)?;
     let text = String::from_utf8_lossy(&bytes);

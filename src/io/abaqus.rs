@@ -1,4 +1,8 @@
-//! Abaqus input decks (`.inp`): `*NODE` and `*ELEMENT` of three- and four-node shell,
+//! Abaqus input decks (`.inp`): reading shell meshes (tools and flow meshes) and writing the
+//! fibre orientations of a layup on a flow mesh.
+//!
+//! # Reading
+//! `*NODE` and `*ELEMENT` of three- and four-node shell,
 //! membrane, surface and rigid types (S3, S3R, S3RS, STRI3, DS3, M3D3, R3D3, SFM3D3 -> Tria3;
 //! S4, S4R, S4RS, S4R5, DS4, M3D4, M3D4R, R3D4, SFM3D4, SFM3D4R -> Quad4); other element types
 //! are skipped.
@@ -17,16 +21,46 @@
 //!
 //! An element's property is a number per `ELSET` name given on its `*ELEMENT` line, 1, 2, ...
 //! in the order the names first appear (names compared case-insensitively), 0 without ELSET.
-use super::{read_bytes, Builder, FlowMesh, FlowMeshError, Loc};
+//!
+//! # Writing
+//! The flow mesh as shell elements and, per ply, a local material
+//! orientation per element (Abaqus Keywords Reference: *DISTRIBUTION TABLE, *DISTRIBUTION,
+//! *ORIENTATION).
+//!
+//! Layout:
+//! ```text
+//! *NODE, NSET=DRAPE_NODES                        id, x, y, z
+//! *ELEMENT, TYPE=S3, ELSET=DRAPE_S3              id, n1, n2, n3
+//! *ELEMENT, TYPE=S4, ELSET=DRAPE_S4              id, n1, n2, n3, n4
+//! *DISTRIBUTION TABLE, NAME=DRAPE_DIRECTIONS     COORD3D, COORD3D
+//! per ply P (TAG = "P<k>_" + the ply name with characters other than A-Z, a-z, 0-9, _ as _):
+//! *ELSET, ELSET=<TAG>                            the elements the ply covers (16 per line)
+//! *ELSET, ELSET=<TAG>_UNCOVERED                  the others (only if any)
+//! *DISTRIBUTION, NAME=<TAG>_DIR, LOCATION=ELEMENT, TABLE=DRAPE_DIRECTIONS
+//! , 1., 0., 0., 0., 1., 0.                       default line (required; used by no element)
+//! id, a1, a2, a3, b1, b2, b3                     a = warp, b = weft (covered elements only)
+//! *ORIENTATION, NAME=<TAG>_ORI, SYSTEM=RECTANGULAR, DEFINITION=COORDINATES
+//! <TAG>_DIR
+//! 3, 0.
+//! ```
+//! Abaqus takes local 1 = a projected onto the shell and local 2 in the plane of a and b, so
+//! local 1 is the warp; b = weft keeps the sheared weft in the file (angle a-b = 90 - shear).
+//! Reference the orientation from your *SHELL SECTION / *SHELL SECTION, COMPOSITE on ELSET <TAG>.
+use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
+use super::{write_atomic, ExportError};
+use crate::mapping::{ElementShape, FlowMesh, LayupMap};
 use nalgebra::Vector3;
 use std::collections::HashMap;
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
+/// Abaqus as a shell-mesh format.
+pub const FORMAT: super::MeshFormat = super::MeshFormat { name: "Abaqus", extensions: &["inp"], read };
 /// How deep `*INCLUDE` may nest before we assume a cycle.
 const MAX_INCLUDE_DEPTH: usize = 32;
 
 /// Read an Abaqus input deck (see the module documentation).
-pub fn read_abaqus(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
+pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
     let mut b = Builder::new(path, scale)?;
     let mut lines = Vec::new();
     load(&mut b, 0, 0, &mut lines)?;
@@ -409,6 +443,89 @@ fn add(
             return Err(b.syntax(*loc, format!("element id {id} of {what} is already defined ({at}): {HINT}")));
         }
         b.add_element(*id, nodes, *prop, *loc)?;
+    }
+    Ok(())
+}
+
+// ---- writing -------------------------------------------------------------------------------
+
+/// Name of the shared distribution table.
+pub const TABLE: &str = "DRAPE_DIRECTIONS";
+/// Abaqus allows at most 16 entries on a data line of *ELSET.
+const PER_LINE: usize = 16;
+
+pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
+    write_atomic(out, |w| write_flow_to(mesh, map, w))
+}
+
+/// The Abaqus name of ply `k` (0-based): unique, starts with a letter, at most 80 characters.
+pub fn ply_tag(k: usize, ply: &str) -> String {
+    let clean: String = ply.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
+    let mut tag = format!("P{}_{clean}", k + 1);
+    tag.truncate(64); // room for the _UNCOVERED / _DIR / _ORI suffixes
+    tag
+}
+
+fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Result<()> {
+    writeln!(w, "** drape: fibre orientations on flow mesh {}", mesh.path.display())?;
+    writeln!(w, "*HEADING")?;
+    writeln!(w, "drape fibre orientations, {} ply(s)", map.plies.len())?;
+    for (k, ply) in map.plies.iter().enumerate() {
+        writeln!(w, "** ply {} '{}' -> {}", k + 1, ply.ply.replace(['\n', '\r'], " "), ply_tag(k, &ply.ply))?;
+    }
+    writeln!(w, "*NODE, NSET=DRAPE_NODES")?;
+    for (p, id) in mesh.nodes.iter().zip(&mesh.node_ids) {
+        writeln!(w, "{id}, {:?}, {:?}, {:?}", p.x, p.y, p.z)?;
+    }
+    for (shape, ty) in [(ElementShape::Tria3, "S3"), (ElementShape::Quad4, "S4")] {
+        let els: Vec<_> = mesh.elements.iter().filter(|e| e.shape == shape).collect();
+        if els.is_empty() {
+            continue;
+        }
+        writeln!(w, "*ELEMENT, TYPE={ty}, ELSET=DRAPE_{ty}")?;
+        for el in els {
+            let nodes: Vec<String> = el.nodes.iter().map(|&k| mesh.node_ids[k].to_string()).collect();
+            writeln!(w, "{}, {}", el.id, nodes.join(", "))?;
+        }
+    }
+    writeln!(w, "*DISTRIBUTION TABLE, NAME={TABLE}")?;
+    writeln!(w, "COORD3D, COORD3D")?;
+    for (k, ply) in map.plies.iter().enumerate() {
+        let tag = ply_tag(k, &ply.ply);
+        let ids = |covered: bool| -> Vec<u64> {
+            mesh.elements.iter().zip(&ply.elements).filter(|(_, f)| f.is_some() == covered).map(|(e, _)| e.id).collect()
+        };
+        let (cov, unc) = (ids(true), ids(false));
+        elset(w, &tag, &cov)?;
+        if !unc.is_empty() {
+            writeln!(
+                w,
+                "** {} element(s) not covered by ply '{}': no orientation",
+                unc.len(),
+                ply.ply.replace(['\n', '\r'], " ")
+            )?;
+            elset(w, &format!("{tag}_UNCOVERED"), &unc)?;
+        }
+        writeln!(w, "*DISTRIBUTION, NAME={tag}_DIR, LOCATION=ELEMENT, TABLE={TABLE}")?;
+        writeln!(w, ", 1., 0., 0., 0., 1., 0.")?;
+        for (el, f) in mesh.elements.iter().zip(&ply.elements) {
+            if let Some(f) = f {
+                let (a, b) = (f.warp, f.weft);
+                writeln!(w, "{}, {:?}, {:?}, {:?}, {:?}, {:?}, {:?}", el.id, a.x, a.y, a.z, b.x, b.y, b.z)?;
+            }
+        }
+        writeln!(w, "*ORIENTATION, NAME={tag}_ORI, SYSTEM=RECTANGULAR, DEFINITION=COORDINATES")?;
+        writeln!(w, "{tag}_DIR")?;
+        writeln!(w, "3, 0.")?;
+    }
+    Ok(())
+}
+
+fn elset<W: Write>(w: &mut W, name: &str, ids: &[u64]) -> io::Result<()> {
+    writeln!(w, "*ELSET, ELSET={name}")?;
+    for chunk in ids.chunks(PER_LINE) {
+        let s: Vec<String> = chunk.iter().map(u64::to_string).collect();
+        writeln!(w, "{}", s.join(", "))?;
     }
     Ok(())
 }

@@ -23,9 +23,11 @@
 //! lists them). Inlets are left to RTMsim's interactive selection (`i_interactive` 2, or 1 when
 //! there is no set); the process values (pressures, viscosity, tmax) are RTMsim's documented
 //! example values: edit them. Run RTMsim in the output directory (the mesh name is relative).
-use super::{fit_real, sibling, write_atomic, ExportError, FlowMesh, LayupMap, RtmsimReport};
-use crate::export::flowmesh::ElementShape;
+use super::flow::{sibling, RtmsimReport};
+use super::nastran::fit_real;
+use super::{write_atomic, ExportError};
 use crate::geometry::Vector;
+use crate::mapping::{ElementShape, FlowMesh, LayupMap};
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -176,7 +178,7 @@ fn distance(a: &RtmsimRegion, b: &RtmsimRegion) -> f64 {
         + a.refdir.dot(&b.refdir).abs().min(1.0).acos().to_degrees() / DIRECTION_BIN_DEG
 }
 
-pub(super) fn write(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<RtmsimReport, ExportError> {
+pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<RtmsimReport, ExportError> {
     let mesh_path = sibling(out, ".bdf");
     let input_path = sibling(out, "_input.txt");
     let (cells, uncovered) = cells(mesh, map)?;

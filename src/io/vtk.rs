@@ -1,3 +1,6 @@
+//! VTK XML files (UnstructuredGrid, ASCII, version 0.1, little endian) for ParaView and meshio:
+//! a draped net and the flow mesh with the fibres mapped onto it.
+//!
 //! `<ply>.vtu`: VTK XML UnstructuredGrid (ASCII, version 0.1, little endian) for ParaView and
 //! meshio. Points are the placed nodes only, renumbered compactly in node order; cells are
 //! VTK_QUAD (type 9), one for every cell whose four corners are placed, with connectivity
@@ -6,13 +9,24 @@
 //! CellData: `shear_deg` (Float64), `warp`, `weft`, `normal` (Float64 x 3, unit), `cell_i`,
 //! `cell_j` (Int32). PointData: `node_i`, `node_j` (Int32). Floats are written with `{:?}`, the
 //! shortest text that parses back to the same f64.
+//!
+//! The flow mesh with the fibres of a mapped layup as cell data (`drape export --format vtu`,
+//! `flow.vtu`): points are the mesh nodes in mesh order; cells are VTK_TRIANGLE (5) and VTK_QUAD (9) in
+//! element order with the element's corner order. Cell data for one net (`map.layup == false`):
+//! `element_id` (Int64, the mesh's id), `covered` (Int32 0/1), `warp`, `weft` (Float64 x 3),
+//! `shear_deg`, `thickness`, `vf` (Float64) and `permeability` (Float64 x 9, row-major, only if
+//! some element has one). For a layup the per-ply fields get the prefix `<ply>_` (`covered`
+//! too) and the laminate fields `laminate_thickness`, `mean_vf` and `laminate_permeability`
+//! (only if present) follow. Where a ply does not cover an element: covered = 0 and zeros in
+//! its other fields (never NaN); likewise zeros where a laminate value is missing.
 use super::check::{cells, check_net};
+use super::xml::xml_escape;
 use super::{write_atomic, ExportError};
 use crate::geometry::Vector;
 use crate::kinematic::{DrapeNet, NodeStatus};
+use crate::mapping::{ElementShape, FlowMesh, LayupMap};
 use std::io::{self, Write};
 use std::path::Path;
-
 /// VTK cell type of a linear quadrilateral.
 const VTK_QUAD: u8 = 9;
 /// Values per line in the data arrays (keeps lines short; any layout is valid VTK).
@@ -105,6 +119,91 @@ pub(crate) fn data_array<W: Write, T: std::fmt::Debug>(
         write!(w, "{sep}{v:?}")?;
     }
     w.write_all(b"\n</DataArray>\n")
+}
+
+// ---- the flow mesh with the fibres -------------------------------------------------------------
+
+const VTK_TRIANGLE: u8 = 5;
+
+pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
+    write_atomic(out, |w| write_flow_to(mesh, map, w))
+}
+
+fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Result<()> {
+    let n = mesh.elements.len();
+    w.write_all(b"<?xml version=\"1.0\"?>\n")?;
+    w.write_all(
+        b"<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n",
+    )?;
+    writeln!(w, "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{n}\">", mesh.nodes.len())?;
+    w.write_all(b"<CellData>\n")?;
+    tuple_array(w, "Int64", "element_id", 1, mesh.elements.iter().map(|e| e.id))?;
+    for ply in &map.plies {
+        let p = if map.layup { format!("{}_", xml_escape(&ply.ply)) } else { String::new() };
+        let els = &ply.elements;
+        tuple_array(w, "Int32", &format!("{p}covered"), 1, els.iter().map(|f| i32::from(f.is_some())))?;
+        let vec3 = |pick: fn(&crate::mapping::ElementFibres) -> [f64; 3]| {
+            els.iter().flat_map(move |f| f.as_ref().map_or([0.0; 3], pick))
+        };
+        tuple_array(w, "Float64", &format!("{p}warp"), 3, vec3(|f| [f.warp.x, f.warp.y, f.warp.z]))?;
+        tuple_array(w, "Float64", &format!("{p}weft"), 3, vec3(|f| [f.weft.x, f.weft.y, f.weft.z]))?;
+        let scalar =
+            |pick: fn(&crate::mapping::ElementFibres) -> f64| els.iter().map(move |f| f.as_ref().map_or(0.0, pick));
+        tuple_array(w, "Float64", &format!("{p}shear_deg"), 1, scalar(|f| f.shear.to_degrees()))?;
+        tuple_array(w, "Float64", &format!("{p}thickness"), 1, scalar(|f| f.thickness))?;
+        tuple_array(w, "Float64", &format!("{p}vf"), 1, scalar(|f| f.vf))?;
+        if els.iter().flatten().any(|f| f.permeability.is_some()) {
+            let k = els.iter().flat_map(|f| row_major(f.as_ref().and_then(|f| f.permeability.as_ref())));
+            tuple_array(w, "Float64", &format!("{p}permeability"), 9, k)?;
+        }
+    }
+    if map.layup {
+        tuple_array(w, "Float64", "laminate_thickness", 1, map.thickness.iter().copied())?;
+        tuple_array(w, "Float64", "mean_vf", 1, map.mean_vf.iter().map(|v| v.unwrap_or(0.0)))?;
+        if map.permeability.iter().any(Option::is_some) {
+            let k = map.permeability.iter().flat_map(|k| row_major(k.as_ref()));
+            tuple_array(w, "Float64", "laminate_permeability", 9, k)?;
+        }
+    }
+    w.write_all(b"</CellData>\n<Points>\n")?;
+    tuple_array(w, "Float64", "Points", 3, mesh.nodes.iter().flat_map(|p| [p.x, p.y, p.z]))?;
+    w.write_all(b"</Points>\n<Cells>\n")?;
+    tuple_array(w, "Int64", "connectivity", 1, mesh.elements.iter().flat_map(|e| e.nodes.iter().copied()))?;
+    let offsets = mesh.elements.iter().scan(0usize, |acc, e| {
+        *acc += e.nodes.len();
+        Some(*acc)
+    });
+    tuple_array(w, "Int64", "offsets", 1, offsets)?;
+    let types = mesh.elements.iter().map(|e| match e.shape {
+        ElementShape::Tria3 => VTK_TRIANGLE,
+        ElementShape::Quad4 => VTK_QUAD,
+    });
+    tuple_array(w, "UInt8", "types", 1, types)?;
+    w.write_all(b"</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
+}
+
+/// The 9 entries of `k` row by row, zeros for `None`.
+fn row_major(k: Option<&nalgebra::Matrix3<f64>>) -> [f64; 9] {
+    let mut out = [0.0; 9];
+    if let Some(k) = k {
+        for r in 0..3 {
+            for c in 0..3 {
+                out[3 * r + c] = k[(r, c)];
+            }
+        }
+    }
+    out
+}
+
+/// One ASCII `<DataArray>` with a whole tuple a group.
+fn tuple_array<W: Write, T: std::fmt::Debug>(
+    w: &mut W,
+    ty: &str,
+    name: &str,
+    components: usize,
+    values: impl Iterator<Item = T>,
+) -> io::Result<()> {
+    data_array(w, ty, name, components, components, values)
 }
 
 #[cfg(test)]

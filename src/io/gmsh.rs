@@ -5,12 +5,16 @@
 //! `$Entities` gives one, else the entity tag. Other sections are skipped. Binary 4.1 files
 //! (little-endian, 8-byte size_t, as Gmsh writes them on every common machine) are read the
 //! same way. Older versions (2.x, 4.0) are refused with a message saying how to re-save.
-use super::{read_bytes, Builder, FlowMesh, FlowMeshError, Loc};
+use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
+use crate::mapping::FlowMesh;
 use std::collections::HashMap;
 use std::path::Path;
 
+/// Gmsh 4 as a shell-mesh format.
+pub const FORMAT: super::MeshFormat = super::MeshFormat { name: "Gmsh 4", extensions: &["msh"], read };
+
 /// Read a Gmsh 4.1 ASCII mesh (see the module documentation).
-pub fn read_gmsh(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
+pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
     let mut b = Builder::new(path, scale)?;
     let bytes = read_bytes(path)?;
     // Binary files hold raw bytes after the header; only the header needs to be text.

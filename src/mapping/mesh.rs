@@ -1,0 +1,111 @@
+//! The resin-flow mesh: the user's own shell mesh of the part (not the drape grid), as the readers
+//! in [`crate::io`] return it: nodes in metres with the ids the file gave them, and three- and
+//! four-node shell elements with their own ids, so that writers can give results back under the
+//! user's numbering.
+use crate::geometry::{Point, Vector};
+use std::path::PathBuf;
+
+/// Shape of a shell element of a flow mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ElementShape {
+    /// Three-node triangle (CTRIA3, S3, M3D3, ...).
+    Tria3,
+    /// Four-node quadrilateral (CQUAD4, S4, M3D4, ...).
+    Quad4,
+}
+
+impl ElementShape {
+    /// Number of corner nodes.
+    pub fn corners(self) -> usize {
+        match self {
+            ElementShape::Tria3 => 3,
+            ElementShape::Quad4 => 4,
+        }
+    }
+}
+
+/// One shell element of a flow mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowElement {
+    /// Element id in the source file (for OBJ: the face number, from 1).
+    pub id: u64,
+    pub shape: ElementShape,
+    /// Corner node indices into [`FlowMesh::nodes`], in the file's order (G1, G2, G3[, G4]).
+    pub nodes: Vec<usize>,
+    /// Property / section / physical-group id from the source file, 0 when it has none.
+    pub property: u64,
+}
+
+/// A shell mesh of the part, in metres.
+#[derive(Debug, Clone, Default)]
+pub struct FlowMesh {
+    /// The file it was read from.
+    pub path: PathBuf,
+    /// Node coordinates in metres.
+    pub nodes: Vec<Point>,
+    /// Node ids in the source file, one per node (for OBJ: the vertex number, from 1).
+    pub node_ids: Vec<u64>,
+    pub elements: Vec<FlowElement>,
+}
+
+impl FlowMesh {
+    /// Corner points of element `e`.
+    pub fn corners(&self, e: usize) -> Vec<Point> {
+        self.elements[e].nodes.iter().map(|&n| self.nodes[n]).collect()
+    }
+
+    /// Centroid (mean of the corners) of element `e`.
+    pub fn centroid(&self, e: usize) -> Point {
+        let c = self.corners(e);
+        let sum = c.iter().fold(Vector::zeros(), |s, p| s + p.coords);
+        Point::from(sum / c.len() as f64)
+    }
+
+    /// Area-weighted normal of element `e` (Newell's method; for a warped quad the normal of its
+    /// mean plane), of length twice the area for a triangle and the projected area x 2 for a
+    /// quad. Zero for a degenerate element.
+    pub fn area_normal(&self, e: usize) -> Vector {
+        let c = self.corners(e);
+        let mut n = Vector::zeros();
+        for k in 0..c.len() {
+            n += c[k].coords.cross(&c[(k + 1) % c.len()].coords);
+        }
+        n
+    }
+
+    /// Unit normal of element `e` (right-handed over G1, G2, G3...), or `None` if degenerate.
+    pub fn normal(&self, e: usize) -> Option<Vector> {
+        let n = self.area_normal(e);
+        let len = n.norm();
+        (len > 0.0 && len.is_finite()).then(|| n / len)
+    }
+
+    /// Area of element `e` (of its mean plane for a warped quad).
+    pub fn area(&self, e: usize) -> f64 {
+        0.5 * self.area_normal(e).norm()
+    }
+
+    /// Unit direction of the element's first edge G1 -> G2 projected into its plane: the
+    /// reference of Nastran's material angle THETA.
+    pub fn first_edge(&self, e: usize) -> Option<Vector> {
+        let n = self.normal(e)?;
+        let el = &self.elements[e];
+        let d = self.nodes[el.nodes[1]] - self.nodes[el.nodes[0]];
+        let d = d - n * n.dot(&d);
+        let len = d.norm();
+        (len > 0.0).then(|| d / len)
+    }
+}
+
+impl FlowMesh {
+    /// Index in [`FlowMesh::nodes`] of the node with file id `id` (a linear search: build a map
+    /// for many look-ups).
+    pub fn node_by_id(&self, id: u64) -> Option<usize> {
+        self.node_ids.iter().position(|&n| n == id)
+    }
+
+    /// The file ids of the corners of element `e`.
+    pub fn element_node_ids(&self, e: usize) -> Vec<u64> {
+        self.elements[e].nodes.iter().map(|&n| self.node_ids[n]).collect()
+    }
+}
