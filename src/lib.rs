@@ -12,6 +12,7 @@ pub mod mapping;
 pub mod material;
 pub mod mechanics;
 pub mod numeric;
+pub mod pipeline;
 pub mod report;
 
 pub use geometry::ToolSurface;

@@ -23,6 +23,7 @@ mod mechanics_properties;
 mod mechanics_references;
 mod mechanics_refine;
 mod mechanics_shear_tests;
+mod module_layers;
 mod net_properties;
 mod offset_bladelike;
 mod report;

@@ -3,7 +3,7 @@
 //! data are absent (a user's fresh clone has no ../shared).
 use drape::geometry::offset::offset_surface;
 use drape::geometry::ToolSurface;
-use drape::layup::load_tool;
+use drape::io::read_tool as load_tool;
 use std::path::PathBuf;
 
 fn data_dir() -> Option<PathBuf> {

@@ -7,12 +7,12 @@
 //! ```
 use super::{compute, input, Failure};
 use crate::io::write_atomic;
-use crate::layup::unit_scale;
 use crate::material::calibrate::{
     fit_knit_uniaxial, fit_shear_bias_extension, fit_shear_picture_frame, parse_xy_csv, FitError, FitReport,
     ShearLawKind,
 };
 use crate::material::card::{Fibre, KnitParams, MaterialCard, ShearLaw, TensionLaw};
+use crate::pipeline::unit_scale;
 use anyhow::anyhow;
 use clap::{Args, Subcommand, ValueEnum};
 use std::io::Write;

@@ -2,11 +2,11 @@
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
 use super::{compute, input, Failure};
 use crate::io::flow::{write_flow, FlowFormat};
-use crate::io::read_flow_mesh;
-use crate::io::read_net;
-use crate::layup::unit_scale;
-use crate::mapping::{map_net, Cavity, LayupMap, PermeabilityModel, PlyMapSettings};
+use crate::io::{read_flow_mesh, read_net};
+use crate::mapping::{map_plies, PlyMap, PlyToMap};
+use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP};
 use crate::material::MaterialCard;
+use crate::pipeline::unit_scale;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -96,21 +96,17 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     let t = Instant::now();
     let mesh = read_flow_mesh(&a.mesh, scale).map_err(input)?;
     let read_ms = t.elapsed().as_secs_f64() * 1e3;
-    let (settings, notes) = PlyMapSettings::for_net(&net, card.as_ref(), a.thickness, cavity, permeability);
-    for n in &notes {
-        eprintln!("note: {n}");
-    }
+    let ply = PlyToMap { net: &net, card: card.as_ref(), thickness: a.thickness, permeability };
     let t = Instant::now();
-    let ply = map_net(&net, &mesh, &settings).map_err(input)?;
+    let map = map_plies(&mesh, &[ply], cavity, false, &mut |n| eprintln!("note: {n}")).map_err(input)?;
     let map_ms = t.elapsed().as_secs_f64() * 1e3;
-    let map = LayupMap::new(vec![ply], false, mesh.elements.len());
     println!(
         "flow mesh {}: {} nodes, {} elements (read in {read_ms:.1} ms)",
         a.mesh.display(),
         mesh.nodes.len(),
         mesh.elements.len()
     );
-    println!("{}", coverage_line(&map, 0));
+    println!("{}", coverage_line(&map.plies[0]));
     println!("  mapped in {map_ms:.1} ms");
     let written = write_flow(&mesh, &map, format, &a.out).map_err(compute)?;
     for p in written {
@@ -119,23 +115,17 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// One line on ply `k` of a map: elements covered and their shear.
-pub(crate) fn coverage_line(map: &LayupMap, k: usize) -> String {
-    let ply = &map.plies[k];
-    let covered: Vec<f64> = ply.elements.iter().flatten().map(|f| f.shear.abs().to_degrees()).collect();
-    let max = covered.iter().cloned().fold(0.0, f64::max);
-    let mean = if covered.is_empty() { 0.0 } else { covered.iter().sum::<f64>() / covered.len() as f64 };
-    let capped = ply.elements.iter().flatten().filter(|f| f.vf >= crate::mapping::VF_CAP).count();
+/// One line on a mapped ply: elements covered and their shear.
+pub(crate) fn coverage_line(ply: &PlyMap) -> String {
+    let c = ply.coverage();
     let mut line = format!(
-        "  ply {}: covers {} of {} elements; |shear| max {max:.2} deg, mean {mean:.2} deg",
-        ply.ply,
-        covered.len(),
-        ply.elements.len()
+        "  ply {}: covers {} of {} elements; |shear| max {:.2} deg, mean {:.2} deg",
+        ply.ply, c.covered, c.elements, c.max_abs_shear_deg, c.mean_abs_shear_deg
     );
-    if capped > 0 {
+    if c.capped > 0 {
         line += &format!(
-            "; Vf0 / cos(shear) passes the fibre packing limit in {capped} elements: Vf written as {:.4} there (the fabric locks before that)",
-            crate::mapping::VF_CAP
+            "; Vf0 / cos(shear) passes the fibre packing limit in {} elements: Vf written as {VF_CAP:.4} there (the fabric locks before that)",
+            c.capped
         );
     }
     line

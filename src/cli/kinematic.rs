@@ -2,10 +2,12 @@
 use super::summary::summary;
 use super::{compute, input, parse_pair, parse_vec3, Failure};
 use crate::geometry::{Point, ToolSurface, Vector};
+use crate::io::points::read_points;
 use crate::io::{write_net, Format};
 use crate::kinematic::fishnet::check_settings;
 use crate::kinematic::{drape, Extent, KinematicSettings};
-use crate::layup::{parse_generators, read_points, scene::DEFAULT_LOCKING_ANGLE_DEG, unit_scale};
+use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::pipeline::{parse_generators, unit_scale};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -92,7 +94,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     // Cheap argument checks come before the (possibly slow) tool load.
     check_settings(&settings).map_err(input)?;
     let t_load = Instant::now();
-    let tool = crate::layup::load_tool(&a.tool, scale).map_err(|m| input(anyhow::anyhow!(m)))?;
+    let tool = crate::io::read_tool(&a.tool, scale).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
     let mut net = drape(&tool, &settings).map_err(input)?;

@@ -6,7 +6,7 @@ mod kinematic;
 mod progress;
 mod refine;
 mod report;
-mod scene;
+mod run;
 mod summary;
 mod virtual_test;
 
@@ -65,7 +65,7 @@ pub enum Command {
     /// Drape one ply on a tool with the kinematic (pin-jointed net) method.
     Kinematic(kinematic::KinematicArgs),
     /// Drape every ply of a scene file.
-    Run(scene::RunArgs),
+    Run(run::RunArgs),
     /// Refine a kinematic net mechanically (tension, shear, bending, gravity, tool contact).
     Refine(refine::RefineArgs),
     /// Map a draped net onto a resin-flow mesh and write fibre directions, shear, thickness and Vf.
@@ -84,7 +84,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Kinematic(a) => kinematic::run(a),
-        Command::Run(a) => scene::run(a),
+        Command::Run(a) => run::run(a),
         Command::Refine(a) => refine::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Test(a) => virtual_test::run(a),

@@ -4,7 +4,7 @@ use super::summary::summary;
 use super::{compute, input, parse_vec3, Failure};
 use crate::geometry::Vector;
 use crate::io::{read_net, write_net, Format};
-use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
 use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
 use crate::mechanics::{ContactMode, SolverSettings};
@@ -65,7 +65,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     let net = read_net(&a.net).map_err(input)?;
     let material = MaterialCard::load(&a.material).map_err(input)?;
     let t_load = Instant::now();
-    let tool = crate::layup::load_tool(&a.tool, 1.0).map_err(|m| input(anyhow::anyhow!(m)))?;
+    let tool = crate::io::read_tool(&a.tool, 1.0).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
     let settings = RefineSettings {

@@ -26,9 +26,11 @@ pub mod flow;
 pub mod net;
 pub mod net_json;
 pub mod optistruct;
+pub mod points;
 pub mod rtmsim;
 pub(crate) mod shell_mesh;
 pub mod svg;
+mod tool;
 pub mod vtk;
 pub mod xml;
 
@@ -38,6 +40,7 @@ pub use error::ExportError;
 pub use net::{write_net, Format};
 pub use net_json::{read_net, write_json};
 pub use shell_mesh::FlowMeshError;
+pub use tool::{read_tool, ReadToolError};
 pub use vtk::write_vtu;
 
 use crate::mapping::FlowMesh;

@@ -1,7 +1,7 @@
 //! Draping a layup: each ply in stacking order on the tool offset by the plies below it, its warp
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
-use super::scene::{Orientation, Ply, Scene, StackSide};
+use super::{Layup, Orientation, Ply, StackSide};
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
 use crate::geometry::{ObjError, Point, ToolSurface, Vector};
 use crate::kinematic::fishnet::DrapeError;
@@ -149,22 +149,22 @@ fn seed_normal(surface: &ToolSurface, p: &Point) -> Vector {
 /// Facets within this distance (times the tool's diagonal) of a seed touch it.
 const SEED_CONTACT_REL: f64 = 1e-9;
 
-/// Drape every ply of `scene` on `tool` in stacking order. `on_ply(k, name)` is called before
+/// Drape every ply of `layup` on `tool` in stacking order. `on_ply(k, name)` is called before
 /// ply `k` starts (for progress display).
 pub fn drape_layup(
-    scene: &Scene,
+    layup: &Layup,
     tool: &ToolSurface,
     mut on_ply: impl FnMut(usize, &str),
 ) -> Result<Vec<PlyResult>, LayupError> {
     let (dirs, clipped) = offset_directions(tool);
-    let sign = match scene.stack_side {
+    let sign = match layup.stack_side {
         StackSide::Normal => 1.0,
         StackSide::Opposite => -1.0,
     };
     // Thickness of the stack so far at every tool vertex, metres.
     let mut stack = vec![0.0; tool.vertices().len()];
     let mut results: Vec<PlyResult> = Vec::new();
-    for (k, ply) in scene.plies.iter().enumerate() {
+    for (k, ply) in layup.plies.iter().enumerate() {
         on_ply(k, &ply.settings.name);
         let name = ply.settings.name.clone();
         let line = ply.line;
@@ -196,7 +196,7 @@ pub fn drape_layup(
                 settings.origin = riding;
             }
         }
-        let warp = resolve_warp(ply, &settings.origin, &scene.reference, surface, scene.stack_side)
+        let warp = resolve_warp(ply, &settings.origin, &layup.reference, surface, layup.stack_side)
             .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
         let mut net =
@@ -229,9 +229,8 @@ pub fn drape_layup(
         if let Some(t) = ply.thickness {
             net.meta.insert("thickness_m".into(), serde_json::json!(t));
         }
-        net.meta.insert("tool_scale".into(), serde_json::json!(scene.scale));
         if let Some(t0) = ply.thickness {
-            if k + 1 < scene.plies.len() {
+            if k + 1 < layup.plies.len() {
                 add_ply_thickness(&mut stack, &under, &net, t0);
             }
         }

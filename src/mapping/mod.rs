@@ -212,6 +212,70 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
     Ok(PlyMap { ply: net.name.clone(), elements: elements? })
 }
 
+/// One ply to map onto a flow mesh: its net and what it is made of.
+#[derive(Debug, Clone, Copy)]
+pub struct PlyToMap<'a> {
+    /// The draped net.
+    pub net: &'a DrapeNet,
+    /// Its material card, if any (thickness, Vf0).
+    pub card: Option<&'a crate::material::MaterialCard>,
+    /// Thickness as laid flat overriding the card's, metres.
+    pub thickness: Option<f64>,
+    /// Permeability tensors, when asked for.
+    pub permeability: Option<PermeabilityModel>,
+}
+
+/// Map every ply of `plies` (in stacking order) onto `mesh` and compute the laminate fields:
+/// what `drape run` does with a scene's `[export]` and `drape export` with one net. `note` is
+/// told every value that was assumed (a ply without a card or thickness). `layup`: field names
+/// get a `<ply>_` prefix (see [`LayupMap::layup`]).
+pub fn map_plies(
+    mesh: &FlowMesh,
+    plies: &[PlyToMap],
+    cavity: Cavity,
+    layup: bool,
+    note: &mut dyn FnMut(&str),
+) -> Result<LayupMap, MapError> {
+    let mut maps = Vec::with_capacity(plies.len());
+    for p in plies {
+        let (settings, notes) = PlyMapSettings::for_net(p.net, p.card, p.thickness, cavity, p.permeability);
+        notes.iter().for_each(|n| note(n));
+        maps.push(map_net(p.net, mesh, &settings)?);
+    }
+    Ok(LayupMap::new(maps, layup, mesh.elements.len()))
+}
+
+/// How much of a flow mesh one ply covers and how it shears there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coverage {
+    /// Elements the ply covers.
+    pub covered: usize,
+    /// Elements of the mesh.
+    pub elements: usize,
+    /// Largest and mean |shear| over the covered elements, degrees (0 when none is covered).
+    pub max_abs_shear_deg: f64,
+    /// Mean |shear| over the covered elements, degrees.
+    pub mean_abs_shear_deg: f64,
+    /// Covered elements whose Vf0 / cos(shear) reached the packing cap [`VF_CAP`].
+    pub capped: usize,
+}
+
+impl PlyMap {
+    /// What the ply covers (see [`Coverage`]).
+    pub fn coverage(&self) -> Coverage {
+        let shears: Vec<f64> = self.elements.iter().flatten().map(|f| f.shear.abs().to_degrees()).collect();
+        let max = shears.iter().cloned().fold(0.0, f64::max);
+        let mean = if shears.is_empty() { 0.0 } else { shears.iter().sum::<f64>() / shears.len() as f64 };
+        Coverage {
+            covered: shears.len(),
+            elements: self.elements.len(),
+            max_abs_shear_deg: max,
+            mean_abs_shear_deg: mean,
+            capped: self.elements.iter().flatten().filter(|f| f.vf >= VF_CAP).count(),
+        }
+    }
+}
+
 impl LayupMap {
     /// Gather mapped plies (in stacking order) and compute the laminate fields: thickness is the
     /// sum over the covering plies; Vf and permeability are thickness-weighted means (layers

@@ -24,7 +24,7 @@ use crate::geometry::obj::read_obj;
 use crate::geometry::Point;
 use crate::io::{read_net, write_atomic, ExportError};
 use crate::kinematic::{DrapeNet, Method};
-use crate::layup::scene::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use render::{Mark, ToolLayer};

@@ -1,4 +1,4 @@
-//! The scene file: a tool OBJ and the layup to drape on it, plies in stacking order (the first
+//! The scene file: a tool and the layup to drape on it, plies in stacking order (the first
 //! lies on the tool, each next one on the plies below it).
 //!
 //! ```toml
@@ -37,20 +37,18 @@
 //!                             # ply's material card
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
 //! ```
-use super::{parse_generators, read_points, unit_scale};
+use super::{parse_generators, unit_scale};
 use crate::geometry::{Point, Vector};
 use crate::io::flow::FlowFormat;
+use crate::io::points::read_points;
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
-use crate::mapping::Cavity;
+use crate::layup::{Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, DEFAULT_LOCKING_ANGLE_DEG};
+use crate::material::flow::Cavity;
 use crate::material::MaterialCard;
 use crate::mechanics::ContactMode;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// Locking angle used for reporting when a ply gives none (degrees; woven glass and carbon
-/// lock between about 40 and 60 degrees).
-pub const DEFAULT_LOCKING_ANGLE_DEG: f64 = 45.0;
 
 /// Why a scene could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -135,70 +133,6 @@ fn default_method() -> String {
     "kinematic".into()
 }
 
-/// How a ply's warp direction is given.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Orientation {
-    /// The warp direction itself (projected onto the tool at the seed).
-    Warp(Vector),
-    /// The scene's reference direction turned by this angle (radians) about the tool normal at
-    /// the seed, counter-clockwise seen from the side the normal points to.
-    Angle(f64),
-}
-
-/// A material card and the name the scene gives it.
-#[derive(Debug, Clone)]
-pub struct PlyMaterial {
-    /// The name in `[materials]`, or the card's own name when the ply gives a file.
-    pub name: String,
-    pub card: MaterialCard,
-    pub path: PathBuf,
-}
-
-/// One ply of a scene, ready to drape (SI units).
-#[derive(Debug, Clone)]
-pub struct Ply {
-    /// Kinematic settings; `settings.warp` is only final once [`Ply::orientation`] has been
-    /// resolved on the (offset) tool by [`super::stack`].
-    pub settings: KinematicSettings,
-    pub orientation: Orientation,
-    pub material: Option<PlyMaterial>,
-    /// Thickness as laid flat, metres: the ply's `thickness`, else its card's; `None` if neither.
-    pub thickness: Option<f64>,
-    /// Mechanical refinement after the kinematic drape, if the ply asks for it.
-    pub refinement: Option<Refinement>,
-    /// Locking angle for reporting, radians.
-    pub locking_angle: f64,
-    /// Line of the scene file where the ply starts.
-    pub line: usize,
-}
-
-impl Ply {
-    /// The ply angle in degrees for tables, `None` when the warp was given as a vector.
-    pub fn angle_deg(&self) -> Option<f64> {
-        match self.orientation {
-            Orientation::Angle(a) => Some(a.to_degrees()),
-            Orientation::Warp(_) => None,
-        }
-    }
-}
-
-/// A ply's mechanical refinement: the material card and the contact mode.
-#[derive(Debug, Clone)]
-pub struct Refinement {
-    pub material: MaterialCard,
-    pub material_path: PathBuf,
-    pub mode: ContactMode,
-}
-
-/// Which side of the tool the plies stack on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StackSide {
-    /// The side the tool's facet normals point to.
-    Normal,
-    /// The other side.
-    Opposite,
-}
-
 /// The scene's `[export]` table: map every ply onto a resin-flow mesh.
 #[derive(Debug, Clone)]
 pub struct SceneExport {
@@ -218,9 +152,8 @@ pub struct Scene {
     /// Metres per unit of the scene and OBJ.
     pub scale: f64,
     pub tool: PathBuf,
-    /// The 0 deg direction of ply angles (unit).
-    pub reference: Vector,
-    pub stack_side: StackSide,
+    /// The plies, their reference direction and stacking side.
+    pub layup: Layup,
     /// Fabric roll width for nesting, metres.
     pub roll_width: Option<f64>,
     /// Gap between nested pieces, metres.
@@ -230,7 +163,6 @@ pub struct Scene {
     /// Whether pieces may be turned 90 degrees on the roll (warp across the roll).
     pub rotate_patterns: bool,
     pub export: Option<SceneExport>,
-    pub plies: Vec<Ply>,
 }
 
 impl Scene {
@@ -464,14 +396,12 @@ impl Scene {
             path: path.into(),
             scale,
             tool: base.join(&file.tool),
-            reference,
-            stack_side,
+            layup: Layup { reference, stack_side, plies },
             roll_width,
             nesting_gap,
             cutting_margin,
             rotate_patterns: file.rotate_patterns,
             export,
-            plies,
         })
     }
 }

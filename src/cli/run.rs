@@ -1,0 +1,162 @@
+//! `drape run SCENE --out DIR`: drape every ply of a layup, write the nets, the layup table and
+//! (from the scene's `[export]`) the fibre data on the resin-flow mesh; this prints what
+//! [`crate::pipeline::run::run`] reports.
+use super::export::coverage_line;
+use super::kinematic::print_tool_report;
+use super::refine::print_solver;
+use super::summary::summary;
+use super::{compute, input, Failure};
+use crate::io::Format;
+use crate::layup::stack::PlyResult;
+use crate::pipeline::run::{run as run_scene, Event, RunError};
+use crate::pipeline::Scene;
+use clap::Args;
+use indicatif::ProgressBar;
+use std::path::PathBuf;
+
+/// Arguments of `drape run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scene file (TOML): the tool and the plies.
+    pub scene: PathBuf,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Output formats: comma-separated json,vtu,csv, or none.
+    #[arg(long, default_value = "json,vtu,csv")]
+    pub format: String,
+}
+
+/// Run `drape run`.
+pub fn run(a: RunArgs) -> Result<(), Failure> {
+    let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
+    let scene = Scene::load(&a.scene).map_err(input)?;
+    let mut bar: Option<ProgressBar> = None;
+    run_scene(&scene, &a.out, &formats, &mut |event| print(event, &mut bar)).map_err(|e: RunError| {
+        if e.is_bad_input() {
+            input(e)
+        } else {
+            compute(e)
+        }
+    })
+}
+
+/// Print one step of the run.
+fn print(event: Event, bar: &mut Option<ProgressBar>) {
+    match event {
+        Event::ToolRead { path, tool } => print_tool_report(path, tool),
+        Event::Draping { index, count, name } => {
+            let bar = bar.get_or_insert_with(|| super::progress::bar(count as u64, "draping"));
+            bar.set_position(index as u64);
+            bar.set_message(name.to_string());
+        }
+        Event::Draped => {
+            if let Some(bar) = bar.take() {
+                bar.finish_and_clear();
+            }
+        }
+        Event::PlyWritten { ply, result, files, load_ms, write_ms } => {
+            let name = &ply.settings.name;
+            if result.offset.relaxed > 0 {
+                println!(
+                    "ply '{name}': the plies below bridge concave corners tighter than their thickness ({} offset vertices moved off the normals)",
+                    result.offset.relaxed
+                );
+            }
+            if result.offset.folded > 0 {
+                println!(
+                    "warning: ply '{name}': the offset surface of the plies below folded over in {} triangles (a concave radius smaller than the stack); the ply was draped on it regardless",
+                    result.offset.folded
+                );
+            }
+            println!("{}", summary(&result.net, ply.locking_angle, load_ms, write_ms));
+            if let Some(refined) = &result.refined {
+                print_solver(refined);
+            }
+            for p in files {
+                println!("  wrote {}", p.display());
+            }
+        }
+        Event::Layup { scene, results } => println!("{}", layup_table(scene, results)),
+        Event::NoPattern { ply } => println!("ply {ply}: no complete cell, no flat pattern"),
+        Event::RollWidthAssumed { width } => {
+            println!("no roll_width in the scene: nesting on a roll {width:.3} m wide (the widest piece)")
+        }
+        Event::CuttingPlan { pieces, nesting, files } => {
+            println!(
+                "flat patterns: {} pieces, {:.4} m^2 of fabric on {:.3} m of a {:.3} m roll ({:.4} m^2 used, {:.1}% waste)",
+                pieces,
+                nesting.pattern_area,
+                nesting.length,
+                nesting.roll_width,
+                nesting.used_area,
+                100.0 * nesting.waste_fraction
+            );
+            for p in files {
+                println!("  wrote {}", p.display());
+            }
+        }
+        Event::TableWritten { path } => println!("wrote {}", path.display()),
+        Event::FlowNote(n) => println!("note: {n}"),
+        Event::FlowMapped { path, mesh, map, ms } => {
+            println!(
+                "flow mesh {}: {} nodes, {} elements; mapped {} plies in {:.1} ms",
+                path.display(),
+                mesh.nodes.len(),
+                mesh.elements.len(),
+                map.plies.len(),
+                ms
+            );
+            for ply in &map.plies {
+                println!("{}", coverage_line(ply));
+            }
+        }
+        Event::FlowWritten { files } => {
+            for p in files {
+                println!("  wrote {}", p.display());
+            }
+        }
+    }
+}
+
+/// The layup table: one row per ply in stacking order.
+fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
+    let mut out = format!(
+        "layup: {} plies on {}\n{:<12} {:>7} {:<10} {:<20} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
+        scene.layup.plies.len(),
+        scene.tool.display(),
+        "ply",
+        "angle",
+        "method",
+        "material",
+        "max|g|",
+        "mean|g|",
+        "over lock",
+        "coverage",
+        "fabric",
+        "mass",
+        "offset"
+    );
+    out += &format!(
+        "{:<12} {:>7} {:<10} {:<20} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
+        "", "deg", "", "", "deg", "deg", "m^2", "%", "m^2", "kg", "mm"
+    );
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        let s = &r.stats;
+        out += &format!(
+            "{:<12} {:>7} {:<10} {:<20} {:>9.2} {:>9.2} {:>12.3e} {:>8.1} {:>11.4} {:>9} {:>10.3}\n",
+            ply.settings.name,
+            ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
+            if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
+            ply.material.as_ref().map_or("-", |m| m.name.as_str()),
+            s.max_abs_shear.to_degrees(),
+            s.mean_abs_shear.to_degrees(),
+            s.area_over_locking,
+            100.0 * s.coverage,
+            s.fabric_area,
+            s.fabric_mass.map_or("-".to_string(), |m| format!("{m:.4}")),
+            r.offset.max_distance * 1e3,
+        );
+    }
+    out.trim_end().to_string()
+}

@@ -1,0 +1,88 @@
+//! The plies of a layup, ready to drape: what each ply is made of, how its warp is given and
+//! whether it is refined mechanically. A scene file ([`crate::pipeline::scene`]) is one way to
+//! make them.
+use crate::geometry::Vector;
+use crate::kinematic::KinematicSettings;
+use crate::material::MaterialCard;
+use crate::mechanics::ContactMode;
+use std::path::PathBuf;
+
+/// Locking angle used for reporting when a ply gives none (degrees; woven glass and carbon
+/// lock between about 40 and 60 degrees).
+pub const DEFAULT_LOCKING_ANGLE_DEG: f64 = 45.0;
+
+/// How a ply's warp direction is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Orientation {
+    /// The warp direction itself (projected onto the tool at the seed).
+    Warp(Vector),
+    /// The scene's reference direction turned by this angle (radians) about the tool normal at
+    /// the seed, counter-clockwise seen from the side the normal points to.
+    Angle(f64),
+}
+
+/// A material card and the name the scene gives it.
+#[derive(Debug, Clone)]
+pub struct PlyMaterial {
+    /// The name in `[materials]`, or the card's own name when the ply gives a file.
+    pub name: String,
+    pub card: MaterialCard,
+    pub path: PathBuf,
+}
+
+/// One ply of a scene, ready to drape (SI units).
+#[derive(Debug, Clone)]
+pub struct Ply {
+    /// Kinematic settings; `settings.warp` is only final once [`Ply::orientation`] has been
+    /// resolved on the (offset) tool by [`super::stack`].
+    pub settings: KinematicSettings,
+    pub orientation: Orientation,
+    pub material: Option<PlyMaterial>,
+    /// Thickness as laid flat, metres: the ply's `thickness`, else its card's; `None` if neither.
+    pub thickness: Option<f64>,
+    /// Mechanical refinement after the kinematic drape, if the ply asks for it.
+    pub refinement: Option<Refinement>,
+    /// Locking angle for reporting, radians.
+    pub locking_angle: f64,
+    /// Line of the scene file where the ply starts.
+    pub line: usize,
+}
+
+impl Ply {
+    /// The ply angle in degrees for tables, `None` when the warp was given as a vector.
+    pub fn angle_deg(&self) -> Option<f64> {
+        match self.orientation {
+            Orientation::Angle(a) => Some(a.to_degrees()),
+            Orientation::Warp(_) => None,
+        }
+    }
+}
+
+/// A ply's mechanical refinement: the material card and the contact mode.
+#[derive(Debug, Clone)]
+pub struct Refinement {
+    pub material: MaterialCard,
+    pub material_path: PathBuf,
+    pub mode: ContactMode,
+}
+
+/// Which side of the tool the plies stack on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StackSide {
+    /// The side the tool's facet normals point to.
+    Normal,
+    /// The other side.
+    Opposite,
+}
+
+/// The plies to drape, in stacking order (the first lies on the tool, each next one on the plies
+/// below it), and how their angles and stacking side are measured.
+#[derive(Debug, Clone)]
+pub struct Layup {
+    /// The 0 deg direction of ply angles (unit).
+    pub reference: Vector,
+    /// Which side of the tool the plies stack on.
+    pub stack_side: StackSide,
+    /// The plies in stacking order.
+    pub plies: Vec<Ply>,
+}

@@ -1,0 +1,372 @@
+//! `drape run` as a library call: [`run`] drapes every ply of a [`Scene`] and writes everything
+//! the run produces into one folder, telling its caller what it did through [`Event`]s (the
+//! command line prints them).
+//!
+//! Order, so that bad input costs nothing computed: the plies' settings are checked, the tool is
+//! read, every ply is draped (a bad ply stops the run before any file is written), then each
+//! net is written, the flat patterns are nested and drawn, `layup.json` is written, and last the
+//! plies are mapped onto the scene's flow mesh (a bad flow mesh costs nothing already computed).
+use super::scene::{Scene, SceneExport};
+use crate::geometry::ToolSurface;
+use crate::io::drawing::{write_cutting_plan, PatternError};
+use crate::io::flow::write_flow;
+use crate::io::{read_flow_mesh, read_tool, write_atomic, write_net, ExportError, Format, ReadToolError};
+use crate::kinematic::fishnet::{check_settings, DrapeError};
+use crate::layup::flat::{flat_pattern_with_margin, FlatError};
+use crate::layup::nest::{nest, Nesting, Rotation};
+use crate::layup::stack::{drape_layup, LayupError, PlyResult};
+use crate::layup::Ply;
+use crate::mapping::{map_plies, FlowMesh, LayupMap, MapError, PlyToMap};
+use crate::material::flow::PermeabilityModel;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Name of the layup table a run writes into its folder.
+pub const LAYUP_FILE: &str = "layup.json";
+
+/// What [`run`] reports, in the order it happens.
+pub enum Event<'a> {
+    /// The tool was read and checked.
+    ToolRead {
+        /// The tool file.
+        path: &'a Path,
+        /// The checked surface (its report says what was mended).
+        tool: &'a ToolSurface,
+    },
+    /// Ply `index` (from 0) of `count` starts draping.
+    Draping {
+        /// Position in the stack.
+        index: usize,
+        /// Plies in the stack.
+        count: usize,
+        /// The ply's name.
+        name: &'a str,
+    },
+    /// Every ply is draped.
+    Draped,
+    /// A ply's net was written.
+    PlyWritten {
+        /// The ply as the scene gives it.
+        ply: &'a Ply,
+        /// Its drape.
+        result: &'a PlyResult,
+        /// The files written, in the order of the formats.
+        files: &'a [PathBuf],
+        /// Time to read the tool, ms.
+        load_ms: f64,
+        /// Time to write the files, ms.
+        write_ms: f64,
+    },
+    /// Every net is written: the layup table can be shown.
+    Layup {
+        /// The scene.
+        scene: &'a Scene,
+        /// Every ply's drape, in stacking order.
+        results: &'a [PlyResult],
+    },
+    /// A ply has no complete cell, so it has no flat pattern.
+    NoPattern {
+        /// The ply's name.
+        ply: &'a str,
+    },
+    /// The scene gives no roll width: the pieces were nested on a roll as wide as the widest.
+    RollWidthAssumed {
+        /// That width, m.
+        width: f64,
+    },
+    /// The flat patterns were nested and drawn.
+    CuttingPlan {
+        /// Pieces nested.
+        pieces: usize,
+        /// Where they lie on the roll.
+        nesting: &'a Nesting,
+        /// The drawings written.
+        files: &'a [PathBuf],
+    },
+    /// The layup table was written.
+    TableWritten {
+        /// `DIR/layup.json`.
+        path: &'a Path,
+    },
+    /// A value the flow mapping assumed for a ply.
+    FlowNote(&'a str),
+    /// Every ply was mapped onto the flow mesh.
+    FlowMapped {
+        /// The flow mesh file.
+        path: &'a Path,
+        /// The flow mesh.
+        mesh: &'a FlowMesh,
+        /// The plies on it.
+        map: &'a LayupMap,
+        /// Time to read and map, ms.
+        ms: f64,
+    },
+    /// One flow format was written.
+    FlowWritten {
+        /// Its files.
+        files: &'a [PathBuf],
+    },
+}
+
+/// Why a run stopped. [`RunError::is_bad_input`] tells bad input (exit code 2) from a failed
+/// computation (exit code 1).
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// A ply's kinematic settings are unusable.
+    #[error("scene {scene}: ply '{ply}' (line {line}): {error}")]
+    Settings {
+        /// The scene file.
+        scene: PathBuf,
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+        /// What is wrong.
+        error: DrapeError,
+    },
+    /// The tool could not be read.
+    #[error("{0}")]
+    Tool(ReadToolError),
+    /// A ply could not be draped.
+    #[error("scene {scene}: {error}")]
+    Layup {
+        /// The scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        error: LayupError,
+    },
+    /// A flat pattern or the nesting could not be made.
+    #[error(transparent)]
+    Flat(FlatError),
+    /// The flow mesh could not be read.
+    #[error("scene {scene}: [export] mesh: {error}")]
+    FlowMesh {
+        /// The scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        error: crate::io::FlowMeshError,
+    },
+    /// Permeability was asked for but a ply's card has no fibre radius.
+    #[error("scene {scene}: ply '{ply}' (line {line}): [export] permeability = true needs a material card with a [flow] section (fibre_radius)")]
+    NoFibreRadius {
+        /// The scene file.
+        scene: PathBuf,
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+    },
+    /// A ply could not be mapped onto the flow mesh.
+    #[error(transparent)]
+    Map(MapError),
+    /// A file could not be written.
+    #[error(transparent)]
+    Write(#[from] ExportError),
+    /// A drawing could not be written.
+    #[error(transparent)]
+    Pattern(PatternError),
+    /// Every file was written but a mechanical ply did not reach equilibrium.
+    #[error("the mechanical solver stopped without equilibrium for {plies}; the last accepted states were written")]
+    Unconverged {
+        /// The plies and how their solves ended.
+        plies: String,
+    },
+}
+
+impl RunError {
+    /// Whether the input (scene, tool, flow mesh) is at fault rather than the computation.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            RunError::Settings { .. }
+                | RunError::Tool(_)
+                | RunError::Layup { .. }
+                | RunError::Flat(_)
+                | RunError::FlowMesh { .. }
+                | RunError::NoFibreRadius { .. }
+                | RunError::Map(_)
+        )
+    }
+}
+
+/// Drape every ply of `scene` and write into `out`: each net in `formats`, the flat patterns
+/// nested on the roll, `layup.json` and, with the scene's `[export]`, the plies on its flow mesh.
+/// `on` hears what happens (see [`Event`]). Nets of mechanical plies that did not reach
+/// equilibrium are written, and the run ends with [`RunError::Unconverged`].
+pub fn run(scene: &Scene, out: &Path, formats: &[Format], on: &mut dyn FnMut(Event)) -> Result<(), RunError> {
+    for ply in &scene.layup.plies {
+        check_settings(&ply.settings).map_err(|error| RunError::Settings {
+            scene: scene.path.clone(),
+            ply: ply.settings.name.clone(),
+            line: ply.line,
+            error,
+        })?;
+    }
+    let t_load = Instant::now();
+    let tool = read_tool(&scene.tool, scene.scale).map_err(RunError::Tool)?;
+    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
+    on(Event::ToolRead { path: &scene.tool, tool: &tool });
+    // Drape every ply first, so a bad ply is reported before any file is written.
+    let count = scene.layup.plies.len();
+    let mut results = drape_layup(&scene.layup, &tool, |index, name| on(Event::Draping { index, count, name }))
+        .map_err(|error| RunError::Layup { scene: scene.path.clone(), error })?;
+    on(Event::Draped);
+    let mut unconverged = Vec::new();
+    for (ply, r) in scene.layup.plies.iter().zip(results.iter_mut()) {
+        r.net.timing.load_ms = load_ms;
+        r.net.meta.insert("tool".into(), serde_json::json!(scene.tool.display().to_string()));
+        r.net.meta.insert("tool_scale".into(), serde_json::json!(scene.scale));
+        r.net.meta.insert("scene".into(), serde_json::json!(scene.path.display().to_string()));
+        if let Some(refined) = &r.refined {
+            if !refined.ok() {
+                unconverged.push(format!("ply '{}' ({:?})", ply.settings.name, refined.outcome()));
+            }
+        }
+    }
+    for (ply, result) in scene.layup.plies.iter().zip(&results) {
+        let t_write = Instant::now();
+        let files = write_net(&result.net, out, formats)?;
+        let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
+        on(Event::PlyWritten { ply, result, files: &files, load_ms, write_ms });
+    }
+    on(Event::Layup { scene, results: &results });
+    let nesting = cutting_plan(scene, &results, out, on)?;
+    let table = out.join(LAYUP_FILE);
+    let mut json = layup_json(scene, &results);
+    if let Some(n) = nesting {
+        json["nesting"] = serde_json::json!({
+            "roll_width_m": n.roll_width,
+            "gap_m": n.gap,
+            "length_m": n.length,
+            "used_area_m2": n.used_area,
+            "pattern_area_m2": n.pattern_area,
+            "waste_area_m2": n.waste_area,
+            "waste_fraction": n.waste_fraction,
+        });
+    }
+    write_atomic(&table, |w| {
+        serde_json::to_writer_pretty(&mut *w, &json)?;
+        std::io::Write::write_all(w, b"\n")
+    })?;
+    on(Event::TableWritten { path: &table });
+    // Last, so that a bad flow mesh costs nothing already computed.
+    if let Some(export) = &scene.export {
+        export_flow(scene, export, &results, out, on)?;
+    }
+    if !unconverged.is_empty() {
+        return Err(RunError::Unconverged { plies: unconverged.join(", ") });
+    }
+    Ok(())
+}
+
+/// Flat patterns of every ply, nested on the roll: `patterns.dxf`, `patterns.svg` and one SVG a
+/// ply. Plies without a complete cell have no pattern and are named.
+fn cutting_plan(
+    scene: &Scene,
+    results: &[PlyResult],
+    out: &Path,
+    on: &mut dyn FnMut(Event),
+) -> Result<Option<Nesting>, RunError> {
+    let mut patterns = Vec::new();
+    for r in results {
+        match flat_pattern_with_margin(&r.net, scene.cutting_margin) {
+            Ok(p) => patterns.push(p),
+            Err(FlatError::NoCells { ply }) => on(Event::NoPattern { ply: &ply }),
+            Err(e) => return Err(RunError::Flat(e)),
+        }
+    }
+    if patterns.is_empty() {
+        return Ok(None);
+    }
+    let rotation = if scene.rotate_patterns { Rotation::AllowQuarterTurn } else { Rotation::WarpAlongRoll };
+    let roll_width = match scene.roll_width {
+        Some(w) => w,
+        None => {
+            // Without a roll width the pieces go on a roll as wide as the widest of them.
+            let width = patterns.iter().map(|p| p.size()[1]).fold(0.0, f64::max);
+            on(Event::RollWidthAssumed { width });
+            width
+        }
+    };
+    let nesting = nest(&patterns, roll_width, scene.nesting_gap, rotation).map_err(RunError::Flat)?;
+    let files = write_cutting_plan(&patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
+    on(Event::CuttingPlan { pieces: patterns.len(), nesting: &nesting, files: &files });
+    Ok(Some(nesting))
+}
+
+/// Map every ply onto the scene's resin-flow mesh and write the formats it asks for as
+/// `DIR/flow.<ext>` (`FlowFormat::scene_file`; field names prefixed by the ply).
+fn export_flow(
+    scene: &Scene,
+    export: &SceneExport,
+    results: &[PlyResult],
+    out: &Path,
+    on: &mut dyn FnMut(Event),
+) -> Result<(), RunError> {
+    let t = Instant::now();
+    let mesh = read_flow_mesh(&export.mesh, scene.scale)
+        .map_err(|error| RunError::FlowMesh { scene: scene.path.clone(), error })?;
+    let mut plies = Vec::with_capacity(results.len());
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        let card = ply.material.as_ref().map(|m| &m.card);
+        let permeability = if export.permeability {
+            let radius = card.and_then(|c| c.flow).map(|f| f.fibre_radius).ok_or_else(|| RunError::NoFibreRadius {
+                scene: scene.path.clone(),
+                ply: ply.settings.name.clone(),
+                line: ply.line,
+            })?;
+            Some(PermeabilityModel { fibre_radius: radius })
+        } else {
+            None
+        };
+        plies.push(PlyToMap { net: &r.net, card, thickness: ply.thickness, permeability });
+    }
+    let map = map_plies(&mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
+    on(Event::FlowMapped { path: &export.mesh, mesh: &mesh, map: &map, ms: t.elapsed().as_secs_f64() * 1e3 });
+    for &format in &export.formats {
+        let files = write_flow(&mesh, &map, format, &out.join(format.scene_file()))?;
+        on(Event::FlowWritten { files: &files });
+    }
+    Ok(())
+}
+
+/// `layup.json`: the layup table for reports and other tools.
+fn layup_json(scene: &Scene, results: &[PlyResult]) -> serde_json::Value {
+    let path = |p: &Path| p.display().to_string();
+    let plies: Vec<serde_json::Value> = scene
+        .layup
+        .plies
+        .iter()
+        .zip(results)
+        .map(|(ply, r)| {
+            let s = &r.stats;
+            serde_json::json!({
+                "name": ply.settings.name,
+                "material": ply.material.as_ref().map(|m| m.name.clone()),
+                "material_card": ply.material.as_ref().map(|m| path(&m.path)),
+                "angle_deg": ply.angle_deg(),
+                "warp": [r.warp.x, r.warp.y, r.warp.z],
+                "method": if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
+                "thickness_m": ply.thickness,
+                "locking_angle_deg": ply.locking_angle.to_degrees(),
+                "max_abs_shear_deg": s.max_abs_shear.to_degrees(),
+                "mean_abs_shear_deg": s.mean_abs_shear.to_degrees(),
+                "area_over_locking_m2": s.area_over_locking,
+                "coverage": s.coverage,
+                "cells": s.cells,
+                "draped_area_m2": s.draped_area,
+                "fabric_area_m2": s.fabric_area,
+                "fabric_mass_kg": s.fabric_mass,
+                "offset_m": r.offset.max_distance,
+                "offset_folded_triangles": r.offset.folded,
+                "offset_bridged_vertices": r.offset.relaxed,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "scene": path(&scene.path),
+        "tool": path(&scene.tool),
+        "plies": plies,
+        "nesting": serde_json::Value::Null,
+    })
+}
