@@ -3,7 +3,7 @@
 //! unfolding the net into its flat pattern. Run: `cargo bench --bench layup`.
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use drape::geometry::offset::offset_surface;
-use drape::geometry::shapes::{self, TriangleMesh};
+use drape::geometry::{shapes, TriangleMesh};
 use drape::geometry::{Point, Vector};
 use drape::kinematic::{drape, KinematicSettings};
 use drape::layup::flat::flat_pattern;

@@ -333,3 +333,23 @@ fn cli_report() {
     let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
     assert!(err.contains("no drape net") && err.contains("empty"), "{err}");
 }
+
+/// A run whose tool is an Abaqus deck (or any shell mesh a tool may be) draws its tool: the
+/// report reads tools as the drape does, not only from OBJ. The plate deck is in millimetres
+/// and the net records that scale.
+#[test]
+fn a_tool_given_as_a_shell_mesh_is_drawn_at_the_scale_the_run_read_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/flowmesh/plate.inp");
+    let scale = 1e-3;
+    let tool = drape::io::read_tool(&deck, scale).unwrap();
+    let origin = Point::new(50.0, 75.0, 0.0) * scale;
+    let mut net = drape(&tool, &KinematicSettings::grid("deck", origin, Vector::x(), 5.0 * scale, 11, 11)).unwrap();
+    net.meta.insert("tool".into(), serde_json::json!(deck.display().to_string()));
+    net.meta.insert("tool_scale".into(), serde_json::json!(scale));
+    write_net(&net, tmp.path(), &[Format::Json]).unwrap();
+    let s = write_report(tmp.path(), &tmp.path().join("r"), false).unwrap();
+    assert!(s.plies[0].tool_drawn, "{:?}", s.notes);
+    let hist = check_picture(&tmp.path().join("r/deck-shear.png"));
+    assert!(tool_pixels(&hist) > MIN_TOOL_PIXELS, "the plate is drawn around the ply");
+}

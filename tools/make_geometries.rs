@@ -26,7 +26,9 @@
 //! The output is deterministic: the same build writes byte-identical files. `--out DIR` writes
 //! under `DIR` instead of the crate's `geometries/` folder.
 use drape::geometry::shapes::*;
+use drape::geometry::TriangleMesh;
 use std::f64::consts::{PI, TAU};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A committed mesh: its path under the output folder and how to build it.
@@ -81,7 +83,7 @@ fn write(root: &Path, name: &str, mesh: &TriangleMesh) -> anyhow::Result<()> {
     }
     let text =
         format!("# {name}: written by `cargo run --release --example make_geometries`\n{}", mesh.to_obj_string());
-    std::fs::write(&path, &text).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    drape::io::write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
     println!(
         "{:<36} {:>8} triangles {:>8} vertices {:>10} bytes",
         name,

@@ -1,5 +1,5 @@
 //! Mesh checks and repairs: welding, degenerate and duplicate faces, topology, orientation.
-use super::obj::{MeshReport, ObjError, RawMesh};
+use super::mesh::{MeshReport, ToolError, TriangleMesh};
 use super::surface::bounding_diagonal;
 use super::{Point, Vector};
 use std::path::Path;
@@ -37,12 +37,17 @@ pub struct MendedMesh {
 /// (in any order). Pieces are the sets of triangles connected through manifold edges; each is
 /// wound like the majority of its triangles (ties: like its first triangle). A non-orientable
 /// piece (a Moebius strip) keeps the winding a breadth-first walk gives it.
-pub fn mend(raw: RawMesh, weld_tolerance: f64, path: &Path, report: &mut MeshReport) -> Result<MendedMesh, ObjError> {
-    let RawMesh { vertices, triangles } = raw;
+pub fn mend(
+    raw: TriangleMesh,
+    weld_tolerance: f64,
+    path: &Path,
+    report: &mut MeshReport,
+) -> Result<MendedMesh, ToolError> {
+    let TriangleMesh { vertices, triangles } = raw;
     let count = vertices.len();
     for (face, tri) in triangles.iter().enumerate() {
         if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
-            return Err(ObjError::BadIndex { path: path.into(), face, index: index as usize, count });
+            return Err(ToolError::BadIndex { path: path.into(), face, index: index as usize, count });
         }
     }
 
@@ -72,7 +77,7 @@ pub fn mend(raw: RawMesh, weld_tolerance: f64, path: &Path, report: &mut MeshRep
     }
     report.degenerate_faces_dropped += degenerate;
     if kept.is_empty() {
-        return Err(ObjError::AllDegenerate { path: path.into() });
+        return Err(ToolError::AllDegenerate { path: path.into() });
     }
 
     // Keep used vertices only, in input order.
@@ -386,12 +391,12 @@ fn orient(tris: &mut [[u32; 3]], neighbours: &mut [[u32; 3]]) -> (usize, usize) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::obj::read_obj;
     use crate::geometry::surface::WELD_TOLERANCE_REL;
     use crate::geometry::Vector;
+    use crate::io::obj::read_obj;
 
-    /// Read an OBJ text and mend it the way `ToolSurface::from_obj` does.
-    fn load(text: &str) -> Result<(MendedMesh, MeshReport), ObjError> {
+    /// Read an OBJ text and mend it the way a tool read from a file is.
+    fn load(text: &str) -> Result<(MendedMesh, MeshReport), ToolError> {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("mesh.obj");
         std::fs::write(&path, text).unwrap();
@@ -405,7 +410,7 @@ mod tests {
     fn mend_raw(vertices: Vec<Point>, triangles: Vec<[u32; 3]>) -> (MendedMesh, MeshReport) {
         let tolerance = WELD_TOLERANCE_REL * bounding_diagonal(&vertices);
         let mut report = MeshReport::default();
-        let mesh = mend(RawMesh { vertices, triangles }, tolerance, Path::new("t"), &mut report).unwrap();
+        let mesh = mend(TriangleMesh { vertices, triangles }, tolerance, Path::new("t"), &mut report).unwrap();
         check_adjacency(&mesh);
         (mesh, report)
     }
@@ -520,7 +525,7 @@ mod tests {
         ];
         let triangles = vec![[0, 1, 2], [3, 4, 5]];
         let mut report = MeshReport::default();
-        let mesh = mend(RawMesh { vertices, triangles }, 1e-3, Path::new("t"), &mut report).unwrap();
+        let mesh = mend(TriangleMesh { vertices, triangles }, 1e-3, Path::new("t"), &mut report).unwrap();
         assert_eq!(report.vertices_welded, 1);
         assert_eq!(mesh.vertices.len(), 5);
         assert_eq!(mesh.vertices[1], Point::new(1.0, 0.0, 0.0), "first vertex wins");
@@ -536,7 +541,7 @@ mod tests {
             Point::new(1.0, 1.0, 0.0),
         ];
         let mut report = MeshReport::default();
-        let raw = RawMesh { vertices, triangles: vec![[0, 1, 2], [3, 4, 5]] };
+        let raw = TriangleMesh { vertices, triangles: vec![[0, 1, 2], [3, 4, 5]] };
         let mesh = mend(raw, 0.0, Path::new("t"), &mut report).unwrap();
         assert_eq!(report.vertices_welded, 1);
         assert_eq!(mesh.vertices.len(), 5);
@@ -614,7 +619,7 @@ mod tests {
         assert_eq!(report.vertices, 3);
 
         let err = load("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 3 2 1\n").unwrap_err();
-        assert!(matches!(err, ObjError::AllDegenerate { .. }), "{err}");
+        assert!(matches!(err, ToolError::AllDegenerate { .. }), "{err}");
     }
 
     #[test]

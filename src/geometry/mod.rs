@@ -1,15 +1,15 @@
-//! Tool surfaces: OBJ loading and checks, the queryable [`ToolSurface`], straightest geodesics,
-//! and analytic test shapes.
+//! Tool surfaces: mesh checks and repairs, the queryable [`ToolSurface`], smooth patches over
+//! its facets, straightest geodesics and offset surfaces.
 pub mod check;
 pub mod geodesic;
-pub mod obj;
+pub mod mesh;
 pub mod offset;
 pub mod shapes;
 pub mod smooth;
 pub mod surface;
 
 pub use check::NO_NEIGHBOUR;
-pub use obj::{MeshReport, ObjError};
+pub use mesh::{MeshReport, ToolError, TriangleMesh};
 pub use smooth::{SmoothPoint, SmoothSurface};
 pub use surface::{SurfacePoint, ToolSurface};
 

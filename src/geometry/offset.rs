@@ -8,7 +8,7 @@
 //! move by the full thickness instead of the corner thinning the stack. The distance per vertex
 //! comes from the caller (it varies where the plies below shear and thicken, and steps down at
 //! their edges).
-use super::{ObjError, Point, ToolSurface, Vector};
+use super::{Point, ToolError, ToolSurface, Vector};
 use nalgebra::{Matrix3, SymmetricEigen};
 
 /// Eigenvalues of the normal scatter below this fraction of the largest are dropped: the
@@ -85,7 +85,7 @@ pub fn offset_directions(tool: &ToolSurface) -> (Vec<Vector>, usize) {
 
 /// The tool offset by `distance[v]` metres at vertex `v` (to the side its normals point to; a
 /// negative distance moves the other way). The result is a new, checked [`ToolSurface`].
-pub fn offset_surface(tool: &ToolSurface, distance: &[f64]) -> Result<(ToolSurface, OffsetReport), ObjError> {
+pub fn offset_surface(tool: &ToolSurface, distance: &[f64]) -> Result<(ToolSurface, OffsetReport), ToolError> {
     let (dirs, clipped) = offset_directions(tool);
     offset_along(tool, &dirs, clipped, distance)
 }
@@ -97,7 +97,7 @@ pub fn offset_along(
     dirs: &[Vector],
     clipped: usize,
     distance: &[f64],
-) -> Result<(ToolSurface, OffsetReport), ObjError> {
+) -> Result<(ToolSurface, OffsetReport), ToolError> {
     assert_eq!(distance.len(), tool.vertices().len(), "one offset distance per tool vertex");
     let mut report = OffsetReport { clipped, ..Default::default() };
     let moved = offset_vertices(tool, dirs, distance);

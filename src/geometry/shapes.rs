@@ -15,59 +15,8 @@
 //!
 //! [`TriangleMesh::to_obj_string`] writes a mesh as Wavefront OBJ at full `f64` precision and
 //! [`TriangleMesh::into_surface`] turns it into a checked [`ToolSurface`].
-use super::{ObjError, Point, ToolSurface, Vector};
+use super::{Point, TriangleMesh, Vector};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
-use std::fmt::Write as _;
-
-/// An indexed triangle mesh: welded vertices and counter-clockwise triangles (0-based indices).
-#[derive(Debug, Clone, PartialEq)]
-pub struct TriangleMesh {
-    pub vertices: Vec<Point>,
-    pub triangles: Vec<[u32; 3]>,
-}
-
-impl TriangleMesh {
-    /// Wavefront OBJ text: a comment line with the counts, one `v x y z` line per vertex (`{}`
-    /// formatting of `f64`, the shortest text that reads back to the same number) and one
-    /// `f i j k` line per triangle (1-based indices, as OBJ requires).
-    pub fn to_obj_string(&self) -> String {
-        let mut s = String::with_capacity(self.vertices.len() * 60 + self.triangles.len() * 24);
-        let _ = writeln!(s, "# {} vertices, {} triangles", self.vertices.len(), self.triangles.len());
-        for v in &self.vertices {
-            let _ = writeln!(s, "v {} {} {}", v.x, v.y, v.z);
-        }
-        for t in &self.triangles {
-            let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
-        }
-        s
-    }
-
-    /// Check the mesh and build the queryable tool surface ([`ToolSurface::from_triangles`]).
-    pub fn into_surface(self) -> Result<ToolSurface, ObjError> {
-        ToolSurface::from_triangles(self.vertices, self.triangles)
-    }
-
-    /// Corner positions of triangle `t`.
-    pub fn corners(&self, t: usize) -> [Point; 3] {
-        self.triangles[t].map(|i| self.vertices[i as usize])
-    }
-
-    /// Unit normal of triangle `t` (`(b - a) x (c - a)`, normalised).
-    pub fn normal(&self, t: usize) -> Vector {
-        let [a, b, c] = self.corners(t);
-        (b - a).cross(&(c - a)).normalize()
-    }
-
-    /// Total area of the triangles.
-    pub fn area(&self) -> f64 {
-        (0..self.triangles.len())
-            .map(|t| {
-                let [a, b, c] = self.corners(t);
-                0.5 * (b - a).cross(&(c - a)).norm()
-            })
-            .sum()
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Structured-grid helpers

@@ -264,10 +264,10 @@ mod tests {
 
     #[test]
     fn patches_meet_without_cracks() {
-        let tool = ToolSurface::from_obj(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/geometries/double-dome/double-dome.obj"
-        )))
+        let tool = crate::io::read_tool(
+            std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/geometries/double-dome/double-dome.obj")),
+            1.0,
+        )
         .unwrap();
         let smooth = SmoothSurface::new(&tool);
         assert_eq!(smooth.creases(), 0, "no edge of the double dome is sharper than the crease angle");

@@ -1,7 +1,7 @@
 //! [`ToolSurface`]: a checked triangle mesh with a BVH (parry3d), edge adjacency and per-triangle
 //! frames, answering the geometric queries the drape engine needs.
 use super::check::{mend, MendedMesh, NO_NEIGHBOUR};
-use super::obj::{read_obj, MeshReport, ObjError, RawMesh};
+use super::mesh::{MeshReport, ToolError, TriangleMesh};
 use super::{Point, Vector};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::query::PointQueryWithLocation;
@@ -81,31 +81,17 @@ impl std::fmt::Debug for ToolSurface {
 }
 
 impl ToolSurface {
-    /// Load, check and mend an OBJ file.
-    pub fn from_obj(path: &Path) -> Result<Self, ObjError> {
-        Self::from_obj_scaled(path, 1.0)
-    }
-
-    /// Load an OBJ whose coordinates are in units of `scale` metres (0.001 for millimetres).
-    pub fn from_obj_scaled(path: &Path, scale: f64) -> Result<Self, ObjError> {
-        let (mut raw, report) = read_obj(path)?;
-        if scale != 1.0 {
-            raw.vertices.iter_mut().for_each(|v| *v *= scale);
-        }
-        Self::from_raw(raw, report, path)
-    }
-
     /// Build from in-memory triangles (analytic shapes, tests); goes through the same checks.
-    pub fn from_triangles(vertices: Vec<Point>, triangles: Vec<[u32; 3]>) -> Result<Self, ObjError> {
+    pub fn from_triangles(vertices: Vec<Point>, triangles: Vec<[u32; 3]>) -> Result<Self, ToolError> {
         let report = MeshReport { vertices_read: vertices.len(), faces_read: triangles.len(), ..Default::default() };
         let path = Path::new("<memory>");
         if triangles.is_empty() {
-            return Err(ObjError::Empty { path: path.into() });
+            return Err(ToolError::Empty { path: path.into() });
         }
         for (f, tri) in triangles.iter().enumerate() {
             for &i in tri {
                 if i as usize >= vertices.len() {
-                    return Err(ObjError::BadIndex {
+                    return Err(ToolError::BadIndex {
                         path: path.into(),
                         face: f,
                         index: i as usize,
@@ -116,18 +102,21 @@ impl ToolSurface {
         }
         for (i, v) in vertices.iter().enumerate() {
             if let Some(&value) = v.coords.iter().find(|c| !c.is_finite()) {
-                return Err(ObjError::NonFinite { path: path.into(), index: i, value });
+                return Err(ToolError::NonFinite { path: path.into(), index: i, value });
             }
         }
-        Self::from_raw(RawMesh { vertices, triangles }, report, path)
+        Self::from_mesh(TriangleMesh { vertices, triangles }, report, path)
     }
 
-    fn from_raw(raw: RawMesh, mut report: MeshReport, path: &Path) -> Result<Self, ObjError> {
+    /// Check and mend `mesh` (read from `path`, with what reading it found in `report`) and build
+    /// the surface: welding, degenerate and duplicate faces, adjacency, orientation
+    /// ([`super::check::mend`]), then the BVH.
+    pub fn from_mesh(raw: TriangleMesh, mut report: MeshReport, path: &Path) -> Result<Self, ToolError> {
         let diagonal = bounding_diagonal(&raw.vertices);
         let MendedMesh { vertices, triangles, neighbours } =
             mend(raw, WELD_TOLERANCE_REL * diagonal, path, &mut report)?;
         if triangles.is_empty() {
-            return Err(ObjError::AllDegenerate { path: path.into() });
+            return Err(ToolError::AllDegenerate { path: path.into() });
         }
         let frames = triangles
             .iter()
@@ -150,7 +139,7 @@ impl ToolSurface {
                 (c, r)
             })
             .collect();
-        let mesh = TriMesh::new(vertices.clone(), triangles.clone()).map_err(|e| ObjError::Parse {
+        let mesh = TriMesh::new(vertices.clone(), triangles.clone()).map_err(|e| ToolError::Parse {
             path: path.into(),
             reason: format!("mesh rejected by the geometry kernel: {e}"),
         })?;

@@ -40,7 +40,7 @@ pub use error::ExportError;
 pub use net::{write_net, Format};
 pub use net_json::{read_net, write_json};
 pub use shell_mesh::FlowMeshError;
-pub use tool::{read_tool, ReadToolError};
+pub use tool::{read_tool, read_tool_mesh, ReadToolError, ToolMesh};
 pub use vtk::write_vtu;
 
 use crate::mapping::FlowMesh;

@@ -1,89 +1,547 @@
-//! Wavefront OBJ: `v x y z [w]` vertices and `f` faces (`a`, `a/t`, `a//n`, `a/t/n`; negative
-//! indices count back from the last vertex read). Triangles and quads are kept as they are; a
-//! polygon with more than four corners is split into a fan of triangles from its first corner.
-//! Node ids are the vertex numbers (from 1); element ids are the elements' numbers in output
-//! order (from 1), which is the face number as long as no polygon was split. Groups, objects,
-//! materials and smoothing (`g`, `o`, `usemtl`, `s`) are ignored: every property is 0. A line
-//! ending in `\` continues on the next.
+//! Wavefront OBJ: one parser ([`parse`]) for tools ([`read_obj`]) and flow meshes ([`read`]),
+//! and the writer of a triangle mesh ([`TriangleMesh::to_obj_string`]).
+//!
+//! Only `v` and `f` statements matter: `v x y z`, optionally followed by a weight w that
+//! divides the coordinates (not 0) or by a colour r g b; `f` with vertex numbers (`a`, `a/t`,
+//! `a//n`, `a/t/n`; negative numbers count back from the last vertex read, positive ones may
+//! refer to vertices further down the file). Normals, texture coordinates, groups, objects,
+//! materials, smoothing and comments (`#`) are ignored, so every group and object of a file is
+//! one mesh keeping the file's vertex numbering. A line ending in `\` continues on the next.
+//! Lines end at `\n`, `\r\n` or a lone `\r`.
+//!
+//! A tool ([`read_obj`]): every polygon is fanned into triangles from its first corner, faces of
+//! fewer than three corners are dropped and counted as degenerate, and vertices no face uses
+//! are left out (numbered in the order faces first use them), so a stray non-finite vertex that
+//! no face uses is harmless. A flow mesh ([`read`]): every vertex is a node whose id is its
+//! number (from 1), triangles and quads are kept as they are, larger polygons are fanned into
+//! triangles, a face of fewer than three corners is an error; element ids number the elements
+//! from 1 in output order (the face number as long as no polygon was split), every property 0.
 use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
+use crate::geometry::{MeshReport, Point, ToolError, TriangleMesh};
 use crate::mapping::FlowMesh;
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// OBJ as a shell-mesh format.
 pub const FORMAT: super::MeshFormat = super::MeshFormat { name: "OBJ", extensions: &["obj"], read };
 
-/// Read an OBJ file (see the module documentation).
+/// The `v` and `f` statements of an OBJ text.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjText {
+    /// Vertices in file order, divided by their weight, with the line of each.
+    pub vertices: Vec<([f64; 3], usize)>,
+    /// Faces in file order.
+    pub faces: Vec<ObjFace>,
+    /// `l` (polyline) statements, which are not surfaces.
+    pub lines: usize,
+    /// `p` (point) statements, which are not surfaces.
+    pub points: usize,
+}
+
+/// One `f` statement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjFace {
+    /// Vertex numbers from 1, relative numbers resolved; not checked against the vertex count
+    /// (a face may refer to a vertex further down the file).
+    pub corners: Vec<u64>,
+    /// Its line in the file.
+    pub line: usize,
+}
+
+/// Why an OBJ text could not be parsed: the line (0 for the whole file) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjSyntaxError {
+    /// 1-based line, 0 when the whole file is at fault.
+    pub line: usize,
+    /// What is wrong and what a valid statement looks like.
+    pub message: String,
+}
+
+/// Parse the statements of an OBJ file's bytes (see the module documentation).
+pub fn parse(bytes: &[u8]) -> Result<ObjText, ObjSyntaxError> {
+    if bytes.contains(&0) {
+        return Err(ObjSyntaxError {
+            line: 0,
+            message: "it is a binary file, not a text (Wavefront) OBJ; binary STL, zipped or native CAD files cannot be read"
+                .into(),
+        });
+    }
+    let mut text = ObjText::default();
+    let mut joined: Option<(usize, String)> = None;
+    for (number, raw) in lines(bytes) {
+        let raw = String::from_utf8_lossy(raw);
+        let raw = raw.split('#').next().unwrap_or("");
+        let (start, mut line) = joined.take().unwrap_or((number, String::new()));
+        if let Some(head) = raw.trim_end().strip_suffix('\\') {
+            line.push_str(head);
+            line.push(' ');
+            joined = Some((start, line));
+            continue;
+        }
+        line.push_str(raw);
+        statement(&line, start, &mut text)?;
+    }
+    if let Some((start, line)) = joined {
+        statement(&line, start, &mut text)?;
+    }
+    Ok(text)
+}
+
+/// The lines of `bytes` with their 1-based numbers; `\n`, `\r\n` and a lone `\r` end a line.
+fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
+    let mut rest = bytes;
+    let mut number = 0;
+    std::iter::from_fn(move || {
+        if rest.is_empty() {
+            return None;
+        }
+        number += 1;
+        let end = rest.iter().position(|&c| c == b'\n' || c == b'\r').unwrap_or(rest.len());
+        let line = &rest[..end];
+        let skip = match (rest.get(end), rest.get(end + 1)) {
+            (Some(b'\r'), Some(b'\n')) => 2,
+            (Some(_), _) => 1,
+            (None, _) => 0,
+        };
+        rest = &rest[end + skip..];
+        Some((number, line))
+    })
+}
+
+/// Add one statement (a whole line, continuations joined) to `text`.
+fn statement(line: &str, number: usize, text: &mut ObjText) -> Result<(), ObjSyntaxError> {
+    let mut words = line.split_whitespace();
+    let quoted = || quote(line);
+    match words.next() {
+        Some("v") => {
+            let numbers: Option<Vec<f64>> = words.map(|w| w.parse::<f64>().ok()).collect();
+            let xyz = match numbers.as_deref() {
+                Some(&[x, y, z]) | Some(&[x, y, z, _, _, _]) => [x, y, z],
+                Some(&[x, y, z, w]) if w != 0.0 => [x / w, y / w, z / w],
+                _ => {
+                    return Err(ObjSyntaxError {
+                        line: number,
+                        message: format!(
+                            "{}: a vertex is `v x y z` with three numbers, optionally followed by a weight w other than 0 or by a colour r g b",
+                            quoted()
+                        ),
+                    })
+                }
+            };
+            text.vertices.push((xyz, number));
+        }
+        Some("f") => {
+            let face = text.faces.len() + 1;
+            let read_so_far = text.vertices.len() as u64;
+            let mut corners = Vec::with_capacity(4);
+            for word in words {
+                let parts: Vec<&str> = word.split('/').collect();
+                let well_formed = parts.len() <= 3 && parts.iter().all(|p| p.is_empty() || p.parse::<i64>().is_ok());
+                let Some(i) = parts[0].parse::<i64>().ok().filter(|_| well_formed) else {
+                    return Err(ObjSyntaxError {
+                        line: number,
+                        message: format!(
+                            "{}: a face is `f` followed by vertex numbers, such as `f 1 2 3` or `f 1/1/1 2/2/2 3/3/3`",
+                            quoted()
+                        ),
+                    });
+                };
+                let vertex = match i {
+                    i if i > 0 => i as u64,
+                    0 => {
+                        return Err(ObjSyntaxError {
+                            line: number,
+                            message: format!("face {face} refers to vertex 0, but OBJ vertex numbers start at 1"),
+                        })
+                    }
+                    i if i.unsigned_abs() <= read_so_far => read_so_far + 1 - i.unsigned_abs(),
+                    i => {
+                        return Err(ObjSyntaxError {
+                            line: number,
+                            message: format!(
+                                "face {face} refers to relative vertex {i}, but only {read_so_far} vertices are defined before it"
+                            ),
+                        })
+                    }
+                };
+                corners.push(vertex);
+            }
+            text.faces.push(ObjFace { corners, line: number });
+        }
+        Some("l") => text.lines += 1,
+        Some("p") => text.points += 1,
+        _ => {}
+    }
+    Ok(())
+}
+
+/// A line, shortened for an error message.
+fn quote(line: &str) -> String {
+    let text = line.trim();
+    match text.char_indices().nth(60) {
+        Some((cut, _)) => format!("`{}...`", &text[..cut]),
+        None => format!("`{text}`"),
+    }
+}
+
+/// Read an OBJ file as a tool: its triangles (see the module documentation) and what was found
+/// on the way. Refuses an unreadable or unparsable file, one without faces or with only
+/// degenerate ones, a face referring to a vertex the file does not have, and a used vertex
+/// with a non-finite coordinate.
+pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
+    let bytes = std::fs::read(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
+    let text = parse(&bytes).map_err(|e| ToolError::Parse {
+        path: path.into(),
+        reason: if e.line == 0 { e.message } else { format!("line {}: {}", e.line, e.message) },
+    })?;
+    let count = text.vertices.len();
+    let mut report = MeshReport { vertices_read: count, faces_read: text.faces.len(), ..Default::default() };
+    if text.faces.is_empty() {
+        return Err(ToolError::Empty { path: path.into() });
+    }
+    // Vertices in the order the faces first use them.
+    let mut index = vec![u32::MAX; count];
+    let mut mesh = TriangleMesh::default();
+    for (f, face) in text.faces.iter().enumerate() {
+        let mut corners = Vec::with_capacity(face.corners.len());
+        for &v in &face.corners {
+            let k = (v as usize).checked_sub(1).filter(|&k| k < count).ok_or(ToolError::BadIndex {
+                path: path.into(),
+                face: f + 1,
+                index: v as usize,
+                count,
+            })?;
+            if index[k] == u32::MAX {
+                let ([x, y, z], _) = text.vertices[k];
+                if let Some(&value) = [x, y, z].iter().find(|c| !c.is_finite()) {
+                    return Err(ToolError::NonFinite { path: path.into(), index: k + 1, value });
+                }
+                index[k] = mesh.vertices.len() as u32;
+                mesh.vertices.push(Point::new(x, y, z));
+            }
+            corners.push(index[k]);
+        }
+        match corners.len() {
+            0..=2 => report.degenerate_faces_dropped += 1,
+            n => {
+                if n > 3 {
+                    report.polygons_triangulated += 1;
+                }
+                for pair in corners[1..].windows(2) {
+                    mesh.triangles.push([corners[0], pair[0], pair[1]]);
+                }
+            }
+        }
+    }
+    if mesh.triangles.is_empty() {
+        return Err(ToolError::AllDegenerate { path: path.into() });
+    }
+    Ok((mesh, report))
+}
+
+/// Read an OBJ file as a flow mesh (see the module documentation); lengths multiplied by `scale`.
 pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
     let mut b = Builder::new(path, scale)?;
     let bytes = read_bytes(path)?;
-    let text = String::from_utf8_lossy(&bytes);
-    let mut nverts: u64 = 0;
+    let text = parse(&bytes).map_err(|e| match e.line {
+        0 => FlowMeshError::Invalid { path: path.into(), message: e.message },
+        line => FlowMeshError::Syntax { path: path.into(), line, message: e.message },
+    })?;
+    for (k, &(xyz, line)) in text.vertices.iter().enumerate() {
+        b.add_node(k as u64 + 1, xyz, Loc { file: 0, line })?;
+    }
     let mut next_element: u64 = 1;
-    let mut joined = String::new();
-    let mut start = 0usize;
-    for (k, raw) in text.lines().enumerate() {
-        let raw = raw.split('#').next().unwrap_or("");
-        if joined.is_empty() {
-            start = k + 1;
-        }
-        if let Some(head) = raw.trim_end().strip_suffix('\\') {
-            joined.push_str(head);
-            joined.push(' ');
-            continue;
-        }
-        joined.push_str(raw);
-        let line = std::mem::take(&mut joined);
-        let loc = Loc { file: 0, line: start };
-        let mut tok = line.split_whitespace();
-        match tok.next() {
-            Some("v") => {
-                let mut x = [0.0; 3];
-                for (i, xi) in x.iter_mut().enumerate() {
-                    let t = tok.next().ok_or_else(|| b.syntax(loc, "vertex line needs three coordinates: v x y z"))?;
-                    *xi = t
-                        .parse()
-                        .map_err(|_| b.syntax(loc, format!("vertex coordinate {}: '{t}' is not a number", i + 1)))?;
-                }
-                nverts += 1;
-                b.add_node(nverts, x, loc)?;
+    for face in &text.faces {
+        let loc = Loc { file: 0, line: face.line };
+        let c = &face.corners;
+        match c.len() {
+            3 | 4 => {
+                b.add_element(next_element, c, 0, loc)?;
+                next_element += 1;
             }
-            Some("f") => {
-                let mut corners: Vec<u64> = Vec::with_capacity(4);
-                for t in tok {
-                    let v = t.split('/').next().unwrap_or("");
-                    let i: i64 = v
-                        .parse()
-                        .map_err(|_| b.syntax(loc, format!("face corner '{t}' does not start with a vertex number")))?;
-                    let n = if i > 0 {
-                        i as u64
-                    } else if i < 0 && i.unsigned_abs() <= nverts {
-                        nverts + 1 - i.unsigned_abs()
-                    } else {
-                        return Err(b.syntax(
-                            loc,
-                            format!("face corner {i} does not name a vertex read so far ({nverts} vertices)"),
-                        ));
-                    };
-                    corners.push(n);
-                }
-                match corners.len() {
-                    3 | 4 => {
-                        b.add_element(next_element, &corners, 0, loc)?;
-                        next_element += 1;
-                    }
-                    n if n > 4 => {
-                        for k in 1..n - 1 {
-                            b.add_element(next_element, &[corners[0], corners[k], corners[k + 1]], 0, loc)?;
-                            next_element += 1;
-                        }
-                    }
-                    n => return Err(b.syntax(loc, format!("face with {n} corners: a face needs at least 3"))),
+            n if n > 4 => {
+                for k in 1..n - 1 {
+                    b.add_element(next_element, &[c[0], c[k], c[k + 1]], 0, loc)?;
+                    next_element += 1;
                 }
             }
-            Some("l") => b.skip("line (l)"),
-            Some("p") => b.skip("point (p)"),
-            _ => {}
+            n => return Err(b.syntax(loc, format!("face with {n} corners: a face needs at least 3"))),
         }
     }
+    for _ in 0..text.lines {
+        b.skip("line (l)");
+    }
+    for _ in 0..text.points {
+        b.skip("point (p)");
+    }
     b.finish("f faces with 3 or more corners")
+}
+
+impl TriangleMesh {
+    /// Wavefront OBJ text: a comment line with the counts, one `v x y z` line per vertex (`{}`
+    /// formatting of `f64`, the shortest text that reads back to the same number) and one
+    /// `f i j k` line per triangle (1-based indices, as OBJ requires).
+    pub fn to_obj_string(&self) -> String {
+        let mut s = String::with_capacity(self.vertices.len() * 60 + self.triangles.len() * 24);
+        let _ = writeln!(s, "# {} vertices, {} triangles", self.vertices.len(), self.triangles.len());
+        for v in &self.vertices {
+            let _ = writeln!(s, "v {} {} {}", v.x, v.y, v.z);
+        }
+        for t in &self.triangles {
+            let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Point;
+    use std::path::PathBuf;
+
+    fn write(dir: &tempfile::TempDir, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
+        let path = dir.path().join(name);
+        std::fs::write(&path, contents).unwrap();
+        path
+    }
+
+    fn read_text(text: &str) -> Result<(TriangleMesh, MeshReport), ToolError> {
+        let dir = tempfile::tempdir().unwrap();
+        read_obj(&write(&dir, "mesh.obj", text))
+    }
+
+    const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+
+    #[test]
+    fn triangles_quads_and_polygons_are_fan_triangulated() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 1.5 0\n\
+                    f 1 2 3\nf 1 2 3 4\nf 1 2 3 5 4\n";
+        let (raw, report) = read_text(text).unwrap();
+        assert_eq!(report.vertices_read, 5);
+        assert_eq!(report.faces_read, 3);
+        assert_eq!(report.polygons_triangulated, 2);
+        assert_eq!(report.degenerate_faces_dropped, 0);
+        assert_eq!(raw.vertices.len(), 5);
+        assert_eq!(raw.vertices[4], Point::new(0.5, 1.5, 0.0));
+        assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 2, 4], [0, 4, 3]]);
+    }
+
+    #[test]
+    fn quad_only_file_becomes_two_triangles() {
+        let (raw, report) = read_text(&format!("{SQUARE}f 1 2 3 4\n")).unwrap();
+        assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!((report.faces_read, report.polygons_triangulated), (1, 1));
+    }
+
+    #[test]
+    fn faces_with_fewer_than_three_corners_are_dropped_as_degenerate() {
+        let (raw, report) = read_text(&format!("{SQUARE}f 1\nf 1 2\nf\nf 1 2 3\n")).unwrap();
+        assert_eq!(raw.triangles, vec![[0, 1, 2]]);
+        assert_eq!(report.faces_read, 4);
+        assert_eq!(report.degenerate_faces_dropped, 3);
+        let err = read_text(&format!("{SQUARE}f 1 2\n")).unwrap_err();
+        assert!(matches!(err, ToolError::AllDegenerate { .. }), "{err}");
+    }
+
+    #[test]
+    fn relative_indices_and_slashed_indices_are_read() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf -3 -2 -1\nvt 0 0\nvn 0 0 1\n\
+                    v 0 1 0\nf 1/1/1 3/1/1 4/1/1\nf 1//1 2//1 4//1\n";
+        let (raw, report) = read_text(text).unwrap();
+        assert_eq!(raw.triangles.len(), 3);
+        assert_eq!(raw.vertices.len(), 4);
+        assert_eq!(report.vertices_read, 4);
+        let tri: Vec<[Point; 3]> = raw.triangles.iter().map(|t| t.map(|i| raw.vertices[i as usize])).collect();
+        assert_eq!(tri[0], [Point::new(0., 0., 0.), Point::new(1., 0., 0.), Point::new(1., 1., 0.)]);
+        assert_eq!(tri[1][2], Point::new(0., 1., 0.));
+
+        // An out-of-range texture index is not read (tobj, the reader before, overflowed on it).
+        let (raw, _) = read_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/-5 2/-5 3/-5\n").unwrap();
+        assert_eq!(raw.triangles.len(), 1);
+    }
+
+    #[test]
+    fn objects_groups_and_other_statements_do_not_split_or_break_the_mesh() {
+        // Groups sharing vertices, materials (library missing), polylines, texture and normal
+        // indices out of range, inline comments, a weight, vertex colours on some vertices only,
+        // Windows line ends and a non-UTF-8 group name.
+        let mut text = b"mtllib missing.mtl\r\no part\r\n".to_vec();
+        text.extend_from_slice(b"g caf\xe9\r\n");
+        text.extend_from_slice(
+            b"v 0 0 0 # origin\r\nv 2 0 0 2\r\nv 1 1 0 1 0 0\r\nv 0 1 0\r\nvt 0 0\r\nvn 0 0 1\r\n\
+              usemtl steel\r\nf 1/7/9 2/7/9 3/7/9\r\ng other\r\nl 1 2 3 4\r\ns off\r\n\
+              f 1/0 3/0 4/0 # second\r\np 1\r\n",
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let (raw, report) = read_obj(&write(&dir, "mixed.obj", &text)).unwrap();
+        assert_eq!(report.vertices_read, 4);
+        assert_eq!(report.faces_read, 2);
+        assert_eq!(raw.vertices.len(), 4, "shared vertices stay shared across groups");
+        assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(raw.vertices[1], Point::new(1.0, 0.0, 0.0), "weight w divides");
+        assert_eq!(raw.vertices[2], Point::new(1.0, 1.0, 0.0), "colour is not a weight");
+
+        // Old Mac line ends.
+        let (raw, _) = read_text(&format!("{SQUARE}f 1 2 3 4\n").replace('\n', "\r")).unwrap();
+        assert_eq!(raw.triangles.len(), 2);
+    }
+
+    #[test]
+    fn non_finite_coordinate_is_refused_with_its_vertex_number() {
+        let err = read_text("v 0 0 0\nv 1 0 0\nv 1 nan 0\nf 1 2 3\n").unwrap_err();
+        match err {
+            ToolError::NonFinite { index, value, .. } => {
+                assert_eq!(index, 3);
+                assert!(value.is_nan());
+            }
+            e => panic!("expected NonFinite, got {e}"),
+        }
+        let err = read_text("v 0 0 0\nv 1 0 -inf\nv 1 1 0\nf 1 2 3\n").unwrap_err();
+        assert!(matches!(err, ToolError::NonFinite { index: 2, value, .. } if value == f64::NEG_INFINITY), "{err}");
+        // Unused non-finite vertices are harmless.
+        assert!(read_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv nan 0 0\nf 1 2 3\n").is_ok());
+    }
+
+    #[test]
+    fn out_of_range_index_is_refused() {
+        let err = read_text(&format!("{SQUARE}f 1 2 3\nf 1 3 7\n")).unwrap_err();
+        assert!(matches!(err, ToolError::BadIndex { face: 2, index: 7, count: 4, .. }), "{err}");
+        assert!(err.to_string().contains("face 2 refers to vertex 7"), "{err}");
+
+        let err = read_text(&format!("{SQUARE}f 0 1 2\n")).unwrap_err();
+        assert!(matches!(err, ToolError::Parse { .. }), "{err}");
+        assert!(err.to_string().contains("start at 1"), "{err}");
+
+        let err = read_text("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 1 1 0\n").unwrap_err();
+        assert!(matches!(err, ToolError::Parse { .. }), "{err}");
+        assert!(err.to_string().contains("relative vertex -3"), "{err}");
+    }
+
+    #[test]
+    fn unparsable_lines_are_refused_with_their_line_number() {
+        let err = read_text("v 0 0 0\nv 1 zero 0\n").unwrap_err();
+        assert!(matches!(err, ToolError::Parse { .. }), "{err}");
+        assert!(err.to_string().contains("line 2"), "{err}");
+        let err = read_text(&format!("{SQUARE}f 1 2 3\nf 1 2 x\n")).unwrap_err();
+        assert!(err.to_string().contains("line 6"), "{err}");
+        let err = read_text("v 0 0 0 0\n").unwrap_err();
+        assert!(err.to_string().contains("line 1"), "{err}");
+    }
+
+    #[test]
+    fn file_without_faces_is_refused() {
+        for text in ["", "# only a comment\n", SQUARE, "l 1 2\n", "hello\nworld\n"] {
+            let err = read_text(text).unwrap_err();
+            assert!(matches!(err, ToolError::Empty { .. }), "{text:?}: {err}");
+        }
+    }
+
+    #[test]
+    fn missing_file_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = read_obj(&dir.path().join("nope.obj")).unwrap_err();
+        assert!(matches!(err, ToolError::Io { .. }), "{err}");
+        assert!(err.to_string().contains("nope.obj"), "{err}");
+        let err = read_obj(dir.path()).unwrap_err();
+        assert!(matches!(err, ToolError::Io { .. }), "{err}");
+    }
+
+    #[test]
+    fn binary_and_garbage_files_are_refused_without_panic() {
+        let dir = tempfile::tempdir().unwrap();
+        // Binary STL-like header with NUL bytes.
+        let mut stl = b"solid part".to_vec();
+        stl.resize(84, 0);
+        stl.extend_from_slice(&[0x3f; 50]);
+        let err = read_obj(&write(&dir, "part.stl", &stl)).unwrap_err();
+        assert!(matches!(err, ToolError::Parse { .. }), "{err}");
+        assert!(err.to_string().contains("binary"), "{err}");
+
+        // Not UTF-8 where it matters.
+        let err = read_obj(&write(&dir, "latin.obj", b"v 0 0 0\nv 1\xff 0 0\n")).unwrap_err();
+        assert!(matches!(err, ToolError::Parse { .. }), "{err}");
+
+        // Random bytes and random OBJ-like words: refused (or, by chance, read), never a panic.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let tokens = ["v", "f", "vt", "l", "1", "-1", "0", "2/3", "//", "/", "1e40", "nan", "\n"];
+        for round in 0..240 {
+            let bytes: Vec<u8> = match round % 3 {
+                0 => (0..200).map(|_| (rnd() % 256) as u8).collect(),
+                1 => (0..200).map(|_| (rnd() % 255 + 1) as u8).collect(),
+                _ => {
+                    let words: Vec<&str> = (0..60).map(|_| tokens[(rnd() % tokens.len() as u64) as usize]).collect();
+                    words.join(" ").into_bytes()
+                }
+            };
+            let path = write(&dir, &format!("garbage{round}.obj"), &bytes);
+            match read_obj(&path) {
+                Ok(_)
+                | Err(ToolError::Parse { .. })
+                | Err(ToolError::Empty { .. })
+                | Err(ToolError::BadIndex { .. })
+                | Err(ToolError::NonFinite { .. })
+                | Err(ToolError::AllDegenerate { .. }) => {}
+                Err(e) => panic!("unexpected error {e}"),
+            }
+        }
+    }
+
+    #[test]
+    fn tool_surface_from_obj_answers_closest_point_queries() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write(&dir, "square.obj", format!("{SQUARE}f 1 2 3\nf 1 3 4\n"));
+        let surface = crate::io::read_tool(&path, 1.0).unwrap();
+        assert_eq!(surface.num_triangles(), 2);
+        assert_eq!(surface.report().boundary_edges, 4);
+        let cases = [
+            (Point::new(0.8, 0.2, 0.5), Point::new(0.8, 0.2, 0.0), 0),
+            (Point::new(0.2, 0.7, -0.3), Point::new(0.2, 0.7, 0.0), 1),
+            (Point::new(2.0, 0.5, 0.0), Point::new(1.0, 0.5, 0.0), 0),
+            (Point::new(-1.0, 0.5, 1.0), Point::new(0.0, 0.5, 0.0), 1),
+        ];
+        for (query, expected, triangle) in cases {
+            let sp = surface.closest_point(&query);
+            assert!((sp.point - expected).norm() < 1e-12, "{query}: {sp:?}");
+            assert_eq!(sp.triangle, triangle, "{query}");
+            assert!((sp.distance - (query - expected).norm()).abs() < 1e-12);
+            assert!((sp.normal.z.abs() - 1.0).abs() < 1e-12);
+        }
+    }
+
+    use crate::mapping::ElementShape;
+
+    /// The flow-mesh reading of one text: every vertex a node (numbered from 1), faces of three
+    /// and four corners kept, larger polygons fanned.
+    fn read_flow(text: &str) -> Result<FlowMesh, FlowMeshError> {
+        let dir = tempfile::tempdir().unwrap();
+        read(&write(&dir, "mesh.obj", text), 1.0)
+    }
+
+    #[test]
+    fn the_flow_reading_keeps_quads_and_continues_lines() {
+        let m = read_flow("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 \\\n 3 4\nf 1 2 3\n").unwrap();
+        let shapes: Vec<ElementShape> = m.elements.iter().map(|e| e.shape).collect();
+        assert_eq!(shapes, [ElementShape::Quad4, ElementShape::Tria3]);
+        assert_eq!(m.node_ids, [1, 2, 3, 4]);
+        let e = read_flow("v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("at least 3"), "{e}");
+    }
+
+    #[test]
+    fn obj_text_round_trips() {
+        let mesh = TriangleMesh {
+            vertices: vec![Point::new(0.1, -0.2, 1.0 / 3.0), Point::new(1e-17, 2.0, 0.0), Point::new(3.0, 0.5, -1e300)],
+            triangles: vec![[0, 1, 2]],
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let (back, _) = read_obj(&write(&dir, "m.obj", mesh.to_obj_string())).unwrap();
+        assert_eq!(back, mesh);
+    }
 }

@@ -1,8 +1,9 @@
 //! Reading a tool surface from a file: an OBJ, or any shell mesh of [`super::MESH_FORMATS`] (an
 //! Abaqus mould deck, a Nastran or Gmsh mesh), its quads split into triangles. Every command and
 //! the report read tools through [`read_tool`].
+use super::obj::read_obj;
 use super::{read_flow_mesh, FlowMeshError};
-use crate::geometry::{ObjError, ToolSurface};
+use crate::geometry::{MeshReport, ToolError, ToolSurface, TriangleMesh};
 use std::path::{Path, PathBuf};
 
 /// Why a tool file could not become a tool surface.
@@ -10,7 +11,7 @@ use std::path::{Path, PathBuf};
 pub enum ReadToolError {
     /// The OBJ could not be read or checked.
     #[error(transparent)]
-    Obj(#[from] ObjError),
+    Obj(#[from] ToolError),
     /// The shell mesh could not be read.
     #[error(transparent)]
     Mesh(#[from] FlowMeshError),
@@ -20,39 +21,68 @@ pub enum ReadToolError {
         /// The tool file.
         path: PathBuf,
         /// What the checks found.
-        error: ObjError,
+        error: ToolError,
     },
 }
 
 /// Read a tool surface from `path` (see the module documentation); lengths scaled by `scale`
 /// (metres per file unit).
 pub fn read_tool(path: &Path, scale: f64) -> Result<ToolSurface, ReadToolError> {
+    match read_tool_mesh(path, scale)? {
+        ToolMesh::Obj(mesh, report) => Ok(ToolSurface::from_mesh(mesh, report, path)?),
+        ToolMesh::Shell(mesh) => mesh.into_surface().map_err(|error| ReadToolError::Check { path: path.into(), error }),
+    }
+}
+
+/// A tool's triangles as its file gives them, before the checks (what the report draws).
+pub enum ToolMesh {
+    /// From an OBJ, with what reading it found.
+    Obj(TriangleMesh, MeshReport),
+    /// From a shell mesh: its elements, quads split into two triangles.
+    Shell(TriangleMesh),
+}
+
+impl ToolMesh {
+    /// The triangles.
+    pub fn into_mesh(self) -> TriangleMesh {
+        match self {
+            ToolMesh::Obj(m, _) | ToolMesh::Shell(m) => m,
+        }
+    }
+}
+
+/// Read the triangles of a tool file (see the module documentation), lengths scaled by `scale`,
+/// without checking or mending them.
+pub fn read_tool_mesh(path: &Path, scale: f64) -> Result<ToolMesh, ReadToolError> {
     let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
-        return Ok(ToolSurface::from_obj_scaled(path, scale)?);
+        let (mut mesh, report) = read_obj(path)?;
+        if scale != 1.0 {
+            mesh.vertices.iter_mut().for_each(|v| *v *= scale);
+        }
+        return Ok(ToolMesh::Obj(mesh, report));
     }
-    let mesh = read_flow_mesh(path, scale)?;
+    let shell = read_flow_mesh(path, scale)?;
     // Only the nodes the elements use: decks carry reference nodes (rigid bodies) that are not
     // part of the surface.
-    let mut index = vec![u32::MAX; mesh.nodes.len()];
-    let mut vertices = Vec::new();
-    let mut triangles = Vec::new();
-    for el in &mesh.elements {
+    let mut index = vec![u32::MAX; shell.nodes.len()];
+    let mut mesh = TriangleMesh::default();
+    for el in &shell.elements {
         let ids: Vec<u32> = el
             .nodes
             .iter()
             .map(|&n| {
                 if index[n] == u32::MAX {
-                    index[n] = vertices.len() as u32;
-                    vertices.push(mesh.nodes[n]);
+                    index[n] = mesh.vertices.len() as u32;
+                    mesh.vertices.push(shell.nodes[n]);
                 }
                 index[n]
             })
             .collect();
-        triangles.push([ids[0], ids[1], ids[2]]);
+        mesh.triangles.push([ids[0], ids[1], ids[2]]);
         if ids.len() == 4 {
-            triangles.push([ids[0], ids[2], ids[3]]);
+            mesh.triangles.push([ids[0], ids[2], ids[3]]);
         }
     }
-    ToolSurface::from_triangles(vertices, triangles).map_err(|error| ReadToolError::Check { path: path.into(), error })
+    Ok(ToolMesh::Shell(mesh))
 }

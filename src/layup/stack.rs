@@ -3,7 +3,7 @@
 //! numbers of the layup table.
 use super::{Layup, Orientation, Ply, StackSide};
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
-use crate::geometry::{ObjError, Point, ToolSurface, Vector};
+use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::fishnet::DrapeError;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, NodeStatus};
@@ -21,7 +21,7 @@ pub enum LayupError {
     #[error("ply '{ply}' (line {line}): {source}")]
     Drape { ply: String, line: usize, source: DrapeError },
     #[error("ply '{ply}' (line {line}): the offset surface of the plies below is unusable: {source}")]
-    Offset { ply: String, line: usize, source: ObjError },
+    Offset { ply: String, line: usize, source: ToolError },
     #[error("ply '{ply}' (line {line}): refinement: {source}")]
     Refine { ply: String, line: usize, source: RefineError },
     #[error("ply '{ply}' (line {line}): {message}")]

@@ -20,8 +20,8 @@ mod view;
 pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL_TRIANGLE_LIMIT, WIDTH};
 pub use view::{change_limit, colour_limit, shear_colour, View, VIEW_TILT_DEG};
 
-use crate::geometry::obj::read_obj;
 use crate::geometry::Point;
+use crate::io::read_tool_mesh;
 use crate::io::{read_net, write_atomic, ExportError};
 use crate::kinematic::{DrapeNet, Method};
 use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
@@ -197,7 +197,7 @@ fn shear_by_cell(net: &DrapeNet, locking_deg: f64) -> (Vec<Option<f64>>, CellSta
     (values, s)
 }
 
-/// A tool mesh as read from its OBJ (file units).
+/// A tool's triangles as read from its file (file units).
 struct RawTool {
     vertices: Vec<Point>,
     triangles: Vec<[u32; 3]>,
@@ -217,7 +217,7 @@ fn locate_tool(recorded: &str, dir: &Path) -> Option<PathBuf> {
 }
 
 fn load_tool(path: &Path) -> Result<RawTool, String> {
-    let (raw, _) = read_obj(path).map_err(|e| e.to_string())?;
+    let raw = read_tool_mesh(path, 1.0).map_err(|e| e.to_string())?.into_mesh();
     let mut lo = Point::from([f64::INFINITY; 3]);
     let mut hi = Point::from([f64::NEG_INFINITY; 3]);
     for v in &raw.vertices {
@@ -227,8 +227,8 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
     Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi })
 }
 
-/// The scale (metres per OBJ unit) the run read the tool with, which the net does not record:
-/// among [`TOOL_SCALES`], those under which the most nodes lie inside the scaled tool's bounding
+/// The scale (metres per file unit) the run read the tool with, for a net that does not record
+/// it (written by an older drape or another tool): among [`TOOL_SCALES`], those under which the most nodes lie inside the scaled tool's bounding
 /// box (grown by 5% of its diagonal), the one whose box size is closest to the net's.
 fn guess_scale(tool: &RawTool, net: &DrapeNet) -> f64 {
     let placed: Vec<&Point> = net
@@ -503,7 +503,9 @@ fn draw_ply(
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
     let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
         Some(Ok(t)) => {
-            let s = guess_scale(t, net);
+            // The scale the run read the tool with, when the net records it.
+            let recorded = net.meta.get("tool_scale").and_then(|s| s.as_f64()).filter(|s| s.is_finite() && *s > 0.0);
+            let s = recorded.unwrap_or_else(|| guess_scale(t, net));
             Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
         }
         Some(Err(e)) => {
