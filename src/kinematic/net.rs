@@ -170,19 +170,33 @@ impl DrapeNet {
         NodeStatus::ALL.iter().zip(counts).filter(|(_, c)| *c > 0).map(|(s, c)| (*s, c)).collect()
     }
 
-    /// Shear statistics over all complete cells.
+    /// Draped area of cell (i, j) if all its corners are placed: half the norm of the cross
+    /// product of its diagonals, the area of a planar quad of any shape (and of the best plane
+    /// through a warped one), m^2.
+    pub fn cell_area(&self, i: usize, j: usize) -> Option<f64> {
+        let [p00, p10, p01, p11] = self.cell_corners(i, j)?;
+        Some(0.5 * (p11 - p00).cross(&(p01 - p10)).norm())
+    }
+
+    /// Shear and area statistics over the complete cells, `locking_angle` in radians: the one
+    /// computation behind the run summary, the layup table and the report.
     pub fn shear_stats(&self, locking_angle: f64) -> ShearStats {
         let mut s = ShearStats::default();
         let mut sum = 0.0;
         for i in 0..self.nu.saturating_sub(1) {
             for j in 0..self.nv.saturating_sub(1) {
-                if let Some(g) = self.cell_shear(i, j) {
-                    s.cells += 1;
-                    sum += g.abs();
-                    s.max_abs = s.max_abs.max(g.abs());
-                    if g.abs() > locking_angle {
-                        s.over_locking += 1;
-                    }
+                let corners = [self.index(i, j), self.index(i + 1, j), self.index(i + 1, j + 1), self.index(i, j + 1)];
+                if corners.iter().all(|&k| self.status[k] != NodeStatus::OutsideOutline) {
+                    s.asked += 1;
+                }
+                let (Some(g), Some(area)) = (self.cell_shear(i, j), self.cell_area(i, j)) else { continue };
+                s.cells += 1;
+                s.area += area;
+                sum += g.abs();
+                s.max_abs = s.max_abs.max(g.abs());
+                if g.abs() > locking_angle {
+                    s.over_locking += 1;
+                    s.area_over_locking += area;
                 }
             }
         }
@@ -202,13 +216,35 @@ pub struct CellFrame {
     pub normal: Vector,
 }
 
-/// Shear statistics of a net (radians).
-#[derive(Debug, Clone, Copy, Default)]
+/// Shear and area statistics of a net's complete cells (radians, m^2), from
+/// [`DrapeNet::shear_stats`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ShearStats {
+    /// Complete cells (all four corners placed).
     pub cells: usize,
+    /// Cells the ply asked for: those with no corner outside its outline (all of a grid).
+    pub asked: usize,
+    /// Largest |shear|.
     pub max_abs: f64,
+    /// Mean |shear|.
     pub mean_abs: f64,
+    /// Cells sheared past the locking angle.
     pub over_locking: usize,
+    /// Draped area of the complete cells ([`DrapeNet::cell_area`]).
+    pub area: f64,
+    /// Draped area of the cells sheared past the locking angle.
+    pub area_over_locking: f64,
+}
+
+impl ShearStats {
+    /// Complete cells over the cells the ply asked for (0 when it asked for none).
+    pub fn coverage(&self) -> f64 {
+        if self.asked > 0 {
+            self.cells as f64 / self.asked as f64
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Shear of one corner: pi/2 minus the angle between the warp and weft edges, radians.
@@ -217,4 +253,40 @@ pub fn corner_shear(warp: &Vector, weft: &Vector) -> f64 {
     // atan2 form: accurate near 0 and near 90 deg, unlike acos of a dot product.
     let angle = warp.cross(weft).norm().atan2(warp.dot(weft));
     std::f64::consts::FRAC_PI_2 - angle
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2 x 2 net whose one cell has the corners `c` ([(0,0), (1,0), (0,1), (1,1)] order).
+    fn one_cell(c: [[f64; 3]; 4]) -> DrapeNet {
+        let mut net = DrapeNet::new("c", 1.0, 2, 2, (0, 0));
+        for (k, (i, j)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+            let n = net.index(i, j);
+            net.positions[n] = Point::from(c[k]);
+            net.status[n] = NodeStatus::Placed;
+        }
+        net
+    }
+
+    #[test]
+    fn cell_area_is_exact_for_any_planar_quad() {
+        // Not a parallelogram: the shoelace area of the ring (0,0), (1,0), (3,3), (0,1) is 3.
+        // (Two triangles on the wrong diagonal, (00, 10, 01) + (00, 01, 11), gave 2.)
+        let net = one_cell([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [3.0, 3.0, 0.0]]);
+        assert!((net.cell_area(0, 0).unwrap() - 3.0).abs() < 1e-15);
+        let s = net.shear_stats(0.0);
+        assert_eq!((s.cells, s.asked, s.over_locking), (1, 1, 1));
+        assert_eq!((s.area, s.area_over_locking, s.coverage()), (3.0, 3.0, 1.0));
+    }
+
+    #[test]
+    fn coverage_counts_the_cells_inside_the_outline() {
+        let mut net = one_cell([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]);
+        net.status[3] = NodeStatus::NoRoot;
+        assert_eq!((net.shear_stats(1.0).asked, net.shear_stats(1.0).coverage()), (1, 0.0));
+        net.status[3] = NodeStatus::OutsideOutline;
+        assert_eq!((net.shear_stats(1.0).asked, net.shear_stats(1.0).coverage()), (0, 0.0));
+    }
 }

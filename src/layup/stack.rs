@@ -6,7 +6,7 @@ use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, 
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::fishnet::DrapeError;
 use crate::kinematic::sampler::NetSampler;
-use crate::kinematic::{drape, DrapeNet, NodeStatus};
+use crate::kinematic::{drape, DrapeNet};
 use crate::material::flow::sheared_thickness;
 use crate::mechanics::refine::{annotate, refine, RefineError, RefineSettings, Refined};
 use std::time::Instant;
@@ -62,35 +62,20 @@ pub struct PlyStats {
     pub cells: usize,
 }
 
-/// The layup-table numbers of a draped net.
+/// The layup-table numbers of a draped net ([`DrapeNet::shear_stats`]); `areal_mass` in kg/m^2.
 pub fn ply_stats(net: &DrapeNet, locking_angle: f64, areal_mass: Option<f64>) -> PlyStats {
-    let mut s = PlyStats::default();
-    let mut asked = 0usize;
-    let mut sum = 0.0;
-    for i in 0..net.nu.saturating_sub(1) {
-        for j in 0..net.nv.saturating_sub(1) {
-            let corners = [net.index(i, j), net.index(i + 1, j), net.index(i + 1, j + 1), net.index(i, j + 1)];
-            if corners.iter().all(|&k| net.status[k] != NodeStatus::OutsideOutline) {
-                asked += 1;
-            }
-            let (Some(c), Some(g)) = (net.cell_corners(i, j), net.cell_shear(i, j)) else { continue };
-            let area = 0.5 * ((c[1] - c[0]).cross(&(c[2] - c[0])).norm() + (c[2] - c[0]).cross(&(c[3] - c[0])).norm());
-            s.cells += 1;
-            s.draped_area += area;
-            s.max_abs_shear = s.max_abs_shear.max(g.abs());
-            sum += g.abs();
-            if g.abs() > locking_angle {
-                s.area_over_locking += area;
-            }
-        }
+    let s = net.shear_stats(locking_angle);
+    let fabric_area = s.cells as f64 * net.spacing * net.spacing;
+    PlyStats {
+        max_abs_shear: s.max_abs,
+        mean_abs_shear: s.mean_abs,
+        area_over_locking: s.area_over_locking,
+        coverage: s.coverage(),
+        draped_area: s.area,
+        fabric_area,
+        fabric_mass: areal_mass.map(|m| m * fabric_area),
+        cells: s.cells,
     }
-    if s.cells > 0 {
-        s.mean_abs_shear = sum / s.cells as f64;
-    }
-    s.coverage = if asked > 0 { s.cells as f64 / asked as f64 } else { 0.0 };
-    s.fabric_area = s.cells as f64 * net.spacing * net.spacing;
-    s.fabric_mass = areal_mass.map(|m| m * s.fabric_area);
-    s
 }
 
 /// The warp direction of `ply` with its seed at `origin` on `surface`: its warp or the scene's

@@ -4,10 +4,8 @@ use super::{method_name, LayupRow, Page, PlyReport};
 use crate::kinematic::DrapeNet;
 use std::fmt::Write;
 
-/// Escape text for HTML element content and attribute values.
-pub fn escape(s: &str) -> String {
-    crate::io::xml::xml_escape(s)
-}
+/// Escape text for HTML element content and attribute values (the crate's one XML escape).
+pub use crate::io::xml::xml_escape as escape;
 
 /// An SVG document without its XML declaration and DOCTYPE, ready to inline in HTML.
 pub fn strip_prolog(svg: &str) -> &str {

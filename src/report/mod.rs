@@ -163,38 +163,15 @@ pub fn read_layup(dir: &Path) -> Result<Option<Layup>, ReportError> {
         .map_err(|e| ReportError::Layup { path, message: format!("line {}, column {}: {e}", e.line(), e.column()) })
 }
 
-/// Per-cell statistics of a net (degrees, m^2).
-#[derive(Debug, Clone, Copy, Default)]
-struct CellStats {
-    cells: usize,
-    max_abs: f64,
-    mean_abs: f64,
-    area: f64,
-    area_over_locking: f64,
-}
-
-/// Signed shear (degrees) per cell index `i * (nv - 1) + j`, and the statistics.
-fn shear_by_cell(net: &DrapeNet, locking_deg: f64) -> (Vec<Option<f64>>, CellStats) {
+/// Signed shear (degrees) per cell index `i * (nv - 1) + j`, `None` where a cell is incomplete.
+fn shear_values(net: &DrapeNet) -> Vec<Option<f64>> {
     let mut values = vec![None; net.num_cells()];
-    let mut s = CellStats::default();
-    let mut sum = 0.0;
-    view::for_each_cell(net, |k, c| {
-        let (i, j) = (k / (net.nv - 1), k % (net.nv - 1));
-        let Some(g) = net.cell_shear(i, j).map(f64::to_degrees).filter(|g| g.is_finite()) else { return };
-        values[k] = Some(g);
-        let a = view::quad_area(&c);
-        s.cells += 1;
-        sum += g.abs();
-        s.max_abs = s.max_abs.max(g.abs());
-        s.area += a;
-        if g.abs() > locking_deg {
-            s.area_over_locking += a;
+    for i in 0..net.nu.saturating_sub(1) {
+        for j in 0..net.nv.saturating_sub(1) {
+            values[i * (net.nv - 1) + j] = net.cell_shear(i, j).map(f64::to_degrees).filter(|g| g.is_finite());
         }
-    });
-    if s.cells > 0 {
-        s.mean_abs = sum / s.cells as f64;
     }
-    (values, s)
+    values
 }
 
 /// A tool's triangles as read from its file (file units).
@@ -337,17 +314,17 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
             .and_then(|r| r.locking_angle_deg)
             .filter(|a| a.is_finite() && *a > 0.0)
             .unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
-        let (_, st) = shear_by_cell(&net, locking_deg);
+        let st = net.shear_stats(locking_deg.to_radians());
         let row = given.unwrap_or_else(|| LayupRow {
             name: stem.clone(),
             material: net.meta.get("material").and_then(|m| m.as_str()).map(str::to_string),
             angle_deg: None,
             method: Some(method_name(net.method).into()),
             locking_angle_deg: Some(locking_deg),
-            max_abs_shear_deg: Some(st.max_abs),
-            mean_abs_shear_deg: Some(st.mean_abs),
+            max_abs_shear_deg: Some(st.max_abs.to_degrees()),
+            mean_abs_shear_deg: Some(st.mean_abs.to_degrees()),
             area_over_locking_m2: Some(st.area_over_locking),
-            coverage: (net.num_cells() > 0).then(|| st.cells as f64 / net.num_cells() as f64),
+            coverage: (net.num_cells() > 0).then(|| st.coverage()),
             draped_area_m2: Some(st.area),
             offset_m: None,
         });
@@ -499,7 +476,9 @@ fn draw_ply(
     bar: &ProgressBar,
 ) -> Result<PlyReport, ReportError> {
     let net = &input.net;
-    let (values, st) = shear_by_cell(net, input.locking_deg);
+    let values = shear_values(net);
+    let st = net.shear_stats(input.locking_deg.to_radians());
+    let (max_abs_deg, mean_abs_deg) = (st.max_abs.to_degrees(), st.mean_abs.to_degrees());
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
     let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
         Some(Ok(t)) => {
@@ -524,7 +503,7 @@ fn draw_ply(
     }
     let kind = method_name(net.method);
     let lock = input.locking_deg;
-    let limit = colour_limit(st.max_abs, lock);
+    let limit = colour_limit(max_abs_deg, lock);
     let lock_marks = vec![
         Mark { value: lock, label: format!("+{lock:.0}° locking") },
         Mark { value: -lock, label: format!("−{lock:.0}° locking") },
@@ -545,8 +524,8 @@ fn draw_ply(
         note: format!(
             "{} cells · mean |γ| {:.1}° · max |γ| {:.1}° · {:.1}% of area over locking",
             st.cells,
-            st.mean_abs,
-            st.max_abs,
+            mean_abs_deg,
+            max_abs_deg,
             if st.area > 0.0 { 100.0 * st.area_over_locking / st.area } else { 0.0 }
         ),
         values: values.iter().flatten().copied().collect(),
@@ -582,8 +561,8 @@ fn draw_ply(
         method: net.method,
         cells: st.cells,
         locking_angle_deg: lock,
-        max_abs_shear_deg: st.max_abs,
-        mean_abs_shear_deg: st.mean_abs,
+        max_abs_shear_deg: max_abs_deg,
+        mean_abs_shear_deg: mean_abs_deg,
         colour_limit_deg: limit,
         tool_drawn: layer.is_some(),
         files,

@@ -124,12 +124,6 @@ pub fn for_each_cell(net: &DrapeNet, mut f: impl FnMut(usize, [Point; 4])) {
     }
 }
 
-/// Area of a (possibly non-planar) quad given in ring order: half the norm of the diagonals'
-/// cross product.
-pub fn quad_area(c: &[Point; 4]) -> f64 {
-    0.5 * (c[2] - c[0]).cross(&(c[3] - c[1])).norm()
-}
-
 /// Maps screen coordinates (metres) into a pixel rectangle with one scale on both axes.
 #[derive(Debug, Clone, Copy)]
 pub struct Fit {
