@@ -17,9 +17,9 @@
 //! non-negative coefficients). The knit law is linear in C and beta at fixed alpha:
 //! variable projection (grid + golden section on alpha) then Levenberg-Marquardt on all three.
 use super::card::{KnitParams, ShearLaw, KNIT_STRETCH_LIMIT};
+use super::test_kinematics::{BiasExtensionKinematics, PictureFrameKinematics};
 use crate::numeric::golden_section_min;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, SQRT_2};
 
 /// Which shear law to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,45 +110,23 @@ pub enum FitError {
     Fit(String),
 }
 
-// ---- test kinematics -------------------------------------------------------------------------
-
-/// Picture frame of side `side` at crosshead displacement `d`: (gamma, dgamma/dd), or None past
-/// the frame's travel (|gamma| must stay below 90 deg: -sqrt(2) L < d < (2 - sqrt(2)) L).
-pub fn picture_frame_angle(d: f64, side: f64) -> Option<(f64, f64)> {
-    let u = FRAC_1_SQRT_2 + d / (2.0 * side);
-    if !(u > 0.0 && u < 1.0) {
-        return None;
-    }
-    let s = (1.0 - u * u).sqrt();
-    Some((FRAC_PI_2 - 2.0 * u.acos(), 1.0 / (side * s)))
-}
+// ---- forces from the test kinematics --------------------------------------------------------
 
 /// Picture-frame force (N) of a law at displacement `d`: F = L^2 M(gamma) dgamma/dd.
 pub fn picture_frame_force(law: &ShearLaw, d: f64, side: f64) -> Option<f64> {
-    let (g, dg) = picture_frame_angle(d, side)?;
+    let (g, dg) = PictureFrameKinematics { side }.shear(d)?;
     Some(side * side * law.moment(g) * dg)
 }
 
-/// Bias-extension shear angle of the central zone at elongation `d` (zones B shear half as
-/// much), or None past 90 deg.
-pub fn bias_extension_angle(d: f64, length: f64, width: f64) -> Option<f64> {
-    let dd = length - width;
-    let u = (dd + d) / (SQRT_2 * dd);
-    if !(u > 0.0 && u < 1.0) {
-        return None;
-    }
-    Some(FRAC_PI_2 - 2.0 * u.acos())
-}
-
 /// The bias-extension force as a combination of moments: [(angle, weight)] with
-/// F = sum weight * M(angle).
+/// F = sum weight * M(angle): F = A_C M(gamma) dgamma/dd + A_B M(gamma/2) dgamma/dd / 2, the
+/// central zone of area A_C = W (L - 3W/2) at gamma and the zones beside the clamps, of total
+/// area A_B = W^2, at gamma / 2.
 fn bias_extension_terms(d: f64, length: f64, width: f64) -> Option<[(f64, f64); 2]> {
-    let g = bias_extension_angle(d, length, width)?;
-    let dd = length - width;
-    let k = 2.0 / (dd * ((g / 2.0).cos() - (g / 2.0).sin()));
+    let (g, rate) = BiasExtensionKinematics { length, width }.shear(d)?;
     let a_c = width * (length - 1.5 * width);
     let a_b = width * width;
-    Some([(g, k * a_c), (g / 2.0, k * a_b / 2.0)])
+    Some([(g, rate * a_c), (g / 2.0, rate * a_b / 2.0)])
 }
 
 /// Bias-extension force (N) of a law at elongation `d`.
@@ -193,12 +171,12 @@ pub fn fit_shear_picture_frame(
     check_points(data, "picture-frame")?;
     let mut obs = Vec::with_capacity(data.len());
     for (i, &(d, f)) in data.iter().enumerate() {
-        let (g, dg) = picture_frame_angle(d, side).ok_or_else(|| {
+        let (g, dg) = PictureFrameKinematics { side }.shear(d).ok_or_else(|| {
             FitError::Data(format!(
                 "picture-frame point {}: displacement {d} is beyond the travel of a frame of side {side} \
                  (the shear angle reaches 90 deg at d = {:.6}); check the units of the data and of the side",
                 i + 1,
-                (2.0 - SQRT_2) * side
+                PictureFrameKinematics { side }.travel()
             ))
         })?;
         obs.push(Obs { terms: vec![(g, 1.0)], target: f / (side * side * dg) });
@@ -229,7 +207,7 @@ pub fn fit_shear_bias_extension(
                 "bias-extension point {}: elongation {d} takes the central zone past 90 deg shear for a {length} x {width} \
                  specimen (limit d = {:.6}); check the units",
                 i + 1,
-                (SQRT_2 - 1.0) * (length - width)
+                BiasExtensionKinematics { length, width }.travel()
             ))
         })?;
         obs.push(Obs { terms: terms.to_vec(), target: f });
@@ -572,6 +550,17 @@ pub fn parse_xy_csv(text: &str) -> Result<Vec<(f64, f64)>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::{FRAC_1_SQRT_2, SQRT_2};
+
+    /// Picture frame of side `side` at `d`: (gamma, dgamma/dd).
+    fn picture_frame_angle(d: f64, side: f64) -> Option<(f64, f64)> {
+        PictureFrameKinematics { side }.shear(d)
+    }
+
+    /// Bias-extension shear of the central zone at `d`.
+    fn bias_extension_angle(d: f64, length: f64, width: f64) -> Option<f64> {
+        BiasExtensionKinematics { length, width }.shear(d).map(|(g, _)| g)
+    }
 
     /// Deterministic pseudo-noise in [-1, 1].
     fn noise(i: usize) -> f64 {

@@ -7,6 +7,7 @@
 pub mod calibrate;
 pub mod card;
 pub mod flow;
+pub mod test_kinematics;
 
 pub use card::{
     Bending, Fibre, FlowProperties, KnitParams, MaterialCard, MaterialError, ShearLaw, ShearTable, Tension, TensionLaw,

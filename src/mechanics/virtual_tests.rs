@@ -27,6 +27,7 @@ use super::energy::{Grid, Laws};
 use super::refine::{NetObjective, STANDARD_GRAVITY};
 use super::solver::{solve, Constraints, SolveReport, SolverSettings};
 use crate::geometry::{Point, Vector};
+use crate::material::test_kinematics::{BiasExtensionKinematics, PictureFrameKinematics};
 use crate::material::Fibre;
 
 /// Load steps of the cantilever: its weight is applied gradually (large deflection).
@@ -306,7 +307,8 @@ pub fn picture_frame_observed<L: Laws + ?Sized>(
 ) -> Result<ShearTest, String> {
     let side = positive("frame side", spec.side, "m")?;
     let spacing = positive("spacing", spec.spacing, "m")?;
-    let travel = (2.0 - std::f64::consts::SQRT_2) * side;
+    let frame = PictureFrameKinematics { side };
+    let travel = frame.travel();
     let dmax = positive("displacement", spec.displacement, "m")?;
     if dmax >= travel {
         return Err(format!(
@@ -334,10 +336,7 @@ pub fn picture_frame_observed<L: Laws + ?Sized>(
     let nv = n + 1;
     let grid = Grid::full(nv, nv, h);
     // Frame kinematics: c = cos(phi/2), s = sin(phi/2) at displacement d.
-    let cs = move |d: f64| {
-        let c = std::f64::consts::FRAC_1_SQRT_2 + d / (2.0 * side);
-        (c, (1.0 - c * c).max(0.0).sqrt())
-    };
+    let cs = move |d: f64| frame.half_angle(d);
     let ij = move |k: usize| ((k / nv) as f64, (k % nv) as f64);
     let place = move |k: usize, d: f64| {
         let (c, s) = cs(d);
@@ -362,7 +361,7 @@ pub fn picture_frame_observed<L: Laws + ?Sized>(
         }
     }
     // d gamma / d d = 1 / (side sin(phi/2)).
-    let shear_rate = move |d: f64| 1.0 / (side * cs(d).1);
+    let shear_rate = move |d: f64| frame.shear(d).map_or(f64::INFINITY, |(_, rate)| rate);
     let rig = Rig {
         grid,
         reference,
@@ -412,8 +411,7 @@ pub fn bias_extension_observed<L: Laws + ?Sized>(
         ));
     }
     let dmax = positive("displacement", spec.displacement, "m")?;
-    let dd = length - width;
-    let travel = (std::f64::consts::SQRT_2 - 1.0) * dd;
+    let travel = BiasExtensionKinematics { length, width }.travel();
     if dmax >= travel {
         return Err(format!(
             "a displacement of {dmax} m takes the central zone of a {length} x {width} m sample past 90 deg shear \
@@ -510,13 +508,9 @@ pub fn bias_extension_observed<L: Laws + ?Sized>(
     let moving_c = moving.clone();
     let place = move |q: usize, d: f64| if moving_c[q] { reference_c[q] + Vector::x() * d } else { reference_c[q] };
     let rate = move |q: usize, _d: f64| if moving[q] { Vector::x() } else { Vector::zeros() };
-    // Zone C: cos(phi/2) = (D + d) / (sqrt 2 D), d gamma / d d = sqrt 2 / (D sin(phi/2)), with the
-    // net's D = length - width.
-    let d_net = x_end - 2.0 * half;
-    let shear_rate = move |d: f64| {
-        let c = (d_net + d) / (sqrt2 * d_net);
-        sqrt2 / (d_net * (1.0 - c * c).max(0.0).sqrt())
-    };
+    // Zone C of the sample the net realises.
+    let zone = BiasExtensionKinematics { length: x_end, width: 2.0 * half };
+    let shear_rate = move |d: f64| zone.shear(d).map_or(f64::INFINITY, |(_, rate)| rate);
     let rig = Rig {
         grid,
         reference,
