@@ -345,8 +345,8 @@ fn a_tool_given_as_a_shell_mesh_is_drawn_at_the_scale_the_run_read_it() {
     let tool = drape::io::read_tool(&deck, scale).unwrap();
     let origin = Point::new(50.0, 75.0, 0.0) * scale;
     let mut net = drape(&tool, &KinematicSettings::grid("deck", origin, Vector::x(), 5.0 * scale, 11, 11)).unwrap();
-    net.meta.insert("tool".into(), serde_json::json!(deck.display().to_string()));
-    net.meta.insert("tool_scale".into(), serde_json::json!(scale));
+    net.meta.tool = Some(deck.display().to_string());
+    net.meta.tool_scale = Some(scale);
     write_net(&net, tmp.path(), &[Format::Json]).unwrap();
     let s = write_report(tmp.path(), &tmp.path().join("r"), false).unwrap();
     assert!(s.plies[0].tool_drawn, "{:?}", s.notes);

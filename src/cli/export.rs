@@ -66,7 +66,7 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
         }
     }
     let net = read_net(&a.net).map_err(input)?;
-    let card_path = a.material.clone().or_else(|| net.meta.get("material").and_then(|m| m.as_str()).map(PathBuf::from));
+    let card_path = a.material.clone().or_else(|| net.meta.material.as_ref().map(PathBuf::from));
     let card = match &card_path {
         Some(p) => Some(MaterialCard::load(p).map_err(|e| {
             input(anyhow::anyhow!(

@@ -99,7 +99,8 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     print_tool_report(&a.tool, &tool);
     let mut net = drape(&tool, &settings).map_err(input)?;
     net.timing.load_ms = load_ms;
-    net.meta.insert("tool".into(), serde_json::json!(a.tool.display().to_string()));
+    net.meta.tool = Some(a.tool.display().to_string());
+    net.meta.tool_scale = Some(scale);
     let t_write = Instant::now();
     let written = write_net(&net, &a.out, &formats).map_err(compute)?;
     let write_ms = t_write.elapsed().as_secs_f64() * 1e3;

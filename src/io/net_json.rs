@@ -11,7 +11,7 @@ use super::check::{cell_count, cells, check_net};
 use super::{write_atomic, ExportError};
 use crate::geometry::Point;
 use crate::kinematic::net::{Method, NodeStatus, Timing};
-use crate::kinematic::DrapeNet;
+use crate::kinematic::{DrapeNet, Provenance};
 use serde::Deserialize;
 use serde_json::ser::{CompactFormatter, Formatter};
 use std::collections::BTreeMap;
@@ -66,7 +66,7 @@ fn write_json_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
         write!(w, "{}{}", separator(k, net.nv), *s as u8)?;
     }
     w.write_all(b"]},\n\"meta\": ")?;
-    write_value(w, &net.meta)?;
+    write_value(w, &net.meta.to_json())?;
 
     w.write_all(b",\n\"nodes\": [")?;
     for (k, (p, s)) in net.positions.iter().zip(&net.status).enumerate() {
@@ -135,7 +135,7 @@ struct NetFile {
     #[serde(default)]
     timing_ms: TimingFile,
     #[serde(default)]
-    meta: serde_json::Map<String, serde_json::Value>,
+    meta: Provenance,
     #[serde(default)]
     triangles: Option<Vec<Option<u32>>>,
 }

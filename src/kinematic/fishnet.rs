@@ -290,13 +290,12 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
     net.timing.generators_ms = generators_ms;
     net.timing.fill_ms = ms(t_fill);
     net.timing.total_ms = ms(start);
-    let w = generators.warp_dir;
-    net.meta.insert("warp_direction".into(), serde_json::json!([w.x, w.y, w.z]));
-    let p = seed.point;
-    net.meta.insert("origin".into(), serde_json::json!([p.x, p.y, p.z]));
-    net.meta.insert("pre_shear_deg".into(), serde_json::json!(settings.pre_shear.to_degrees()));
-    net.meta.insert("generators".into(), serde_json::json!(generators.kind));
-    net.meta.insert("max_shear_deg".into(), serde_json::json!(settings.max_shear.to_degrees()));
+    let (w, p) = (generators.warp_dir, seed.point);
+    net.meta.warp_direction = Some([w.x, w.y, w.z]);
+    net.meta.origin = Some([p.x, p.y, p.z]);
+    net.meta.pre_shear_deg = Some(settings.pre_shear.to_degrees());
+    net.meta.generators = Some(generators.kind.clone());
+    net.meta.max_shear_deg = Some(settings.max_shear.to_degrees());
     Ok(net)
 }
 

@@ -5,10 +5,12 @@ pub mod fishnet;
 pub mod generators;
 pub mod net;
 pub mod outline;
+pub mod provenance;
 pub mod sampler;
 
 pub use fishnet::{drape, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};
+pub use provenance::Provenance;
 
 use crate::geometry::{Point, Vector};
 

@@ -1,4 +1,5 @@
 //! [`DrapeNet`]: the warp/weft grid of nodes that travels through the whole pipeline.
+use super::provenance::Provenance;
 use crate::geometry::{Point, Vector};
 use serde::{Deserialize, Serialize};
 
@@ -94,8 +95,8 @@ pub struct DrapeNet {
     pub triangles: Vec<u32>,
     pub status: Vec<NodeStatus>,
     pub timing: Timing,
-    /// Free-form provenance written with the net (tool file, generators, directions...).
-    pub meta: serde_json::Map<String, serde_json::Value>,
+    /// Where the net came from (`"meta"` in the JSON file): tool, material, directions...
+    pub meta: Provenance,
 }
 
 impl DrapeNet {

@@ -204,16 +204,12 @@ pub fn drape_layup(
             refined = Some(result);
         }
         // What later stages (exports, reports) need to know about the ply.
-        net.meta.insert("stack_offset_max_m".into(), serde_json::json!(offset.max_distance));
-        if let Some(a) = ply.angle_deg() {
-            net.meta.insert("angle_deg".into(), serde_json::json!(a));
-        }
+        net.meta.stack_offset_max_m = Some(offset.max_distance);
+        net.meta.angle_deg = ply.angle_deg();
         if let Some(m) = &ply.material {
-            net.meta.insert("material".into(), serde_json::json!(m.path.display().to_string()));
+            net.meta.material = Some(m.path.display().to_string());
         }
-        if let Some(t) = ply.thickness {
-            net.meta.insert("thickness_m".into(), serde_json::json!(t));
-        }
+        net.meta.thickness_m = ply.thickness;
         if let Some(t0) = ply.thickness {
             if k + 1 < layup.plies.len() {
                 add_ply_thickness(&mut stack, &under, &net, t0);

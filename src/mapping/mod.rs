@@ -94,7 +94,7 @@ pub struct PlyMapSettings {
 impl PlyMapSettings {
     /// Settings for `net` made of `card` (or the defaults when `None`; the returned notes say
     /// which were assumed), `thickness` overriding the card's. The nominal warp is the net's
-    /// warp at its seed (meta `warp_direction`); the search reaches a cell plus the net's stack
+    /// warp at its seed ([`crate::kinematic::Provenance::warp_direction`]); the search reaches a cell plus the net's stack
     /// offset plus its thickness off the net, which takes a flow mesh of the tool surface, the
     /// part's mid-surface or the outer surface.
     pub fn for_net(
@@ -105,7 +105,7 @@ impl PlyMapSettings {
         permeability: Option<PermeabilityModel>,
     ) -> (PlyMapSettings, Vec<String>) {
         let mut notes = Vec::new();
-        let recorded = net.meta.get("thickness_m").and_then(|v| v.as_f64()).filter(|t| t.is_finite() && *t > 0.0);
+        let recorded = net.meta.thickness_m.filter(|t| t.is_finite() && *t > 0.0);
         let thickness = thickness.or(recorded).or(card.map(|c| c.thickness)).unwrap_or_else(|| {
             notes.push(format!(
                 "ply '{}': no material card or thickness: assumed t0 = {} mm",
@@ -123,12 +123,11 @@ impl PlyMapSettings {
         });
         let nominal_warp = net
             .meta
-            .get("warp_direction")
-            .and_then(|v| serde_json::from_value::<[f64; 3]>(v.clone()).ok())
+            .warp_direction
             .map(|w| Vector::new(w[0], w[1], w[2]))
             .filter(|w| w.norm() > 0.0 && w.iter().all(|x| x.is_finite()))
             .unwrap_or_else(Vector::zeros);
-        let stack = net.meta.get("stack_offset_max_m").and_then(|v| v.as_f64()).unwrap_or(0.0);
+        let stack = net.meta.stack_offset_max_m.unwrap_or(0.0);
         let max_distance = net.spacing + stack + thickness;
         (PlyMapSettings { thickness, vf, cavity, permeability, nominal_warp, max_distance }, notes)
     }

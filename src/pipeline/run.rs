@@ -214,9 +214,9 @@ pub fn run(scene: &Scene, out: &Path, formats: &[Format], on: &mut dyn FnMut(Eve
     let mut unconverged = Vec::new();
     for (ply, r) in scene.layup.plies.iter().zip(results.iter_mut()) {
         r.net.timing.load_ms = load_ms;
-        r.net.meta.insert("tool".into(), serde_json::json!(scene.tool.display().to_string()));
-        r.net.meta.insert("tool_scale".into(), serde_json::json!(scene.scale));
-        r.net.meta.insert("scene".into(), serde_json::json!(scene.path.display().to_string()));
+        r.net.meta.tool = Some(scene.tool.display().to_string());
+        r.net.meta.tool_scale = Some(scene.scale);
+        r.net.meta.scene = Some(scene.path.display().to_string());
         if let Some(refined) = &r.refined {
             if !refined.ok() {
                 unconverged.push(format!("ply '{}' ({:?})", ply.settings.name, refined.outcome()));

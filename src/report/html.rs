@@ -41,23 +41,21 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
         nodes += &format!(" ({})", failed.join(", "));
     }
     f.push(("nodes".to_string(), nodes));
-    for key in ["generators", "tool", "material"] {
-        if let Some(v) = net.meta.get(key).and_then(|v| v.as_str()) {
-            f.push((key.to_string(), v.to_string()));
+    let m = &net.meta;
+    for (key, value) in [("generators", &m.generators), ("tool", &m.tool), ("material", &m.material)] {
+        if let Some(v) = value {
+            f.push((key.to_string(), v.clone()));
         }
     }
-    if let Some(s) = net.meta.get("solver") {
-        if let Some(o) = s.get("outcome") {
-            let o = o.as_str().map(str::to_string).unwrap_or_else(|| o.to_string());
-            f.push(("solver outcome".to_string(), o));
-        }
+    if let Some(s) = &m.solver {
+        f.push(("solver outcome".to_string(), s.outcome.clone()));
     }
-    if let Some(a) =
-        net.meta.get("change_from_kinematic").and_then(|c| c.get("warp_angle_deg")).and_then(|a| a.as_array())
-    {
-        let max = a
+    if let Some(c) = &m.change_from_kinematic {
+        let max = c
+            .warp_angle_deg
             .iter()
-            .filter_map(|v| v.as_f64())
+            .flatten()
+            .copied()
             .filter(|v| v.is_finite())
             .fold(None, |m: Option<f64>, v| Some(m.map_or(v.abs(), |m| m.max(v.abs()))));
         if let Some(m) = max {

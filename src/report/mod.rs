@@ -317,7 +317,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         let st = net.shear_stats(locking_deg.to_radians());
         let row = given.unwrap_or_else(|| LayupRow {
             name: stem.clone(),
-            material: net.meta.get("material").and_then(|m| m.as_str()).map(str::to_string),
+            material: net.meta.material.clone(),
             angle_deg: None,
             method: Some(method_name(net.method).into()),
             locking_angle_deg: Some(locking_deg),
@@ -328,12 +328,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
             draped_area_m2: Some(st.area),
             offset_m: None,
         });
-        let recorded = net
-            .meta
-            .get("tool")
-            .and_then(|t| t.as_str())
-            .map(str::to_string)
-            .or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
+        let recorded = net.meta.tool.clone().or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
         let (tool, tool_note) = match recorded {
             None => (None, Some("the net records no tool file: drawn without the tool".to_string())),
             Some(t) => match locate_tool(&t, dir) {
@@ -483,7 +478,7 @@ fn draw_ply(
     let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
         Some(Ok(t)) => {
             // The scale the run read the tool with, when the net records it.
-            let recorded = net.meta.get("tool_scale").and_then(|s| s.as_f64()).filter(|s| s.is_finite() && *s > 0.0);
+            let recorded = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0);
             let s = recorded.unwrap_or_else(|| guess_scale(t, net));
             Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
         }
@@ -574,7 +569,7 @@ fn draw_ply(
 /// "change_from_kinematic"."shear_deg".
 fn change_values(net: &DrapeNet) -> Result<Vec<Option<f64>>, String> {
     let arr =
-        net.meta.get("change_from_kinematic").and_then(|c| c.get("shear_deg")).and_then(|s| s.as_array()).ok_or(
+        net.meta.change_from_kinematic.as_ref().map(|c| &c.shear_deg).ok_or(
             "the net has no \"change_from_kinematic\".\"shear_deg\" (written by `drape refine` and `drape run`)",
         )?;
     if arr.len() != net.num_cells() {
@@ -584,7 +579,7 @@ fn change_values(net: &DrapeNet) -> Result<Vec<Option<f64>>, String> {
             net.num_cells()
         ));
     }
-    Ok(arr.iter().map(|v| v.as_f64().filter(|x| x.is_finite())).collect())
+    Ok(arr.iter().map(|v| v.filter(|x| x.is_finite())).collect())
 }
 
 /// Render a picture to `<base>.png` and `<base>.svg`, atomically, and record the paths.

@@ -1,0 +1,129 @@
+//! [`Provenance`]: where a net came from and what later stages need to know about it (`"meta"`
+//! in `<ply>.drape.json`). Each stage sets the fields it knows; the mapping, the report and the
+//! commands read them by name, so a key one stage writes is the key the next one reads.
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+/// Where a net came from (`"meta"` in `<ply>.drape.json`, keys as the field names). Every field
+/// is optional: a net read from a file has what the stages that made it recorded.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// Unit warp direction at the seed, as the drape resolved it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warp_direction: Option<[f64; 3]>,
+    /// The seed on the tool, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<[f64; 3]>,
+    /// Pre-shear between the generators, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pre_shear_deg: Option<f64>,
+    /// How the generators were laid: `geodesic`, `min-shear` or `steer`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generators: Option<String>,
+    /// Shear past which nodes were refused, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_shear_deg: Option<f64>,
+    /// The ply angle of a layup ply, degrees (absent when its warp was given as a vector).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    /// The material card file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
+    /// Ply thickness as laid flat, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness_m: Option<f64>,
+    /// Largest distance the tool was offset by the plies below, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stack_offset_max_m: Option<f64>,
+    /// The tool file, as given to the command.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool: Option<String>,
+    /// Metres per unit of the tool file: the scale the tool was read with.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_scale: Option<f64>,
+    /// The scene file of a layup ply.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<String>,
+    /// For a refined net: the change of each cell from the kinematic net.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub change_from_kinematic: Option<CellChanges>,
+    /// For a refined net: what the solver did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver: Option<SolverRecord>,
+    /// Keys other tools wrote, kept on a round trip.
+    #[serde(flatten)]
+    pub other: Map<String, Value>,
+}
+
+/// The change of every cell (index `i * (nv - 1) + j`) of a refined net from its kinematic net,
+/// `None` where a cell is missing in either.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CellChanges {
+    /// Shear, refined minus kinematic, degrees.
+    pub shear_deg: Vec<Option<f64>>,
+    /// Angle between the kinematic and refined warp directions, degrees.
+    pub warp_angle_deg: Vec<Option<f64>>,
+}
+
+/// What the mechanical solver did to a net.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolverRecord {
+    /// How the last load step ended (`converged`, ...).
+    pub outcome: String,
+    /// Energy of the kinematic net under the full load, J.
+    pub energy_kinematic: f64,
+    /// Energy of the state the solver started from, J.
+    pub energy_start: f64,
+    /// Energy of the refined net, J.
+    pub energy_final: f64,
+    /// The solver's log, one entry per load step.
+    #[serde(default)]
+    pub load_steps: Value,
+}
+
+impl Provenance {
+    /// Set the entry `key` as if the file held `value` there: the field of that name when
+    /// `value` has its type, else an entry of [`Provenance::other`]. For writers that build the
+    /// JSON themselves (`mechanics::refine::annotate`); elsewhere set the fields.
+    pub fn insert(&mut self, key: &str, value: Value) {
+        let mut map = match serde_json::to_value(&*self) {
+            Ok(Value::Object(map)) => map,
+            _ => unreachable!("provenance serialises to a JSON object"),
+        };
+        map.insert(key.to_string(), value.clone());
+        match serde_json::from_value(Value::Object(map)) {
+            Ok(updated) => *self = updated,
+            Err(_) => {
+                self.other.insert(key.to_string(), value);
+            }
+        }
+    }
+
+    /// The provenance as the JSON object written to a file: keys in sorted order.
+    pub fn to_json(&self) -> Map<String, Value> {
+        match serde_json::to_value(self) {
+            Ok(Value::Object(map)) => map,
+            _ => unreachable!("provenance serialises to a JSON object"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_set_by_name_land_in_their_fields() {
+        let mut p = Provenance::default();
+        p.insert("tool_scale", 0.001.into());
+        p.insert("material", "card.toml".into());
+        p.insert("warp", serde_json::json!([1.0, 0.0, 0.0]));
+        p.insert("tool", 7.into()); // not a path: kept as given
+        assert_eq!(p.tool_scale, Some(0.001));
+        assert_eq!(p.material.as_deref(), Some("card.toml"));
+        assert_eq!(p.other["warp"], serde_json::json!([1.0, 0.0, 0.0]));
+        assert_eq!((p.tool.as_ref(), &p.other["tool"]), (None, &Value::from(7)));
+        let json = p.to_json();
+        assert_eq!(json.keys().collect::<Vec<_>>(), ["material", "tool", "tool_scale", "warp"]);
+    }
+}
