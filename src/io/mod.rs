@@ -23,6 +23,7 @@ pub mod drawing;
 pub mod dxf;
 mod error;
 pub mod flow;
+pub mod layup_json;
 pub mod net;
 pub mod net_json;
 pub mod optistruct;

@@ -4,5 +4,6 @@ pub mod flat;
 pub mod nest;
 pub mod ply;
 pub mod stack;
+pub mod table;
 
 pub use ply::{Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, DEFAULT_LOCKING_ANGLE_DEG};

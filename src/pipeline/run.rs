@@ -10,19 +10,18 @@ use super::scene::{Scene, SceneExport};
 use crate::geometry::ToolSurface;
 use crate::io::drawing::{write_cutting_plan, PatternError};
 use crate::io::flow::write_flow;
-use crate::io::{read_flow_mesh, read_tool, write_atomic, write_net, ExportError, Format, ReadToolError};
+use crate::io::layup_json::{self, LAYUP_FILE};
+use crate::io::{read_flow_mesh, read_tool, write_net, ExportError, Format, ReadToolError};
 use crate::kinematic::fishnet::{check_settings, DrapeError};
 use crate::layup::flat::{flat_pattern_with_margin, FlatError};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::stack::{drape_layup, LayupError, PlyResult};
+use crate::layup::table::{LayupRow, LayupTable, NestingRow};
 use crate::layup::Ply;
 use crate::mapping::{map_plies, FlowMesh, LayupMap, MapError, PlyToMap};
 use crate::material::flow::PermeabilityModel;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Name of the layup table a run writes into its folder.
-pub const LAYUP_FILE: &str = "layup.json";
 
 /// What [`run`] reports, in the order it happens.
 pub enum Event<'a> {
@@ -231,24 +230,15 @@ pub fn run(scene: &Scene, out: &Path, formats: &[Format], on: &mut dyn FnMut(Eve
     }
     on(Event::Layup { scene, results: &results });
     let nesting = cutting_plan(scene, &results, out, on)?;
-    let table = out.join(LAYUP_FILE);
-    let mut json = layup_json(scene, &results);
-    if let Some(n) = nesting {
-        json["nesting"] = serde_json::json!({
-            "roll_width_m": n.roll_width,
-            "gap_m": n.gap,
-            "length_m": n.length,
-            "used_area_m2": n.used_area,
-            "pattern_area_m2": n.pattern_area,
-            "waste_area_m2": n.waste_area,
-            "waste_fraction": n.waste_fraction,
-        });
-    }
-    write_atomic(&table, |w| {
-        serde_json::to_writer_pretty(&mut *w, &json)?;
-        std::io::Write::write_all(w, b"\n")
-    })?;
-    on(Event::TableWritten { path: &table });
+    let table = LayupTable {
+        scene: Some(scene.path.display().to_string()),
+        tool: Some(scene.tool.display().to_string()),
+        plies: scene.layup.plies.iter().zip(&results).map(|(ply, r)| LayupRow::of(ply, r)).collect(),
+        nesting: nesting.as_ref().map(NestingRow::from),
+    };
+    let path = out.join(LAYUP_FILE);
+    layup_json::write(&table, &path)?;
+    on(Event::TableWritten { path: &path });
     // Last, so that a bad flow mesh costs nothing already computed.
     if let Some(export) = &scene.export {
         export_flow(scene, export, &results, out, on)?;
@@ -328,45 +318,4 @@ fn export_flow(
         on(Event::FlowWritten { files: &files });
     }
     Ok(())
-}
-
-/// `layup.json`: the layup table for reports and other tools.
-fn layup_json(scene: &Scene, results: &[PlyResult]) -> serde_json::Value {
-    let path = |p: &Path| p.display().to_string();
-    let plies: Vec<serde_json::Value> = scene
-        .layup
-        .plies
-        .iter()
-        .zip(results)
-        .map(|(ply, r)| {
-            let s = &r.stats;
-            serde_json::json!({
-                "name": ply.settings.name,
-                "material": ply.material.as_ref().map(|m| m.name.clone()),
-                "material_card": ply.material.as_ref().map(|m| path(&m.path)),
-                "angle_deg": ply.angle_deg(),
-                "warp": [r.warp.x, r.warp.y, r.warp.z],
-                "method": if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
-                "thickness_m": ply.thickness,
-                "locking_angle_deg": ply.locking_angle.to_degrees(),
-                "max_abs_shear_deg": s.max_abs_shear.to_degrees(),
-                "mean_abs_shear_deg": s.mean_abs_shear.to_degrees(),
-                "area_over_locking_m2": s.area_over_locking,
-                "coverage": s.coverage,
-                "cells": s.cells,
-                "draped_area_m2": s.draped_area,
-                "fabric_area_m2": s.fabric_area,
-                "fabric_mass_kg": s.fabric_mass,
-                "offset_m": r.offset.max_distance,
-                "offset_folded_triangles": r.offset.folded,
-                "offset_bridged_vertices": r.offset.relaxed,
-            })
-        })
-        .collect();
-    serde_json::json!({
-        "scene": path(&scene.path),
-        "tool": path(&scene.tool),
-        "plies": plies,
-        "nesting": serde_json::Value::Null,
-    })
 }

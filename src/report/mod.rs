@@ -21,14 +21,15 @@ pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL
 pub use view::{change_limit, colour_limit, shear_colour, View, VIEW_TILT_DEG};
 
 use crate::geometry::Point;
+use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::read_tool_mesh;
 use crate::io::{read_net, write_atomic, ExportError};
 use crate::kinematic::{DrapeNet, Method};
+use crate::layup::table::{LayupRow, LayupTable};
 use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use render::{Mark, ToolLayer};
-use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -85,62 +86,6 @@ pub struct PlyReport {
     pub notes: Vec<String>,
 }
 
-/// One row of the layup table (`layup.json` "plies", or computed from a net).
-#[derive(Debug, Clone, Default, Deserialize)]
-pub struct LayupRow {
-    pub name: String,
-    #[serde(default)]
-    pub material: Option<String>,
-    #[serde(default)]
-    pub angle_deg: Option<f64>,
-    #[serde(default)]
-    pub method: Option<String>,
-    #[serde(default)]
-    pub locking_angle_deg: Option<f64>,
-    #[serde(default)]
-    pub max_abs_shear_deg: Option<f64>,
-    #[serde(default)]
-    pub mean_abs_shear_deg: Option<f64>,
-    #[serde(default)]
-    pub area_over_locking_m2: Option<f64>,
-    #[serde(default)]
-    pub coverage: Option<f64>,
-    #[serde(default)]
-    pub draped_area_m2: Option<f64>,
-    #[serde(default)]
-    pub offset_m: Option<f64>,
-}
-
-/// Nesting of the flat patterns on the roll (`layup.json` "nesting").
-#[derive(Debug, Clone, Default, Deserialize)]
-pub struct Nesting {
-    #[serde(default)]
-    pub roll_width_m: Option<f64>,
-    #[serde(default)]
-    pub length_m: Option<f64>,
-    #[serde(default)]
-    pub used_area_m2: Option<f64>,
-    #[serde(default)]
-    pub pattern_area_m2: Option<f64>,
-    #[serde(default)]
-    pub waste_fraction: Option<f64>,
-}
-
-/// `layup.json` as written by `drape run` (unknown keys are ignored).
-#[derive(Debug, Clone, Default, Deserialize)]
-pub struct Layup {
-    #[serde(default)]
-    pub scene: Option<String>,
-    #[serde(default)]
-    pub tool: Option<String>,
-    #[serde(default)]
-    pub plies: Vec<LayupRow>,
-    #[serde(default)]
-    pub nesting: Option<Nesting>,
-}
-
-/// Name of the optional layup file in a run folder.
-pub const LAYUP_FILE: &str = "layup.json";
 /// Suffix of net files.
 const NET_SUFFIX: &str = ".drape.json";
 /// Flat-pattern SVGs larger than this are linked from the page instead of inlined.
@@ -151,16 +96,8 @@ const PICTURES: [&str; 3] = ["shear", "histogram", "change"];
 const TOOL_SCALES: [f64; 2] = [1.0, 1e-3];
 
 /// Read `layup.json` from `dir` if present.
-pub fn read_layup(dir: &Path) -> Result<Option<Layup>, ReportError> {
-    let path = dir.join(LAYUP_FILE);
-    let bytes = match std::fs::read(&path) {
-        Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(ReportError::Layup { path, message: format!("cannot read it: {e}") }),
-    };
-    serde_json::from_slice(&bytes)
-        .map(Some)
-        .map_err(|e| ReportError::Layup { path, message: format!("line {}, column {}: {e}", e.line(), e.column()) })
+pub fn read_layup(dir: &Path) -> Result<Option<LayupTable>, ReportError> {
+    layup_json::read(dir).map_err(|e| ReportError::Layup { path: dir.join(LAYUP_FILE), message: e.message })
 }
 
 /// Signed shear (degrees) per cell index `i * (nv - 1) + j`, `None` where a cell is incomplete.
@@ -246,7 +183,7 @@ struct PlyInput {
 /// Everything the page shows, gathered by [`write_report`].
 pub(crate) struct Page {
     pub title: String,
-    pub layup: Option<Layup>,
+    pub layup: Option<LayupTable>,
     pub rows: Vec<LayupRow>,
     pub plies: Vec<PlyReport>,
     pub patterns: Vec<(String, Result<String, String>)>,
@@ -318,7 +255,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         let row = given.unwrap_or_else(|| LayupRow {
             name: stem.clone(),
             material: net.meta.material.clone(),
-            angle_deg: None,
+            angle_deg: net.meta.angle_deg,
             method: Some(method_name(net.method).into()),
             locking_angle_deg: Some(locking_deg),
             max_abs_shear_deg: Some(st.max_abs.to_degrees()),
@@ -326,7 +263,8 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
             area_over_locking_m2: Some(st.area_over_locking),
             coverage: (net.num_cells() > 0).then(|| st.coverage()),
             draped_area_m2: Some(st.area),
-            offset_m: None,
+            offset_m: net.meta.stack_offset_max_m,
+            ..LayupRow::default()
         });
         let recorded = net.meta.tool.clone().or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
         let (tool, tool_note) = match recorded {

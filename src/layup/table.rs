@@ -1,0 +1,154 @@
+//! The layup table: one row per ply (angle, material, shear, coverage, fabric used, offset) and
+//! the nesting of the flat patterns. `drape run` prints it and writes it as `layup.json`
+//! ([`crate::io::layup_json`]); `drape report` reads that file into the same type.
+use super::nest::Nesting;
+use super::stack::PlyResult;
+use super::Ply;
+use serde::{Deserialize, Serialize};
+
+/// `layup.json`: the layup table of a run. Every field but a row's name may be missing in a file
+/// (other tools write it too); `drape run` writes them all.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LayupTable {
+    /// The scene file.
+    #[serde(default)]
+    pub scene: Option<String>,
+    /// The tool file.
+    #[serde(default)]
+    pub tool: Option<String>,
+    /// One row per ply, in stacking order.
+    #[serde(default)]
+    pub plies: Vec<LayupRow>,
+    /// Where the flat patterns lie on the roll, when there is a pattern.
+    #[serde(default)]
+    pub nesting: Option<NestingRow>,
+}
+
+/// One ply of the layup table.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LayupRow {
+    /// Ply name.
+    pub name: String,
+    /// The material's name in the scene.
+    #[serde(default)]
+    pub material: Option<String>,
+    /// The material card file.
+    #[serde(default)]
+    pub material_card: Option<String>,
+    /// Ply angle, degrees (`None` when the warp was given as a vector).
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+    /// Unit warp direction at the seed.
+    #[serde(default)]
+    pub warp: Option<[f64; 3]>,
+    /// `kinematic` or `mechanical`.
+    #[serde(default)]
+    pub method: Option<String>,
+    /// Thickness as laid flat, m.
+    #[serde(default)]
+    pub thickness_m: Option<f64>,
+    /// Locking angle, degrees.
+    #[serde(default)]
+    pub locking_angle_deg: Option<f64>,
+    /// Largest |shear| over the complete cells, degrees.
+    #[serde(default)]
+    pub max_abs_shear_deg: Option<f64>,
+    /// Mean |shear| over the complete cells, degrees.
+    #[serde(default)]
+    pub mean_abs_shear_deg: Option<f64>,
+    /// Draped area of the cells sheared past the locking angle, m^2.
+    #[serde(default)]
+    pub area_over_locking_m2: Option<f64>,
+    /// Complete cells over the cells the ply asked for.
+    #[serde(default)]
+    pub coverage: Option<f64>,
+    /// Complete cells.
+    #[serde(default)]
+    pub cells: Option<usize>,
+    /// Draped area of the complete cells, m^2.
+    #[serde(default)]
+    pub draped_area_m2: Option<f64>,
+    /// Fabric used (the flat pattern's area), m^2.
+    #[serde(default)]
+    pub fabric_area_m2: Option<f64>,
+    /// Mass of that fabric, kg.
+    #[serde(default)]
+    pub fabric_mass_kg: Option<f64>,
+    /// Largest offset of the tool by the plies below, m.
+    #[serde(default)]
+    pub offset_m: Option<f64>,
+    /// Triangles of that offset surface that folded over.
+    #[serde(default)]
+    pub offset_folded_triangles: Option<usize>,
+    /// Offset vertices moved off their normals to bridge tight concave corners.
+    #[serde(default)]
+    pub offset_bridged_vertices: Option<usize>,
+}
+
+/// The nesting of the flat patterns in the layup table.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct NestingRow {
+    /// Roll width, m.
+    #[serde(default)]
+    pub roll_width_m: Option<f64>,
+    /// Gap kept between pieces, m.
+    #[serde(default)]
+    pub gap_m: Option<f64>,
+    /// Length of roll used, m.
+    #[serde(default)]
+    pub length_m: Option<f64>,
+    /// Material used, m^2.
+    #[serde(default)]
+    pub used_area_m2: Option<f64>,
+    /// Area of the patterns, m^2.
+    #[serde(default)]
+    pub pattern_area_m2: Option<f64>,
+    /// Material wasted, m^2.
+    #[serde(default)]
+    pub waste_area_m2: Option<f64>,
+    /// Waste over material used.
+    #[serde(default)]
+    pub waste_fraction: Option<f64>,
+}
+
+impl LayupRow {
+    /// The row of a draped ply.
+    pub fn of(ply: &Ply, result: &PlyResult) -> LayupRow {
+        let (s, w) = (&result.stats, result.warp);
+        LayupRow {
+            name: ply.settings.name.clone(),
+            material: ply.material.as_ref().map(|m| m.name.clone()),
+            material_card: ply.material.as_ref().map(|m| m.path.display().to_string()),
+            angle_deg: ply.angle_deg(),
+            warp: Some([w.x, w.y, w.z]),
+            method: Some(if ply.refinement.is_some() { "mechanical" } else { "kinematic" }.into()),
+            thickness_m: ply.thickness,
+            locking_angle_deg: Some(ply.locking_angle.to_degrees()),
+            max_abs_shear_deg: Some(s.max_abs_shear.to_degrees()),
+            mean_abs_shear_deg: Some(s.mean_abs_shear.to_degrees()),
+            area_over_locking_m2: Some(s.area_over_locking),
+            coverage: Some(s.coverage),
+            cells: Some(s.cells),
+            draped_area_m2: Some(s.draped_area),
+            fabric_area_m2: Some(s.fabric_area),
+            fabric_mass_kg: s.fabric_mass,
+            offset_m: Some(result.offset.max_distance),
+            offset_folded_triangles: Some(result.offset.folded),
+            offset_bridged_vertices: Some(result.offset.relaxed),
+        }
+    }
+}
+
+impl From<&Nesting> for NestingRow {
+    fn from(n: &Nesting) -> NestingRow {
+        NestingRow {
+            roll_width_m: Some(n.roll_width),
+            gap_m: Some(n.gap),
+            length_m: Some(n.length),
+            used_area_m2: Some(n.used_area),
+            pattern_area_m2: Some(n.pattern_area),
+            waste_area_m2: Some(n.waste_area),
+            waste_fraction: Some(n.waste_fraction),
+        }
+    }
+}
