@@ -1,7 +1,7 @@
 //! `drape calibrate`: fits written into a new card, bad data refused with the line number.
 use assert_cmd::Command;
 use drape::material::calibrate::{bias_extension_force, knit_stress, picture_frame_force};
-use drape::material::card::{Fibre, KnitParams, MaterialCard, ShearLaw, TensionLaw};
+use drape::material::{Fibre, KnitParams, MaterialCard, ShearLaw, TensionLaw};
 use std::path::{Path, PathBuf};
 
 fn drape() -> Command {

@@ -11,7 +11,7 @@ use crate::material::calibrate::{
     fit_knit_uniaxial, fit_shear_bias_extension, fit_shear_picture_frame, parse_xy_csv, FitError, FitReport,
     ShearLawKind,
 };
-use crate::material::card::{Fibre, KnitParams, MaterialCard, ShearLaw, TensionLaw};
+use crate::material::{Fibre, MaterialCard, ShearLaw};
 use crate::pipeline::unit_scale;
 use anyhow::anyhow;
 use clap::{Args, Subcommand, ValueEnum};
@@ -165,18 +165,7 @@ pub fn run(a: CalibrateArgs) -> Result<(), Failure> {
                 1.0 / p.alpha
             );
             print_report(&report, "N/m");
-            // A linear card becomes a knit card; the other family keeps its rigidity (beta = 0).
-            let (mut warp, mut weft) = match card.tension.law {
-                TensionLaw::Knit { warp, weft } => (warp, weft),
-                TensionLaw::Linear { warp, weft } => {
-                    (KnitParams { c: warp, beta: 0.0, alpha: 0.0 }, KnitParams { c: weft, beta: 0.0, alpha: 0.0 })
-                }
-            };
-            match fibre {
-                Fibre::Warp => warp = p,
-                Fibre::Weft => weft = p,
-            }
-            card.tension.law = TensionLaw::Knit { warp, weft };
+            card.set_knit(fibre, p);
             let what = format!("{} knit tension fitted to uniaxial data {}", fibre.name(), k.data.display());
             finish(card, &what, &report, &k.files)
         }
@@ -254,10 +243,7 @@ fn finish(mut card: MaterialCard, what: &str, report: &FitReport, files: &CardFi
         card.name = name.clone();
     }
     let note = format!("{what} by drape calibrate ({} points, R^2 = {:.6})", report.points, report.r_squared);
-    card.source = Some(match card.source.take() {
-        Some(s) if !s.trim().is_empty() => format!("{s}; {note}"),
-        _ => note,
-    });
+    card.add_source_note(note);
     card.validate().map_err(|e| compute(anyhow!("the fitted card is not valid: {e}")))?;
     let text = card.to_toml_string();
     write_atomic(&files.out, |w| w.write_all(text.as_bytes())).map_err(compute)?;

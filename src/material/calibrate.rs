@@ -16,7 +16,7 @@
 //! section picks the locking angle; a polynomial that comes out non-monotone is refitted with
 //! non-negative coefficients). The knit law is linear in C and beta at fixed alpha:
 //! variable projection (grid + golden section on alpha) then Levenberg-Marquardt on all three.
-use super::card::{KnitParams, ShearLaw, KNIT_STRETCH_LIMIT};
+use super::laws::{KnitParams, ShearLaw, KNIT_STRETCH_LIMIT};
 use super::test_kinematics::{BiasExtensionKinematics, PictureFrameKinematics};
 use crate::numeric::golden_section_min;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};

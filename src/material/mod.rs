@@ -6,9 +6,10 @@
 //! Bundled cards live in `materials/` at the crate root.
 pub mod calibrate;
 pub mod card;
+pub mod card_toml;
 pub mod flow;
+pub mod laws;
 pub mod test_kinematics;
 
-pub use card::{
-    Bending, Fibre, FlowProperties, KnitParams, MaterialCard, MaterialError, ShearLaw, ShearTable, Tension, TensionLaw,
-};
+pub use card::{FlowProperties, MaterialCard, MaterialError};
+pub use laws::{Bending, Fibre, KnitParams, ShearLaw, ShearTable, Tension, TensionLaw};
