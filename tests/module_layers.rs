@@ -16,7 +16,6 @@ const LAYERS: &[&str] = &[
     "layup",
     "mapping",
     "io",
-    "shapes",
     "pipeline",
     "report",
     "cli",

@@ -1,6 +1,6 @@
 //! `drape bench`: throughput of the kinematic engine on a generated hemisphere.
 use super::{input, Failure};
-use crate::geometry::shapes;
+use crate::geometry::hemisphere::hemisphere_with_triangles;
 use crate::geometry::{Point, Vector};
 use crate::kinematic::{drape, KinematicSettings};
 use crate::material::MaterialCard;
@@ -42,7 +42,7 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         .build()
         .map_err(|e| input(anyhow::anyhow!("cannot start {} threads: {e}", a.threads.unwrap_or(0))))?;
     let t = Instant::now();
-    let tool = shapes::hemisphere_with_triangles(1.0, a.triangles).into_surface().map_err(input)?;
+    let tool = hemisphere_with_triangles(1.0, a.triangles).into_surface().map_err(input)?;
     println!(
         "hemisphere R = 1 m: {} triangles, built in {:.0} ms",
         tool.num_triangles(),

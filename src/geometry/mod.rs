@@ -2,8 +2,10 @@
 //! its facets, straightest geodesics and offset surfaces.
 pub mod check;
 pub mod geodesic;
+pub mod hemisphere;
 pub mod mesh;
 pub mod offset;
+#[cfg(any(test, feature = "shapes"))]
 pub mod shapes;
 pub mod smooth;
 pub mod surface;
