@@ -1,8 +1,17 @@
 //! `drape`: plans how composite plies lie on a part.
 //!
-//! The pipeline: a [`geometry::ToolSurface`] (checked OBJ mesh + BVH + topology) is draped by the
+//! A [`geometry::ToolSurface`] (a checked mesh with a BVH and its topology) is draped by the
 //! kinematic fishnet mapper ([`kinematic::drape`]) into a [`kinematic::DrapeNet`], the one grid
-//! type that every later stage reads; [`export`] writes it out.
+//! type every later stage reads: [`mechanics`] refines it, [`layup`] drapes plies on plies and
+//! flattens them, [`mapping`] puts them onto a resin-flow mesh, [`io`] reads and writes every
+//! file, [`pipeline`] does what `drape run` does, [`report`] draws a run.
+//!
+//! The modules are layers, each using only those listed before it: [`numeric`], [`geometry`],
+//! [`kinematic`], [`material`], [`mechanics`], [`layup`], [`mapping`], [`io`], [`pipeline`],
+//! [`report`], then the command line (docs/ARCHITECTURE.md; tests/module_layers.rs keeps it so).
+#![warn(missing_docs)]
+// The command line, for src/main.rs: not part of the library's API.
+#[doc(hidden)]
 pub mod cli;
 pub mod geometry;
 pub mod io;

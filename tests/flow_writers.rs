@@ -90,7 +90,7 @@ fn shear_of(e: usize, k: usize) -> f64 {
 }
 
 fn change_of(e: usize, k: usize) -> f64 {
-    0.03 * (e as f64 + 1.0) * if k % 2 == 0 { 1.0 } else { -1.0 }
+    0.03 * (e as f64 + 1.0) * if k.is_multiple_of(2) { 1.0 } else { -1.0 }
 }
 
 fn fibres(mesh: &FlowMesh, e: usize, k: usize, ply_angle: f64) -> ElementFibres {

@@ -235,7 +235,7 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     // 8100 triangles: above the limit, the tool is rasterised.
-    assert!(4 * 45 * 45 > drape::report::TOOL_TRIANGLE_LIMIT);
+    const { assert!(4 * 45 * 45 > drape::report::TOOL_TRIANGLE_LIMIT) };
     let (net, _) = make_run(dir, 45);
     // A third ply whose tool cannot be found.
     let mut lost = net.clone();

@@ -18,7 +18,9 @@ pub const DEGENERATE_SINE: f64 = 1e-10;
 /// A welded, consistently oriented triangle mesh with edge adjacency.
 #[derive(Debug, Clone)]
 pub struct MendedMesh {
+    /// Welded vertices, in input order.
     pub vertices: Vec<Point>,
+    /// Triangles (indices into `vertices`), consistently wound per piece.
     pub triangles: Vec<[u32; 3]>,
     /// `neighbours[t][k]`: the triangle across the edge of `t` opposite its corner `k`
     /// (the edge from corner `(k+1)%3` to corner `(k+2)%3`), or [`NO_NEIGHBOUR`] on an open

@@ -17,8 +17,11 @@ const MAX_FAN: usize = 1024;
 /// Where a geodesic is: a point in a triangle and a unit direction in that triangle's plane.
 #[derive(Debug, Clone, Copy)]
 pub struct TraceState {
+    /// The point.
     pub point: Point,
+    /// The triangle it lies in.
     pub triangle: u32,
+    /// Unit direction in the triangle's plane.
     pub dir: Vector,
     /// Edge (by opposite corner) through which the trace entered `triangle`, if any.
     entry_edge: Option<usize>,

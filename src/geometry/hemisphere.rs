@@ -1,5 +1,5 @@
 //! The generated hemisphere: the tool `drape bench` measures the engine on, and one of the test
-//! shapes ([`super::shapes`], behind the `shapes` feature).
+//! shapes (`geometry::shapes`, behind the `shapes` feature).
 use super::{Point, TriangleMesh, Vector};
 
 /// Upper half (`z >= 0`) of the sphere of `radius` centred at the origin.

@@ -74,22 +74,58 @@ pub struct MeshReport {
 /// names the file (`<memory>` for triangles in memory) and what to do.
 #[derive(Debug, thiserror::Error)]
 pub enum ToolError {
+    /// The file could not be read.
     #[error("cannot read tool mesh {path}: {source}. Check the path and that the file is readable.")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The file is not a valid OBJ.
     #[error("tool mesh {path} is not a valid OBJ file: {reason}. Export the surface again as a Wavefront OBJ with triangles or polygons.")]
-    Parse { path: PathBuf, reason: String },
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// Where and why.
+        reason: String,
+    },
+    /// The mesh has no faces.
     #[error(
         "tool mesh {path} has no faces. Export the surface (not only its points or curves) as triangles or polygons."
     )]
-    Empty { path: PathBuf },
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
     /// `index` is the vertex number: 1-based in file order (as OBJ counts) for a file, 0-based
     /// for an in-memory mesh.
     #[error("tool mesh {path}: vertex {index} has a non-finite coordinate ({value}). Fix or remove that vertex.")]
-    NonFinite { path: PathBuf, index: usize, value: f64 },
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// The vertex.
+        index: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// For a file, `face` is the 1-based number of the `f` statement and `index` the vertex
     /// number as written (1-based); for an in-memory mesh both are 0-based.
     #[error("tool mesh {path}: face {face} refers to vertex {index}, but the file has only {count} vertices. Re-export the mesh.")]
-    BadIndex { path: PathBuf, face: usize, index: usize, count: usize },
+    BadIndex {
+        /// The file.
+        path: PathBuf,
+        /// The face.
+        face: usize,
+        /// The vertex it names.
+        index: usize,
+        /// How many vertices there are.
+        count: usize,
+    },
+    /// Every face has zero area.
     #[error("tool mesh {path}: every face is degenerate (zero area). Check the file's units and export settings.")]
-    AllDegenerate { path: PathBuf },
+    AllDegenerate {
+        /// The file.
+        path: PathBuf,
+    },
 }

@@ -23,8 +23,9 @@ pub const MAX_OFFSET_STRETCH: f64 = 4.0;
 pub struct OffsetReport {
     /// Vertices moved (distance > 0).
     pub moved: usize,
-    /// Largest and mean distance over the moved vertices, metres.
+    /// Largest distance over the moved vertices, metres.
     pub max_distance: f64,
+    /// Mean distance over the moved vertices, metres.
     pub mean_distance: f64,
     /// Vertices whose direction was clipped at [`MAX_OFFSET_STRETCH`].
     pub clipped: usize,
@@ -241,7 +242,7 @@ mod tests {
         let tool = ToolSurface::from_triangles(v, tris).unwrap();
         assert!(tool.normal(0).z > 0.0 && tool.normal(2).x < 0.0, "test mesh winding");
         let h = 0.01;
-        let (off, report) = offset_surface(&tool, &vec![h; 6]).unwrap();
+        let (off, report) = offset_surface(&tool, &[h; 6]).unwrap();
         assert_eq!(report.folded, 0);
         for (k, p) in off.vertices().iter().enumerate() {
             let on_floor = tool.vertices()[k].z == 0.0;

@@ -30,10 +30,13 @@ const PROJECTION_MAX_ITERATIONS: usize = 12;
 /// surface's unit normal there (on the tool's outer side, like the facet normals).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SmoothPoint {
+    /// The point on the patches.
     pub point: Point,
+    /// The facet it lies over.
     pub triangle: u32,
     /// Barycentric coordinates on the facet.
     pub barycentric: [f64; 3],
+    /// Unit normal of the patch there.
     pub normal: Vector,
 }
 

@@ -36,8 +36,11 @@ struct TriangleFrame {
 /// A point on the tool: where it is, in which triangle, and the triangle's unit normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfacePoint {
+    /// The point.
     pub point: Point,
+    /// The triangle it lies in.
     pub triangle: u32,
+    /// The triangle's unit normal.
     pub normal: Vector,
     /// Distance from the query point (zero for points built on the surface).
     pub distance: f64,
@@ -46,16 +49,22 @@ pub struct SurfacePoint {
 /// A circle in space: `center + radius (cos t e1 + sin t e2)`.
 #[derive(Debug, Clone, Copy)]
 pub struct Circle {
+    /// Centre.
     pub center: Point,
+    /// First unit axis in the circle's plane.
     pub e1: Vector,
+    /// Second unit axis, perpendicular to the first.
     pub e2: Vector,
+    /// Radius.
     pub radius: f64,
 }
 
 /// A point where a circle crosses the tool surface.
 #[derive(Debug, Clone, Copy)]
 pub struct CircleRoot {
+    /// Where it crosses.
     pub point: Point,
+    /// The triangle it crosses.
     pub triangle: u32,
     /// cos of the circle parameter: 1 at `center + radius e1`, decreasing away from it.
     pub cos_t: f64,
@@ -212,11 +221,7 @@ impl ToolSurface {
         let mut out = [None; 2];
         let on: Vec<usize> = (0..3).filter(|&k| l[k] <= ON_EDGE_BARYCENTRIC).collect();
         match on.as_slice() {
-            [k] => {
-                if self.neighbours[t as usize][*k] == NO_NEIGHBOUR {
-                    out[0] = Some(self.outward(t, *k));
-                }
-            }
+            [k] if self.neighbours[t as usize][*k] == NO_NEIGHBOUR => out[0] = Some(self.outward(t, *k)),
             [k1, k2] => {
                 // At the corner opposite both: walk around it both ways to the open edges.
                 let corner = 3 - k1 - k2;

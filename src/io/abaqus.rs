@@ -45,7 +45,7 @@
 //! ```
 //! Abaqus takes local 1 = a projected onto the shell and local 2 in the plane of a and b, so
 //! local 1 is the warp; b = weft keeps the sheared weft in the file (angle a-b = 90 - shear).
-//! Reference the orientation from your *SHELL SECTION / *SHELL SECTION, COMPOSITE on ELSET <TAG>.
+//! Reference the orientation from your *SHELL SECTION / *SHELL SECTION, COMPOSITE on ELSET `<TAG>`.
 use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
 use super::{write_atomic, ExportError};
 use crate::mapping::{ElementShape, FlowMesh, LayupMap};

@@ -18,10 +18,28 @@ use std::path::{Path, PathBuf};
 pub enum PatternError {
     /// The nesting was not made from these patterns.
     #[error("cannot draw {path}: the nesting places {placed} piece(s) ({placed_names}) but {given} pattern(s) were given ({given_names}). Nest exactly the patterns you draw, in the same order.")]
-    Mismatch { path: std::path::PathBuf, placed: usize, placed_names: String, given: usize, given_names: String },
+    Mismatch {
+        /// The drawing.
+        path: std::path::PathBuf,
+        /// Pieces nested.
+        placed: usize,
+        /// Their plies.
+        placed_names: String,
+        /// Patterns given.
+        given: usize,
+        /// Their plies.
+        given_names: String,
+    },
     /// A coordinate is not a finite number.
     #[error("cannot draw {path}: ply '{ply}' has a coordinate that is not a finite number ({what}). Nothing was written; this is a bug in the stage that made the pattern or nesting, please report it.")]
-    NonFinite { path: std::path::PathBuf, ply: String, what: &'static str },
+    NonFinite {
+        /// The drawing.
+        path: std::path::PathBuf,
+        /// The ply.
+        ply: String,
+        /// Which coordinate.
+        what: &'static str,
+    },
     /// Writing the file failed.
     #[error(transparent)]
     Export(#[from] ExportError),

@@ -10,7 +10,7 @@
 //! | [`FlowFormat::Csv`] | `out` (one row per element and ply) |
 //!
 //! Everything is checked before the first file is opened (map sizes against the mesh, finite
-//! values), so a bad map writes nothing; each file is written with [`write_atomic`].
+//! values), so a bad map writes nothing; each file is written with [`crate::io::write_atomic`].
 use super::rtmsim::RtmsimRegion;
 use super::{abaqus, csv, nastran, optistruct, rtmsim, vtk, ExportError};
 use crate::mapping::{ElementFibres, FlowMesh, LayupMap};
@@ -19,11 +19,17 @@ use std::path::{Path, PathBuf};
 /// A format of fibre data on a flow mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum FlowFormat {
+    /// VTK XML unstructured grid (`flow.vtu`).
     Vtu,
+    /// Nastran bulk data with THETA (`flow.bdf`, one deck a ply).
     Nastran,
+    /// Abaqus orientations and distributions (`flow.inp`).
     Abaqus,
+    /// OptiStruct PLY and DRAPE entries (`flow.fem`).
     OptiStruct,
+    /// RTMsim mesh and parameter file (`flow-rtmsim.bdf`).
     Rtmsim,
+    /// CSV, one row an element and ply (`flow.csv`).
     Csv,
 }
 
@@ -98,7 +104,7 @@ pub fn write_flow(
 pub struct RtmsimReport {
     /// Mesh file, then parameter file.
     pub files: Vec<PathBuf>,
-    /// Groups of similar laminate found before RTMsim's limit of 1 + [`MAX_RTMSIM_SETS`] regions.
+    /// Groups of similar laminate found before RTMsim's limit of 1 + [`crate::io::rtmsim::MAX_RTMSIM_SETS`] regions.
     pub groups_found: usize,
     /// Regions written: the main preform first, then SET 1..4.
     pub regions: Vec<RtmsimRegion>,

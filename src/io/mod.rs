@@ -15,7 +15,7 @@
 //!
 //! Nets are checked before any file is opened, so a net that would need NaN or infinity in a
 //! file is refused and nothing partial is left behind. A new shell-mesh format is a new module
-//! with a `FORMAT` and its name in [`mesh_formats!`]'s list below.
+//! with a `FORMAT` and its name in the `mesh_formats!` list below.
 mod atomic;
 mod check;
 pub mod csv;

@@ -86,7 +86,7 @@ impl Angles {
 }
 
 fn pad8(fields: &mut Vec<String>) {
-    while fields.len() % 8 != 0 {
+    while !fields.len().is_multiple_of(8) {
         fields.push(String::new());
     }
 }

@@ -10,14 +10,40 @@ use std::path::{Path, PathBuf};
 /// Why a flow mesh could not be read. Messages name the file, the line and what to do.
 #[derive(Debug, thiserror::Error)]
 pub enum FlowMeshError {
+    /// The file could not be read.
     #[error("cannot read flow mesh {path}: {source}. Check the path.")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// No reader takes the file's extension.
     #[error("flow mesh {path}: unknown file type: use {known}")]
-    UnknownFormat { path: PathBuf, known: String },
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+        /// The extensions there are readers for.
+        known: String,
+    },
+    /// A line of the file is wrong.
     #[error("flow mesh {path} line {line}: {message}")]
-    Syntax { path: PathBuf, line: usize, message: String },
+    Syntax {
+        /// The file (the deck or an included one).
+        path: PathBuf,
+        /// The line.
+        line: usize,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// The file as a whole is unusable.
     #[error("flow mesh {path}: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong and what to do.
+        message: String,
+    },
 }
 
 /// Read the whole file, naming it in the error.

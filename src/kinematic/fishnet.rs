@@ -28,26 +28,56 @@ pub const BYTES_PER_NODE: usize = 2 * (24 + 4 + 1) + 8;
 /// Why a drape could not start. Per-node failures are not errors: they are recorded in the net.
 #[derive(Debug, thiserror::Error)]
 pub enum DrapeError {
+    /// The spacing is not a positive length.
     #[error("spacing must be a positive length, got {0}. Give the fibre segment length d, e.g. --spacing 0.005")]
     Spacing(f64),
+    /// The grid is smaller than 2 x 2.
     #[error("grid must be at least 2 x 2 nodes, got {0} x {1}")]
     GridTooSmall(usize, usize),
+    /// The origin node lies outside the grid.
     #[error("origin node ({0}, {1}) is outside the {2} x {3} grid: use 0..{2} and 0..{3}")]
     OriginNode(usize, usize, usize, usize),
+    /// The net would not fit in memory.
     #[error("a {nu} x {nv} net needs about {need_mb} MB but only {have_mb} MB of memory are available: use a larger spacing or a smaller grid")]
-    TooLarge { nu: usize, nv: usize, need_mb: u64, have_mb: u64 },
+    TooLarge {
+        /// Nodes along the warp.
+        nu: usize,
+        /// Nodes along the weft.
+        nv: usize,
+        /// Memory the net needs, MB.
+        need_mb: u64,
+        /// Memory available, MB.
+        have_mb: u64,
+    },
+    /// The seed is farther than one spacing from the tool.
     #[error("the origin ({x}, {y}, {z}) is {distance:.4} from the tool, more than one spacing ({spacing}): give a seed point on (or within one spacing of) the tool surface, in the tool's units")]
-    OriginOffTool { x: f64, y: f64, z: f64, distance: f64, spacing: f64 },
+    OriginOffTool {
+        /// The seed: x,
+        x: f64,
+        /// y
+        y: f64,
+        /// and z.
+        z: f64,
+        /// Its distance from the tool.
+        distance: f64,
+        /// The spacing.
+        spacing: f64,
+    },
+    /// The warp has no direction along the tool at the seed.
     #[error(
         "the warp direction {0:?} is normal to the tool at the origin (or zero): give a direction along the surface"
     )]
     WarpNormal([f64; 3]),
+    /// The pre-shear is not between -90 and 90 degrees.
     #[error("pre-shear must lie strictly between -90 and 90 degrees, got {0} deg")]
     PreShear(f64),
+    /// The shear limit is not between 0 and 90 degrees.
     #[error("the shear limit must lie strictly between 0 and 90 degrees, got {0} deg")]
     MaxShear(f64),
+    /// The outline is unusable (the message says why).
     #[error("{0}")]
     Outline(String),
+    /// The steering curve is unusable (the message says why).
     #[error("{0}")]
     Steering(String),
 }
@@ -55,7 +85,9 @@ pub enum DrapeError {
 /// A node placed on the tool.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placed {
+    /// Where it lies.
     pub point: Point,
+    /// The tool triangle it lies in.
     pub triangle: u32,
 }
 
@@ -89,6 +121,9 @@ thread_local! {
 /// The fishnet step. `a` is the warp parent (differs from the new node in i), `b` the weft parent
 /// (differs in j), `c` the diagonal node; `si`, `sj` (+1 or -1) say in which direction i and j
 /// grow from the parents to the new node. Returns the new node or why it cannot be placed.
+// The step's inputs, as the fill and the min-shear generators have them: no struct to build per
+// node in the hot loop.
+#[allow(clippy::too_many_arguments)]
 pub fn place_node(
     tool: &ToolSurface,
     d: f64,
@@ -357,8 +392,7 @@ fn write_generators(net: &mut DrapeNet, g: &Generators) {
     net.positions[k0] = g.origin.point;
     net.triangles[k0] = g.origin.triangle;
     net.status[k0] = NodeStatus::Placed;
-    let halves: [(&Vec<Result<Placed, NodeStatus>>, i64, i64); 4] =
-        [(&g.warp_pos, 1, 0), (&g.warp_neg, -1, 0), (&g.weft_pos, 0, 1), (&g.weft_neg, 0, -1)];
+    let halves = [(&g.warp_pos, 1i64, 0i64), (&g.warp_neg, -1, 0), (&g.weft_pos, 0, 1), (&g.weft_neg, 0, -1)];
     for (nodes, di, dj) in halves {
         for (k, node) in nodes.iter().enumerate() {
             let step = k as i64 + 1;

@@ -20,13 +20,19 @@ const STEER_REFINE: f64 = 0.125;
 /// The origin node and the four half-generators (nodes 1, 2, ... away from the origin).
 #[derive(Debug, Clone)]
 pub struct Generators {
+    /// The seed on the tool.
     pub origin: Placed,
     /// Unit warp direction at the origin, in the tool's tangent plane.
     pub warp_dir: Vector,
+    /// How they were laid: `geodesic`, `min-shear` or `steer`.
     pub kind: String,
+    /// Nodes along +warp from the seed (or why the generator stopped there).
     pub warp_pos: Vec<Result<Placed, NodeStatus>>,
+    /// Nodes along -warp.
     pub warp_neg: Vec<Result<Placed, NodeStatus>>,
+    /// Nodes along +weft.
     pub weft_pos: Vec<Result<Placed, NodeStatus>>,
+    /// Nodes along -weft.
     pub weft_neg: Vec<Result<Placed, NodeStatus>>,
 }
 

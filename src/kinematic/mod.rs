@@ -30,7 +30,14 @@ pub enum GeneratorKind {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Extent {
     /// A grid of `nu x nv` nodes with the origin at node `origin_node` (default: the centre).
-    Grid { nu: usize, nv: usize, origin_node: Option<(usize, usize)> },
+    Grid {
+        /// Nodes along the warp.
+        nu: usize,
+        /// Nodes along the weft.
+        nv: usize,
+        /// The seed's node.
+        origin_node: Option<(usize, usize)>,
+    },
     /// A closed polyline on the tool: the grid is sized to cover it and nodes outside are dropped.
     Outline(Vec<Point>),
 }
@@ -38,6 +45,7 @@ pub enum Extent {
 /// Everything the kinematic drape of one ply needs (SI units, radians).
 #[derive(Debug, Clone)]
 pub struct KinematicSettings {
+    /// Ply name (file names derive from it).
     pub name: String,
     /// Seed point; projected onto the tool.
     pub origin: Point,
@@ -45,9 +53,11 @@ pub struct KinematicSettings {
     pub warp: Vector,
     /// Fibre segment length d.
     pub spacing: f64,
+    /// How far the net extends.
     pub extent: Extent,
     /// Pre-shear: the generators meet at pi/2 - pre_shear.
     pub pre_shear: f64,
+    /// How the generators through the seed are laid.
     pub generators: GeneratorKind,
     /// Nodes whose corner shear would reach this are not placed (radians, < pi/2).
     pub max_shear: f64,

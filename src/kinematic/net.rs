@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
+    /// By the kinematic (fishnet) drape.
     Kinematic,
+    /// Refined by the mechanical stage.
     Mechanical,
 }
 
@@ -72,9 +74,13 @@ impl NodeStatus {
 /// Wall-clock time per stage, in milliseconds.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 pub struct Timing {
+    /// Reading the tool.
     pub load_ms: f64,
+    /// Laying the generators.
     pub generators_ms: f64,
+    /// Filling the net (the solve, for a refined net).
     pub fill_ms: f64,
+    /// The whole drape.
     pub total_ms: f64,
 }
 
@@ -82,18 +88,25 @@ pub struct Timing {
 /// A node's position is meaningful only where its status is [`NodeStatus::Placed`].
 #[derive(Debug, Clone)]
 pub struct DrapeNet {
+    /// Ply name.
     pub name: String,
+    /// How the net was computed.
     pub method: Method,
     /// Fibre segment length d (m).
     pub spacing: f64,
+    /// Nodes along the warp (i).
     pub nu: usize,
+    /// Nodes along the weft (j).
     pub nv: usize,
     /// Grid indices of the origin node.
     pub origin_node: (usize, usize),
+    /// Node positions, m (meaningful where placed).
     pub positions: Vec<Point>,
     /// Triangle of the tool each placed node lies in.
     pub triangles: Vec<u32>,
+    /// What happened to each node.
     pub status: Vec<NodeStatus>,
+    /// Time per stage.
     pub timing: Timing,
     /// Where the net came from (`"meta"` in the JSON file): tool, material, directions...
     pub meta: Provenance,
@@ -211,9 +224,13 @@ impl DrapeNet {
 /// Local fibre frame of one cell.
 #[derive(Debug, Clone, Copy)]
 pub struct CellFrame {
+    /// Mean of the four corners.
     pub centre: Point,
+    /// Unit warp direction.
     pub warp: Vector,
+    /// Unit weft direction.
     pub weft: Vector,
+    /// Unit normal, warp x weft.
     pub normal: Vector,
 }
 

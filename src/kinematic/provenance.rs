@@ -85,16 +85,16 @@ impl Provenance {
     /// Set the entry `key` as if the file held `value` there: the field of that name when
     /// `value` has its type, else an entry of [`Provenance::other`]. For writers that build the
     /// JSON themselves (`mechanics::refine::annotate`); elsewhere set the fields.
-    pub fn insert(&mut self, key: &str, value: Value) {
+    pub fn insert(&mut self, key: String, value: Value) {
         let mut map = match serde_json::to_value(&*self) {
             Ok(Value::Object(map)) => map,
             _ => unreachable!("provenance serialises to a JSON object"),
         };
-        map.insert(key.to_string(), value.clone());
+        map.insert(key.clone(), value.clone());
         match serde_json::from_value(Value::Object(map)) {
             Ok(updated) => *self = updated,
             Err(_) => {
-                self.other.insert(key.to_string(), value);
+                self.other.insert(key, value);
             }
         }
     }
@@ -115,10 +115,10 @@ mod tests {
     #[test]
     fn keys_set_by_name_land_in_their_fields() {
         let mut p = Provenance::default();
-        p.insert("tool_scale", 0.001.into());
-        p.insert("material", "card.toml".into());
-        p.insert("warp", serde_json::json!([1.0, 0.0, 0.0]));
-        p.insert("tool", 7.into()); // not a path: kept as given
+        p.insert("tool_scale".into(), 0.001.into());
+        p.insert("material".into(), "card.toml".into());
+        p.insert("warp".into(), serde_json::json!([1.0, 0.0, 0.0]));
+        p.insert("tool".into(), 7.into()); // not a path: kept as given
         assert_eq!(p.tool_scale, Some(0.001));
         assert_eq!(p.material.as_deref(), Some("card.toml"));
         assert_eq!(p.other["warp"], serde_json::json!([1.0, 0.0, 0.0]));

@@ -21,11 +21,13 @@ pub struct NetSample {
     pub cell: (usize, usize),
     /// Bilinear parameters in the cell, along the warp (`s`) and the weft (`t`), in [0, 1].
     pub s: f64,
+    /// Bilinear parameter along the weft, in [0, 1].
     pub t: f64,
     /// The closest point of the net.
     pub point: Point,
     /// Warp and weft tangents of the bilinear cell patch there (not normalised).
     pub warp: Vector,
+    /// Weft tangent there (not normalised).
     pub weft: Vector,
     /// Unit normal warp x weft.
     pub normal: Vector,

@@ -20,19 +20,50 @@ use std::collections::HashMap;
 pub enum FlatError {
     /// The net has no cell with four placed corners.
     #[error("ply '{ply}' has no complete cell (no cell with all four corners placed), so it has no flat pattern. Check the drape of this ply: its seed, size and the node statuses in its .drape.json.")]
-    NoCells { ply: String },
+    NoCells {
+        /// The ply.
+        ply: String,
+    },
     /// A cutting allowance that is not a length.
     #[error("ply '{ply}': the cutting margin {margin} is not zero or a positive length in metres. Fix it in the scene file.")]
-    BadMargin { ply: String, margin: f64 },
+    BadMargin {
+        /// The ply.
+        ply: String,
+        /// The margin, m.
+        margin: f64,
+    },
     /// The net's spacing cannot scale a pattern.
     #[error("ply '{ply}': the net spacing {spacing} is not a positive finite length, so the pattern cannot be unfolded. Re-create the net with `drape run`.")]
-    BadSpacing { ply: String, spacing: f64 },
+    BadSpacing {
+        /// The ply.
+        ply: String,
+        /// The spacing, m.
+        spacing: f64,
+    },
     /// A nesting parameter is out of range.
     #[error("nesting: {field} = {value} {reason}. Fix it in the scene file.")]
-    BadNestParameter { field: &'static str, value: f64, reason: &'static str },
+    BadNestParameter {
+        /// The parameter.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        reason: &'static str,
+    },
     /// A pattern does not fit across the roll in any allowed orientation.
     #[error("ply '{ply}' is {across:.6} m across the roll ({orientation}) but the roll is only {roll_width:.6} m wide: {excess:.6} m too wide. Use a wider roll, allow a 90 degree turn if the material permits it, or split the ply.")]
-    TooWide { ply: String, across: f64, roll_width: f64, excess: f64, orientation: &'static str },
+    TooWide {
+        /// The ply.
+        ply: String,
+        /// Its extent across the roll, m.
+        across: f64,
+        /// The roll width, m.
+        roll_width: f64,
+        /// How much too wide, m.
+        excess: f64,
+        /// How it was turned.
+        orientation: &'static str,
+    },
 }
 
 /// One connected piece of a pattern (cells joined through edges; cells that only touch at a

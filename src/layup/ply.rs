@@ -26,7 +26,9 @@ pub enum Orientation {
 pub struct PlyMaterial {
     /// The name in `[materials]`, or the card's own name when the ply gives a file.
     pub name: String,
+    /// The card.
     pub card: MaterialCard,
+    /// Its file.
     pub path: PathBuf,
 }
 
@@ -36,7 +38,9 @@ pub struct Ply {
     /// Kinematic settings; `settings.warp` is only final once [`Ply::orientation`] has been
     /// resolved on the (offset) tool by [`super::stack`].
     pub settings: KinematicSettings,
+    /// How its warp is given.
     pub orientation: Orientation,
+    /// Its material card, if any.
     pub material: Option<PlyMaterial>,
     /// Thickness as laid flat, metres: the ply's `thickness`, else its card's; `None` if neither.
     pub thickness: Option<f64>,
@@ -61,8 +65,11 @@ impl Ply {
 /// A ply's mechanical refinement: the material card and the contact mode.
 #[derive(Debug, Clone)]
 pub struct Refinement {
+    /// The card.
     pub material: MaterialCard,
+    /// Its file (recorded in the net).
     pub material_path: PathBuf,
+    /// Pressed onto the tool or hanging free.
     pub mode: ContactMode,
 }
 

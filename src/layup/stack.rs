@@ -18,14 +18,46 @@ const MIN_REFERENCE_SINE: f64 = 1e-3;
 /// Why a layup could not be draped. Every message names the ply and its line in the scene.
 #[derive(Debug, thiserror::Error)]
 pub enum LayupError {
+    /// The ply could not be draped.
     #[error("ply '{ply}' (line {line}): {source}")]
-    Drape { ply: String, line: usize, source: DrapeError },
+    Drape {
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+        /// Why.
+        source: DrapeError,
+    },
+    /// The tool offset by the plies below is unusable.
     #[error("ply '{ply}' (line {line}): the offset surface of the plies below is unusable: {source}")]
-    Offset { ply: String, line: usize, source: ToolError },
+    Offset {
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+        /// Why.
+        source: ToolError,
+    },
+    /// The mechanical refinement could not start.
     #[error("ply '{ply}' (line {line}): refinement: {source}")]
-    Refine { ply: String, line: usize, source: RefineError },
+    Refine {
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+        /// Why.
+        source: RefineError,
+    },
+    /// The ply's warp has no direction on the tool at its seed.
     #[error("ply '{ply}' (line {line}): {message}")]
-    Orientation { ply: String, line: usize, message: String },
+    Orientation {
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+        /// Why, and what to do.
+        message: String,
+    },
 }
 
 /// One draped ply of a layup.
@@ -39,6 +71,7 @@ pub struct PlyResult {
     pub warp: Vector,
     /// How the tool was offset for this ply (nothing moved for the first).
     pub offset: OffsetReport,
+    /// Its row of the layup table.
     pub stats: PlyStats,
 }
 
@@ -47,6 +80,7 @@ pub struct PlyResult {
 pub struct PlyStats {
     /// Largest and mean |shear| over the complete cells, radians.
     pub max_abs_shear: f64,
+    /// Mean |shear| over the complete cells, radians.
     pub mean_abs_shear: f64,
     /// Draped area (3D) of the cells sheared past the locking angle, m^2.
     pub area_over_locking: f64,

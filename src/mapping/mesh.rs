@@ -29,6 +29,7 @@ impl ElementShape {
 pub struct FlowElement {
     /// Element id in the source file (for OBJ: the face number, from 1).
     pub id: u64,
+    /// Triangle or quad.
     pub shape: ElementShape,
     /// Corner node indices into [`FlowMesh::nodes`], in the file's order (G1, G2, G3[, G4]).
     pub nodes: Vec<usize>,
@@ -45,6 +46,7 @@ pub struct FlowMesh {
     pub nodes: Vec<Point>,
     /// Node ids in the source file, one per node (for OBJ: the vertex number, from 1).
     pub node_ids: Vec<u64>,
+    /// The elements, in file order.
     pub elements: Vec<FlowElement>,
 }
 

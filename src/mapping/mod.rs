@@ -45,7 +45,9 @@ pub struct ElementFibres {
 /// cover the element (marked, not guessed).
 #[derive(Debug, Clone)]
 pub struct PlyMap {
+    /// Ply name.
     pub ply: String,
+    /// One entry per flow element.
     pub elements: Vec<Option<ElementFibres>>,
 }
 
@@ -79,6 +81,7 @@ pub struct PlyMapSettings {
     pub thickness: f64,
     /// Fibre volume fraction as laid flat.
     pub vf: f64,
+    /// What shear does to thickness and Vf.
     pub cavity: Cavity,
     /// Permeability tensors, when asked for.
     pub permeability: Option<PermeabilityModel>,
@@ -136,12 +139,28 @@ impl PlyMapSettings {
 /// Why a net could not be mapped.
 #[derive(Debug, thiserror::Error)]
 pub enum MapError {
+    /// The net has no complete cell.
     #[error("ply '{ply}' has no complete cell to map; drape it again (is the seed on the tool?)")]
-    EmptyNet { ply: String },
+    EmptyNet {
+        /// The ply.
+        ply: String,
+    },
+    /// A flow element has no area.
     #[error("flow mesh {path} element {id} is degenerate (zero area): mend the mesh in its pre-processor")]
-    DegenerateElement { path: std::path::PathBuf, id: u64 },
+    DegenerateElement {
+        /// The flow mesh.
+        path: std::path::PathBuf,
+        /// The element.
+        id: u64,
+    },
+    /// The ply's thickness or fibre volume fraction is unusable.
     #[error("ply '{ply}': {message}")]
-    Settings { ply: String, message: String },
+    Settings {
+        /// The ply.
+        ply: String,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 /// Signed angle from `from` to `to` about `axis` (all in one plane), radians in (-pi, pi].

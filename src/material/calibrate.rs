@@ -25,7 +25,10 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ShearLawKind {
     /// M = c1 g + c3 g^3 + ... with this many odd-power terms (1..=8).
-    Polynomial { terms: usize },
+    Polynomial {
+        /// Odd-power terms.
+        terms: usize,
+    },
     /// M = g1 g up to the locking angle, slope g2 beyond.
     TwoSlope,
 }
@@ -71,7 +74,9 @@ pub struct FitReport {
     pub rms: f64,
     /// Coefficient of determination, 1 - SS_res / SS_tot.
     pub r_squared: f64,
+    /// Largest |residual|.
     pub max_abs_residual: f64,
+    /// Data points fitted.
     pub points: usize,
 }
 

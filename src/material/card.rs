@@ -8,6 +8,7 @@ use super::laws::{Bending, Fibre, KnitParams, ShearLaw, Tension, TensionLaw};
 /// the field at fault, and what is expected.
 #[derive(Debug, thiserror::Error)]
 pub enum MaterialError {
+    /// What is wrong, naming the card, line and field.
     #[error("{0}")]
     Invalid(String),
 }
@@ -15,6 +16,7 @@ pub enum MaterialError {
 /// A fabric material card (SI units).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MaterialCard {
+    /// The card's name.
     pub name: String,
     /// kg/m^2
     pub areal_mass: f64,

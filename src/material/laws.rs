@@ -28,7 +28,9 @@ pub const POLYNOMIAL_CHECK_MAX_DEG: f64 = 85.0;
 /// One of the two fibre families.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Fibre {
+    /// The warp (the first fibre direction, along i).
     Warp,
+    /// The weft (along j).
     Weft,
 }
 
@@ -45,6 +47,7 @@ impl Fibre {
 /// The `[tension]` section.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tension {
+    /// The law of each family.
     pub law: TensionLaw,
     /// Scales the rigidity for fibre compression (e < 0); 0..=1, default 1.
     pub compression_factor: f64,
@@ -54,9 +57,19 @@ pub struct Tension {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TensionLaw {
     /// W = D e^2 / 2 with D (N/m) per family.
-    Linear { warp: f64, weft: f64 },
+    Linear {
+        /// D of the warp, N/m.
+        warp: f64,
+        /// D of the weft, N/m.
+        weft: f64,
+    },
     /// Strain-stiffening law of seed 004 (Supplementary Eq. 14) per family.
-    Knit { warp: KnitParams, weft: KnitParams },
+    Knit {
+        /// Parameters of the warp.
+        warp: KnitParams,
+        /// Parameters of the weft.
+        weft: KnitParams,
+    },
 }
 
 /// Parameters of the knit law sigma(e) = C e + beta (1/(1 - alpha e)^2 - 1 - 2 alpha e).
@@ -112,7 +125,9 @@ impl KnitParams {
 /// Flexural rigidities per unit width, N m.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bending {
+    /// Warp rigidity.
     pub warp: f64,
+    /// Weft rigidity.
     pub weft: f64,
 }
 
@@ -120,9 +135,19 @@ pub struct Bending {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ShearLaw {
     /// M = c1 g + c3 g^3 + c5 g^5 + ...; `coefficients` = [c1, c3, c5, ...], N/m.
-    Polynomial { coefficients: Vec<f64> },
+    Polynomial {
+        /// [c1, c3, ...], N/m.
+        coefficients: Vec<f64>,
+    },
     /// M = g1 g for |g| <= locking angle, continued with slope g2 beyond (N/m per rad).
-    TwoSlope { g1: f64, g2: f64, locking_angle_deg: f64 },
+    TwoSlope {
+        /// Slope below the locking angle, N/m per rad.
+        g1: f64,
+        /// Slope above it, N/m per rad.
+        g2: f64,
+        /// Locking angle, degrees.
+        locking_angle_deg: f64,
+    },
     /// Measured M(g), monotone cubic interpolation.
     Table(ShearTable),
 }

@@ -51,11 +51,14 @@ pub enum ContactMode {
 /// `basis`); 0 = fixed, 2 = sliding on the tool, 3 = free.
 #[derive(Debug, Clone, Copy)]
 pub struct NodeBasis {
+    /// How many directions: 0 fixed, 2 sliding, 3 free.
     pub dofs: usize,
+    /// The directions, as columns.
     pub basis: Matrix3<f64>,
 }
 
 impl NodeBasis {
+    /// No direction: the node stays.
     pub const FIXED: NodeBasis =
         NodeBasis { dofs: 0, basis: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
 
@@ -169,7 +172,9 @@ pub fn tangent_pair(n: &Vector) -> (Vector, Vector) {
 /// A linearised one-sided contact constraint: `normal . (x + delta - point) >= 0`.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactRow {
+    /// The node.
     pub node: usize,
+    /// Unit normal of the tool at the contact point.
     pub normal: Vector,
     /// Signed gap `normal . (x - point)` at the current state (>= 0 when outside the tool).
     pub gap: f64,

@@ -4,6 +4,9 @@
 pub mod contact;
 pub mod energy;
 pub mod refine;
+// The solver is being rewritten on another branch; its two lint findings (a spelled-out column
+// type, an index loop over a sparse column) are left to that rewrite.
+#[allow(clippy::type_complexity, clippy::needless_range_loop)]
 pub mod solver;
 pub mod sparse;
 pub mod virtual_tests;

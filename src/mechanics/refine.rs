@@ -87,6 +87,7 @@ pub enum PressedSurface {
 /// How to refine.
 #[derive(Debug, Clone)]
 pub struct RefineSettings {
+    /// How the term moves: pressed, free or none.
     pub mode: ContactMode,
     /// What pressed nodes slide on.
     pub pressed_surface: PressedSurface,
@@ -94,6 +95,7 @@ pub struct RefineSettings {
     pub gravity: Vector,
     /// Gravity is applied in this many equal steps.
     pub load_steps: usize,
+    /// The solver's settings.
     pub solver: SolverSettings,
 }
 
@@ -112,6 +114,7 @@ impl Default for RefineSettings {
 /// A refined net and what the solver did.
 #[derive(Debug, Clone)]
 pub struct Refined {
+    /// The refined net.
     pub net: DrapeNet,
     /// One report per load step.
     pub steps: Vec<SolveReport>,
@@ -123,6 +126,7 @@ pub struct Refined {
     /// little more shear than its facets, so the refined energy is bounded by this one, and by
     /// `energy_kinematic` only on the facets.
     pub energy_start: f64,
+    /// Energy (full load) of the refined net.
     pub energy_final: f64,
 }
 
@@ -140,8 +144,10 @@ impl Refined {
 /// Why a refinement could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum RefineError {
+    /// The net has no placed node.
     #[error("the net has no placed nodes to refine")]
     Empty,
+    /// No load step was asked for.
     #[error("load steps must be at least 1")]
     LoadSteps,
 }

@@ -34,12 +34,14 @@ pub struct Evaluation {
     pub internal: Vec<Vector>,
     /// External loads per node (P).
     pub external: Vec<Vector>,
+    /// Hessian blocks of the internal energy, when asked for.
     pub hessian: Option<Box<dyn HessianBlocks>>,
 }
 
 /// Settings of the solver (builder style: `SolverSettings::default().max_iterations(80)`).
 #[derive(Debug, Clone)]
 pub struct SolverSettings {
+    /// Iteration limit per solve.
     pub max_iterations: usize,
     /// Converged when |F - P| / max(|P|, |F|, |F at the start|) <= tolerance (seed 000 eq. 20:
     /// |F - P| / |P| <= 1e-4).
@@ -47,6 +49,7 @@ pub struct SolverSettings {
     /// Converged too when the energy changes by less than this (relative) over `stall_window`
     /// accepted steps.
     pub stall_tolerance: f64,
+    /// Accepted steps over which the energy must stall.
     pub stall_window: usize,
     /// Initial Levenberg-Marquardt damping, relative to the Hessian's mean diagonal.
     pub initial_damping: f64,
@@ -74,10 +77,12 @@ impl Default for SolverSettings {
 }
 
 impl SolverSettings {
+    /// Set the iteration limit.
     pub fn max_iterations(mut self, n: usize) -> Self {
         self.max_iterations = n;
         self
     }
+    /// Set the residual tolerance.
     pub fn tolerance(mut self, t: f64) -> Self {
         self.tolerance = t;
         self
@@ -87,14 +92,23 @@ impl SolverSettings {
 /// One solver iteration, for the log.
 #[derive(Debug, Clone, Serialize)]
 pub struct IterationLog {
+    /// Iteration number, from 1.
     pub iteration: usize,
+    /// Energy after the iteration.
     pub energy: f64,
+    /// Relative residual |F - P| after it.
     pub residual: f64,
+    /// Length of the step taken.
     pub step: f64,
+    /// Levenberg-Marquardt damping used.
     pub damping: f64,
+    /// Nodes in contact.
     pub active_contacts: usize,
+    /// Whether the step was accepted.
     pub accepted: bool,
+    /// Interior-point iterations of the subproblem.
     pub qp_iterations: u32,
+    /// Wall-clock time, ms.
     pub time_ms: f64,
 }
 
@@ -117,11 +131,17 @@ pub enum Outcome {
 /// What a solve did.
 #[derive(Debug, Clone, Serialize)]
 pub struct SolveReport {
+    /// How the solve ended.
     pub outcome: Outcome,
+    /// Energy at the start.
     pub energy_start: f64,
+    /// Energy at the end.
     pub energy_end: f64,
+    /// Relative residual at the end.
     pub residual: f64,
+    /// One entry per iteration.
     pub iterations: Vec<IterationLog>,
+    /// Wall-clock time, ms.
     pub time_ms: f64,
 }
 
@@ -134,7 +154,9 @@ impl SolveReport {
 
 /// What the solver moves and how: each node's freedom, the tool for contact.
 pub struct Constraints<'a> {
+    /// How each node may move.
     pub freedom: Vec<Freedom>,
+    /// Pressed, free or no contact.
     pub mode: ContactMode,
     /// Pressed nodes slide on it; free nodes stay out of it.
     pub tool: Option<&'a dyn ContactSurface>,

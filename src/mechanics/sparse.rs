@@ -63,9 +63,11 @@ impl SymmetricPattern {
         SymmetricPattern { nu, nv, colptr, rowval, ranks }
     }
 
+    /// Nodes along the warp.
     pub fn nu(&self) -> usize {
         self.nu
     }
+    /// Nodes along the weft.
     pub fn nv(&self) -> usize {
         self.nv
     }
@@ -202,7 +204,9 @@ impl SymmetricPattern {
 /// A symmetric matrix on a [`SymmetricPattern`] (upper triangle stored).
 #[derive(Debug, Clone)]
 pub struct SymmetricMatrix {
+    /// Where the entries are.
     pub pattern: Arc<SymmetricPattern>,
+    /// The entries, column by column.
     pub values: Vec<f64>,
 }
 
@@ -220,15 +224,19 @@ impl SymmetricMatrix {
     pub fn dim(&self) -> usize {
         self.pattern.dim()
     }
+    /// Start of each column in `rowval` and `values`.
     pub fn colptr(&self) -> &[usize] {
         self.pattern.colptr()
     }
+    /// Row of each entry.
     pub fn rowval(&self) -> &[usize] {
         self.pattern.rowval()
     }
+    /// The entries.
     pub fn values(&self) -> &[f64] {
         &self.values
     }
+    /// The entries, to change them.
     pub fn values_mut(&mut self) -> &mut [f64] {
         &mut self.values
     }

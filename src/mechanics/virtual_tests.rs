@@ -36,7 +36,9 @@ pub const CANTILEVER_LOAD_STEPS: usize = 20;
 /// The result of a cantilever test: the strip's centre line from the clamp to the tip.
 #[derive(Debug, Clone)]
 pub struct Cantilever {
+    /// Centre line of the strip from the clamp to the tip.
     pub nodes: Vec<Point>,
+    /// One report per load step.
     pub steps: Vec<SolveReport>,
 }
 
@@ -140,11 +142,14 @@ pub const SHEAR_TEST_TOLERANCE: f64 = 1e-11;
 /// along the frame's arms, `steps` equal crosshead steps up to `displacement` (all in m).
 #[derive(Debug, Clone, Copy)]
 pub struct PictureFrame {
+    /// Frame side L, hinge to hinge, m.
     pub side: f64,
     /// Requested fibre spacing of the net: the side is cut into `round(side / spacing)` cells
     /// (at least 2) and the spacing adjusted to fit exactly.
     pub spacing: f64,
+    /// Final crosshead displacement, m.
     pub displacement: f64,
+    /// Equal load steps up to it.
     pub steps: usize,
 }
 
@@ -153,12 +158,16 @@ pub struct PictureFrame {
 /// `steps` equal clamp displacements up to `displacement` (all in m).
 #[derive(Debug, Clone, Copy)]
 pub struct BiasExtension {
+    /// Free length between the clamps, m.
     pub length: f64,
+    /// Width, m.
     pub width: f64,
     /// Requested fibre spacing; adjusted so that the clamp corners are nodes (see
     /// [`bias_extension`]).
     pub spacing: f64,
+    /// Final clamp displacement, m.
     pub displacement: f64,
+    /// Equal load steps up to it.
     pub steps: usize,
 }
 
@@ -166,9 +175,11 @@ pub struct BiasExtension {
 pub struct ShearState<'s> {
     /// Load step (1..=steps).
     pub step: usize,
+    /// Crosshead displacement, m.
     pub displacement: f64,
     /// Crosshead force (N).
     pub force: f64,
+    /// The net's grid.
     pub grid: &'s Grid,
     /// Node positions at d = 0.
     pub reference: &'s [Point],
@@ -191,6 +202,7 @@ pub struct ShearTest {
     pub force: Vec<f64>,
     /// Load steps requested and completed.
     pub requested: usize,
+    /// Load steps completed.
     pub completed: usize,
     /// One report per solve, in order (sub-steps included; a failed solve is the last one).
     pub solves: Vec<SolveReport>,

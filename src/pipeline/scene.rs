@@ -53,10 +53,22 @@ use std::path::{Path, PathBuf};
 /// Why a scene could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The scene file could not be read.
     #[error("cannot read scene {path}: {source}. Check the path.")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The scene is wrong; the message names the field and line.
     #[error("scene {path}: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong and what to do.
+        message: String,
+    },
 }
 
 #[derive(Deserialize)]
@@ -136,9 +148,13 @@ fn default_method() -> String {
 /// The scene's `[export]` table: map every ply onto a resin-flow mesh.
 #[derive(Debug, Clone)]
 pub struct SceneExport {
+    /// The flow mesh file.
     pub mesh: PathBuf,
+    /// The formats to write.
     pub formats: Vec<FlowFormat>,
+    /// What shear does to thickness and Vf.
     pub cavity: Cavity,
+    /// Whether to write permeability tensors.
     pub permeability: bool,
 }
 
@@ -148,9 +164,11 @@ pub const DEFAULT_NESTING_GAP: f64 = 0.01;
 /// A scene: the tool and its plies in stacking order.
 #[derive(Debug, Clone)]
 pub struct Scene {
+    /// The scene file.
     pub path: PathBuf,
     /// Metres per unit of the scene and OBJ.
     pub scale: f64,
+    /// The tool file.
     pub tool: PathBuf,
     /// The plies, their reference direction and stacking side.
     pub layup: Layup,
@@ -162,6 +180,7 @@ pub struct Scene {
     pub cutting_margin: f64,
     /// Whether pieces may be turned 90 degrees on the roll (warp across the roll).
     pub rotate_patterns: bool,
+    /// The flow export, if the scene has an `[export]` table.
     pub export: Option<SceneExport>,
 }
 

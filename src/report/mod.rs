@@ -37,18 +37,47 @@ use std::path::{Path, PathBuf};
 /// Why a report could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
+    /// The run folder cannot be listed.
     #[error("cannot list {path}: {source}. Give the folder `drape run --out` wrote.")]
-    ReadDir { path: PathBuf, source: std::io::Error },
+    ReadDir {
+        /// The folder.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The run folder holds no net.
     #[error("{path} holds no drape net (*.drape.json). Give the folder `drape run --out` wrote, and run with the json format.")]
-    NoNets { path: PathBuf },
+    NoNets {
+        /// The folder.
+        path: PathBuf,
+    },
+    /// A net could not be read, or a file written.
     #[error(transparent)]
     Net(#[from] ExportError),
+    /// `layup.json` could not be read.
     #[error("{path}: {message}. Re-create it with `drape run`, or delete it to build the table from the nets.")]
-    Layup { path: PathBuf, message: String },
+    Layup {
+        /// The file.
+        path: PathBuf,
+        /// Where and why.
+        message: String,
+    },
+    /// The report folder could not be created.
     #[error("cannot create report folder {path}: {source}. Check the --out path and that its parent is writable.")]
-    CreateDir { path: PathBuf, source: std::io::Error },
+    CreateDir {
+        /// The folder.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// A picture could not be drawn.
     #[error("cannot draw {path}: {message}. This is a bug; please report it with the run folder.")]
-    Draw { path: PathBuf, message: String },
+    Draw {
+        /// The picture.
+        path: PathBuf,
+        /// What the renderer said.
+        message: String,
+    },
 }
 
 /// What a report wrote.
@@ -69,12 +98,15 @@ pub struct ReportSummary {
 pub struct PlyReport {
     /// Ply name (the file stem of its net).
     pub name: String,
+    /// How the net was computed.
     pub method: Method,
     /// Complete cells drawn.
     pub cells: usize,
     /// Locking angle used for the marks (degrees).
     pub locking_angle_deg: f64,
+    /// Largest |shear| over the complete cells, degrees.
     pub max_abs_shear_deg: f64,
+    /// Mean |shear|, degrees.
     pub mean_abs_shear_deg: f64,
     /// Colour limit of the shear map (degrees, symmetric).
     pub colour_limit_deg: f64,
@@ -372,28 +404,6 @@ fn link_to(file: &Path, dir: &Path, out: &Path) -> String {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn tool_scale_is_the_one_that_fits_the_net() {
-        let tool = |k: f64| RawTool {
-            vertices: vec![],
-            triangles: vec![],
-            lo: Point::new(-k, -k, 0.0),
-            hi: Point::new(k, k, k),
-        };
-        let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
-        for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
-            net.positions[k] = Point::new(p.0, p.1, 0.09);
-            net.status[k] = crate::kinematic::NodeStatus::Placed;
-        }
-        assert_eq!(guess_scale(&tool(0.1), &net), 1.0, "metres");
-        assert_eq!(guess_scale(&tool(100.0), &net), 1e-3, "millimetres: both boxes hold the net, the mm one fits");
-    }
-}
-
 pub(crate) fn method_name(m: Method) -> &'static str {
     match m {
         Method::Kinematic => "kinematic",
@@ -545,4 +555,26 @@ fn write_pair(
     write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
     files.push(p);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tool_scale_is_the_one_that_fits_the_net() {
+        let tool = |k: f64| RawTool {
+            vertices: vec![],
+            triangles: vec![],
+            lo: Point::new(-k, -k, 0.0),
+            hi: Point::new(k, k, k),
+        };
+        let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
+        for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
+            net.positions[k] = Point::new(p.0, p.1, 0.09);
+            net.status[k] = crate::kinematic::NodeStatus::Placed;
+        }
+        assert_eq!(guess_scale(&tool(0.1), &net), 1.0, "metres");
+        assert_eq!(guess_scale(&tool(100.0), &net), 1e-3, "millimetres: both boxes hold the net, the mm one fits");
+    }
 }

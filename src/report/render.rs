@@ -17,7 +17,7 @@ pub const HEIGHT: u32 = 720;
 const FONT: &str = "sans-serif";
 
 /// Above this many triangles the tool is drawn as a depth-buffered raster of
-/// [`TOOL_BIN_PX`]-pixel bins (merged into runs) instead of one polygon per triangle, so a
+/// `TOOL_BIN_PX`-pixel bins (merged into runs) instead of one polygon per triangle, so a
 /// 200k-triangle tool stays fast and its SVG small.
 pub const TOOL_TRIANGLE_LIMIT: usize = 6000;
 /// Bin size of the rasterised tool, pixels.
@@ -66,6 +66,11 @@ pub struct Mark {
     pub label: String,
 }
 
+/// A tool triangle in pixels and its grey.
+pub type ToolTriangle = ([(i32, i32); 3], u8);
+/// A cell in pixels and its colour.
+pub type PaintedCell = ([(i32, i32); 4], [u8; 3]);
+
 /// A map picture laid out in pixels: the tool underneath, the cells on top, a colour bar.
 #[derive(Debug, Clone, Default)]
 pub struct MapPicture {
@@ -75,9 +80,9 @@ pub struct MapPicture {
     /// Tool raster runs: ([x0, y0, x1, y1], grey), drawn first.
     pub tool_runs: Vec<([i32; 4], u8)>,
     /// Tool triangles in paint order (far to near), with their grey.
-    pub tool_triangles: Vec<([(i32, i32); 3], u8)>,
+    pub tool_triangles: Vec<ToolTriangle>,
     /// Cells in paint order (far to near) with their colour.
-    pub cells: Vec<([(i32, i32); 4], [u8; 3])>,
+    pub cells: Vec<PaintedCell>,
     /// Whether cells get outlines.
     pub outlines: bool,
     /// Scale bar: left pixel, baseline pixel, length in pixels, label.
@@ -131,7 +136,7 @@ pub fn layout_map(net: &DrapeNet, values: &[Option<f64>], tool: Option<&ToolLaye
         if t.triangles.len() > TOOL_TRIANGLE_LIMIT {
             pic.tool_runs = raster_tool(t, &view, &fit, clip);
         } else {
-            let mut tris: Vec<(f64, [(i32, i32); 3], u8)> = t
+            let mut tris: Vec<(f64, ToolTriangle)> = t
                 .triangles
                 .iter()
                 .filter_map(|tri| {
@@ -145,11 +150,11 @@ pub fn layout_map(net: &DrapeNet, values: &[Option<f64>], tool: Option<&ToolLaye
                     if out(0, clip[0], clip[2]) || out(1, clip[1], clip[3]) {
                         return None;
                     }
-                    Some(((p[0].2 + p[1].2 + p[2].2) / 3.0, pix, tool_grey(&c, &view)))
+                    Some(((p[0].2 + p[1].2 + p[2].2) / 3.0, (pix, tool_grey(&c, &view))))
                 })
                 .collect();
             tris.sort_by(|a, b| a.0.total_cmp(&b.0));
-            pic.tool_triangles = tris.into_iter().map(|(_, p, g)| (p, g)).collect();
+            pic.tool_triangles = tris.into_iter().map(|(_, t)| t).collect();
         }
     }
     cells3.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -368,7 +373,7 @@ pub struct HistogramPicture {
     pub marks: Vec<Mark>,
 }
 
-/// Bin width (degrees) giving about [`HISTOGRAM_BINS`] bins over [-limit, limit].
+/// Bin width (degrees) giving about `HISTOGRAM_BINS` bins over [-limit, limit].
 pub fn bin_width(limit: f64) -> f64 {
     nice_ceil(2.0 * limit / HISTOGRAM_BINS)
 }

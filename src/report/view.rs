@@ -39,7 +39,7 @@ pub fn colour_limit(max_abs_deg: f64, locking_deg: f64) -> f64 {
 const COLOUR_LIMIT_MARGIN: f64 = 1.05;
 
 /// Symmetric limit for a map of small differences (degrees): the largest |value| rounded up to
-/// a 1-2-5 step, at least [`MIN_CHANGE_LIMIT_DEG`].
+/// a 1-2-5 step, at least `MIN_CHANGE_LIMIT_DEG`.
 pub fn change_limit(max_abs_deg: f64) -> f64 {
     nice_ceil(max_abs_deg.max(MIN_CHANGE_LIMIT_DEG))
 }
@@ -75,8 +75,11 @@ pub const VIEW_TILT_DEG: f64 = 30.0;
 /// An orthographic view: screen right, screen up, and towards the viewer.
 #[derive(Debug, Clone, Copy)]
 pub struct View {
+    /// Screen right.
     pub right: Vector,
+    /// Screen up.
     pub up: Vector,
+    /// Towards the viewer.
     pub toward: Vector,
 }
 

@@ -1,7 +1,7 @@
-//! Nastran bulk data: reading shell meshes ([`read`]) and writing the fibre orientations of a
-//! layup ([`write`]); OptiStruct and RTMsim decks are Nastran bulk data too and share the fields
-//! below. One parser reads a real field ([`parse_real`]), and the writers check every number
-//! they write with it ([`fit_real`]).
+//! Nastran bulk data: reading shell meshes ([`read()`]) and writing the fibre orientations of a
+//! layup ([`mod@write`]); OptiStruct and RTMsim decks are Nastran bulk data too and share the
+//! fields below. One parser reads a real field ([`parse_real`]), and the writers check every
+//! number they write with it (`fit_real`).
 pub mod read;
 pub mod write;
 

@@ -11,10 +11,12 @@ use std::ops::Range;
 
 /// The bending term.
 pub struct Bending<'a, L: Laws + ?Sized> {
+    /// The material whose bending rigidities the term uses.
     pub material: &'a L,
 }
 
 impl<'a, L: Laws + ?Sized> Bending<'a, L> {
+    /// The term for `material`.
     pub fn new(material: &'a L) -> Self {
         Bending { material }
     }

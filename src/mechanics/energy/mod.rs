@@ -84,7 +84,9 @@ pub enum HessianKind {
 /// The grid the energy lives on: its size, fibre spacing and which nodes are active.
 #[derive(Debug, Clone)]
 pub struct Grid {
+    /// Nodes along the warp (i).
     pub nu: usize,
+    /// Nodes along the weft (j).
     pub nv: usize,
     /// Reference fibre segment length d (m).
     pub spacing: f64,
@@ -109,10 +111,12 @@ impl Grid {
         let active = net.status.iter().map(|s| *s == NodeStatus::Placed).collect();
         Self::with_active(net.nu, net.nv, net.spacing, active)
     }
+    /// Nodes of the grid, `nu * nv`.
     #[inline]
     pub fn num_nodes(&self) -> usize {
         self.nu * self.nv
     }
+    /// Linear index of node (i, j): `i * nv + j`.
     #[inline]
     pub fn index(&self, i: usize, j: usize) -> usize {
         i * self.nv + j
@@ -263,6 +267,7 @@ impl<'s> Sink<'s> {
 
 /// One term of the energy.
 pub trait EnergyTerm: Sync {
+    /// The term's name in energy listings.
     fn name(&self) -> &'static str;
     /// How many rows beyond its base row (its lowest node row) an element reaches: 0 for nodal
     /// terms, 1 for segments and cells, 2 for bending triples.
@@ -298,6 +303,7 @@ impl Evaluation {
 
 /// The energy of a ply on its grid: a list of terms evaluated together.
 pub struct Model<'a> {
+    /// The grid the terms live on.
     pub grid: Grid,
     terms: Vec<Box<dyn EnergyTerm + 'a>>,
     pattern: Arc<SymmetricPattern>,

@@ -20,10 +20,12 @@ use std::ops::Range;
 
 /// The shear term.
 pub struct Shear<'a, L: Laws + ?Sized> {
+    /// The material whose shear law the term uses.
     pub material: &'a L,
 }
 
 impl<'a, L: Laws + ?Sized> Shear<'a, L> {
+    /// The term for `material`.
     pub fn new(material: &'a L) -> Self {
         Shear { material }
     }

@@ -14,10 +14,12 @@ use std::ops::Range;
 
 /// The stretch term.
 pub struct Stretch<'a, L: Laws + ?Sized> {
+    /// The material whose tension law the term uses.
     pub material: &'a L,
 }
 
 impl<'a, L: Laws + ?Sized> Stretch<'a, L> {
+    /// The term for `material`.
     pub fn new(material: &'a L) -> Self {
         Stretch { material }
     }
