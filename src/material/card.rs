@@ -213,6 +213,21 @@ mod tests {
         (f(x + h) - f(x - h)) / (2.0 * h)
     }
 
+    /// The integral of `f` from 0 to `end` by Simpson's rule on `n` (even) intervals.
+    fn simpson(f: impl Fn(f64) -> f64, end: f64, n: usize) -> f64 {
+        let h = end / n as f64;
+        let weight = |i: usize| {
+            if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            }
+        };
+        (0..=n).map(|i| weight(i) * f(i as f64 * h)).sum::<f64>() * h / 3.0
+    }
+
     fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
         (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
     }
@@ -319,22 +334,8 @@ mod tests {
         let xl = 50f64.to_radians();
         assert!(close(card.shear(xl - 1e-9).1, card.shear(xl + 1e-9).1, 1e-7, 0.0));
         // Energy is the integral of M (Simpson on a fine grid).
-        let n = 2000;
         let g_end = 1.1;
-        let hh = g_end / n as f64;
-        let mut simpson = 0.0;
-        for i in 0..=n {
-            let wgt = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            simpson += wgt * card.shear(i as f64 * hh).1;
-        }
-        simpson *= hh / 3.0;
-        assert!(close(card.shear(g_end).0, simpson, 1e-8, 0.0));
+        assert!(close(card.shear(g_end).0, simpson(|g| card.shear(g).1, g_end, 2000), 1e-8, 0.0));
         // An explicit (0, 0) gives the same law.
         let t0 = ShearTable::new(vec![0.0, 10.0, 20.0, 30.0, 40.0, 50.0], vec![0.0, 0.2, 0.5, 1.1, 3.0, 12.0]).unwrap();
         for g in [0.1, 0.3, 0.7, 1.0] {
@@ -352,20 +353,7 @@ mod tests {
         }
         // W = integral of sigma, by Simpson.
         let e_end = 0.35;
-        let n = 4000;
-        let h = e_end / n as f64;
-        let mut s = 0.0;
-        for i in 0..=n {
-            let wgt = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            s += wgt * k.stretch(i as f64 * h).1;
-        }
-        assert!(close(k.stretch(e_end).0, s * h / 3.0, 1e-9, 0.0));
+        assert!(close(k.stretch(e_end).0, simpson(|e| k.stretch(e).1, e_end, 4000), 1e-9, 0.0));
         // Past the singularity: huge, finite, increasing.
         let (w, t, kk) = k.stretch(1.0);
         assert!(w.is_finite() && t > 1e6 * 10.0 && kk > 0.0);
