@@ -5,7 +5,7 @@
 use crate::geometry::surface::closest_point_on_triangle;
 use crate::geometry::{Point, Vector};
 use crate::kinematic::DrapeNet;
-use std::collections::HashMap;
+use rstar::{PointDistance, RTree, RTreeObject, AABB};
 
 /// A centroid whose closest point on the net lies further than this (times the net spacing) from
 /// it along the net's tangent plane is off the net's edge: the element is not covered.
@@ -45,82 +45,94 @@ impl NetSample {
     }
 }
 
-/// A net as triangles (two per complete cell) in a uniform hash grid of cell size 2d, for
-/// closest-point queries near the net. (Our own grid rather than a BVH: nets are regular, their
-/// triangles all about d in size, and collapsed or coincident cells of a locked net must not
-/// upset the search structure.)
+/// A net as triangles (two per complete cell) in an R-tree (`rstar`), for closest-point queries
+/// near the net. Collapsed halves of folded or locked cells are left out (they carry no area to
+/// find); the tree takes the flat boxes of coincident cells as they are.
 pub struct NetSampler<'a> {
     net: &'a DrapeNet,
-    /// Triangle corners by node index, and the cell (i, j) and half (0: corners 00-10-11,
-    /// 1: corners 00-11-01) of each triangle.
-    triangles: Vec<([usize; 3], (usize, usize, u8))>,
-    grid: HashMap<[i64; 3], Vec<u32>>,
-    bin: f64,
+    tree: RTree<HalfCell>,
+}
+
+/// One triangle of the net: half 0 of cell (i, j) has the corners 00-10-11, half 1 00-11-01.
+struct HalfCell {
+    /// Its number: ties between triangles at the same distance go to the lowest, so the answer
+    /// does not depend on how the tree is built.
+    number: u32,
+    /// Corner node indices.
+    nodes: [usize; 3],
+    /// Corner positions.
+    corners: [Point; 3],
+    /// Cell (i, j) and half.
+    cell: (usize, usize, u8),
+}
+
+impl HalfCell {
+    fn closest_point(&self, p: &Point) -> Point {
+        let [a, b, c] = &self.corners;
+        closest_point_on_triangle(p, a, b, c)
+    }
+}
+
+impl RTreeObject for HalfCell {
+    type Envelope = AABB<[f64; 3]>;
+    fn envelope(&self) -> Self::Envelope {
+        let [a, b, c] = &self.corners;
+        let (lo, hi) = (a.coords.inf(&b.coords).inf(&c.coords), a.coords.sup(&b.coords).sup(&c.coords));
+        AABB::from_corners([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z])
+    }
+}
+
+impl PointDistance for HalfCell {
+    fn distance_2(&self, p: &[f64; 3]) -> f64 {
+        let p = Point::from(*p);
+        (self.closest_point(&p) - p).norm_squared()
+    }
 }
 
 impl<'a> NetSampler<'a> {
     /// `None` when the net has no complete cell.
     pub fn new(net: &'a DrapeNet) -> Option<Self> {
-        let bin = 2.0 * net.spacing;
-        let key = |p: &Point| [(p.x / bin).floor() as i64, (p.y / bin).floor() as i64, (p.z / bin).floor() as i64];
         let min_area = MIN_TRIANGLE_AREA_REL * net.spacing * net.spacing;
         let mut triangles = Vec::new();
-        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
         for i in 0..net.nu.saturating_sub(1) {
             for j in 0..net.nv.saturating_sub(1) {
                 if net.cell_corners(i, j).is_none() {
                     continue;
                 }
                 let c = [net.index(i, j), net.index(i + 1, j), net.index(i + 1, j + 1), net.index(i, j + 1)];
-                for (half, tri) in [(0u8, [c[0], c[1], c[2]]), (1, [c[0], c[2], c[3]])] {
-                    let [a, b, d] = tri.map(|k| net.positions[k]);
+                for (half, nodes) in [(0u8, [c[0], c[1], c[2]]), (1, [c[0], c[2], c[3]])] {
+                    let corners = nodes.map(|k| net.positions[k]);
+                    let [a, b, d] = corners;
                     // Collapsed halves (a folded or locked cell) carry no area to find.
                     if (b - a).cross(&(d - a)).norm() <= min_area {
                         continue;
                     }
-                    let lo = key(&Point::from(a.coords.inf(&b.coords).inf(&d.coords)));
-                    let hi = key(&Point::from(a.coords.sup(&b.coords).sup(&d.coords)));
-                    for x in lo[0]..=hi[0] {
-                        for y in lo[1]..=hi[1] {
-                            for z in lo[2]..=hi[2] {
-                                grid.entry([x, y, z]).or_default().push(triangles.len() as u32);
-                            }
-                        }
-                    }
-                    triangles.push((tri, (i, j, half)));
+                    let number = triangles.len() as u32;
+                    triangles.push(HalfCell { number, nodes, corners, cell: (i, j, half) });
                 }
             }
         }
-        (!triangles.is_empty()).then_some(NetSampler { net, triangles, grid, bin })
+        (!triangles.is_empty()).then(|| NetSampler { net, tree: RTree::bulk_load(triangles) })
     }
 
     /// The net at its closest point to `p`, if the net comes within `radius` of `p`.
     pub fn nearest_within(&self, p: &Point, radius: f64) -> Option<NetSample> {
         let net = self.net;
-        let lo = ((p.coords - Vector::repeat(radius)) / self.bin).map(f64::floor);
-        let hi = ((p.coords + Vector::repeat(radius)) / self.bin).map(f64::floor);
-        let mut best: Option<(f64, u32, Point)> = None;
-        for x in lo.x as i64..=hi.x as i64 {
-            for y in lo.y as i64..=hi.y as i64 {
-                for z in lo.z as i64..=hi.z as i64 {
-                    for &t in self.grid.get(&[x, y, z]).map_or(&[][..], Vec::as_slice) {
-                        let [a, b, c] = self.triangles[t as usize].0.map(|k| net.positions[k]);
-                        let q = closest_point_on_triangle(p, &a, &b, &c);
-                        let d2 = (q - p).norm_squared();
-                        // Ties go to the lower triangle number, so the answer does not depend on
-                        // the order the grid lists them in.
-                        if best.is_none_or(|(bd, bt, _)| d2 < bd || (d2 == bd && t < bt)) {
-                            best = Some((d2, t, q));
-                        }
-                    }
-                }
+        // The nearest triangles come first; of those at the same distance, the lowest number.
+        let mut best: Option<(f64, &HalfCell)> = None;
+        for (t, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&[p.x, p.y, p.z]) {
+            match best {
+                Some((bd, _)) if d2 > bd => break,
+                Some((_, bt)) if t.number > bt.number => {}
+                _ => best = Some((d2, t)),
             }
         }
-        let (d2, t, x) = best?;
+        let (d2, half) = best?;
+        let x = half.closest_point(p);
+        let ([k0, k1, k2], (i, j, half)) = (half.nodes, half.cell);
         if d2 > radius * radius {
             return None;
         }
-        let ([k0, k1, k2], (i, j, half)) = self.triangles[t as usize];
         // Parameters of p's projection onto the triangle's plane, not clamped: a point over the
         // net lies inside its cell up to the kink between neighbouring facets; one beyond the
         // net's edge lies outside a cell that has no neighbour on that side.
