@@ -143,8 +143,9 @@ pub fn nest(patterns: &[FlatPattern], roll_width: f64, gap: f64, rotation: Rotat
                 continue;
             }
             for s in &sky {
-                let y = s.y0.min(roll_width - wide); // the last stretch may start the piece lower
-                                                     // The piece and its clearance on the +y side; pieces below keep theirs.
+                // The last stretch may start the piece lower.
+                let y = s.y0.min(roll_width - wide);
+                // The piece and its clearance on the +y side; pieces below keep theirs.
                 let top = (y + wide + gap).min(roll_width);
                 let x = sky.iter().filter(|o| o.y1 > y && o.y0 < top).map(|o| o.x).fold(0.0, f64::max);
                 let cand = (x + along, x, y, t);
