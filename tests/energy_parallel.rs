@@ -88,8 +88,9 @@ fn solver_objective_splits_internal_forces_and_loads() {
     let grid = holed_grid(12, 9);
     let x = perturbed(&grid, 0.3, 0.05, 14);
     let model: Model = full(&grid, &m);
-    let ev = model.evaluate(&x, Some(HessianKind::Convex));
-    // The solver's view of the same model: gravity as constant nodal loads.
+    let ev = model.evaluate(&x, Some(HessianKind::Exact));
+    // The solver's view of the same model: gravity as constant nodal loads, the exact Hessian
+    // (and the convex one on request).
     let objective = NetObjective::new(grid.clone(), &m, Vector::new(0.3, -1.0, -9.81));
     let ob = Objective::evaluate(&objective, &x, true);
     assert!((ob.energy - ev.energy).abs() <= 1e-13 * ev.energy.abs());
@@ -102,7 +103,10 @@ fn solver_objective_splits_internal_forces_and_loads() {
     }
     let h = ev.hessian.unwrap();
     let blocks = ob.hessian.unwrap();
+    let convex = model.evaluate(&x, Some(HessianKind::Convex)).hessian.unwrap();
+    let convex_blocks = objective.convex_hessian(&x).unwrap();
     for (a, b) in objective.coupled_pairs() {
         assert_eq!(blocks.block(a, b), h.block(a, b));
+        assert_eq!(convex_blocks.block(a, b), convex.block(a, b));
     }
 }

@@ -48,7 +48,7 @@ proptest! {
             if r.net.status[k] == NodeStatus::Placed {
                 let p = r.net.positions[k];
                 let sp = tool().closest_point(&p);
-                prop_assert!(sp.normal.dot(&(p - sp.point)) > -1e-9, "node {} inside the tool", k);
+                prop_assert!(sp.normal.dot(&(p - sp.point)) > -1e-9, "node {} inside the tool by {:e} at {}", k, sp.normal.dot(&(p - sp.point)), p);
             }
         }
     }

@@ -5,6 +5,7 @@ use drape::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, NodeStatus};
 use drape::material::MaterialCard;
 use drape::mechanics::refine::{refine, RefineSettings};
+use drape::mechanics::solver::MAX_STEP_SPACINGS;
 use drape::mechanics::{ContactMode, SolverSettings};
 use std::path::Path;
 
@@ -42,7 +43,13 @@ fn pressed_refinement_stays_on_the_tool_keeps_fibre_lengths_and_lowers_the_energ
     let tool = shapes::hemisphere_with_triangles(0.1, 20_000).into_surface().unwrap();
     let net = hemisphere_net(&tool, 31);
     let glass = card("glass-plain-weave.toml");
-    let r = refine(&net, &tool, &glass, &RefineSettings::default()).unwrap();
+    // The kinematic net is symmetric (warp and weft alike on a sphere) and so sits on a saddle
+    // of the energy: within 2e-4 of balance in 5 iterations, it then twists off it (the ply
+    // turns about its seed by about half a spacing at the rim) to the stable equilibrium, which
+    // takes a few hundred iterations.
+    let settings =
+        RefineSettings { solver: SolverSettings::default().max_iterations(600), ..RefineSettings::default() };
+    let r = refine(&net, &tool, &glass, &settings).unwrap();
     assert!(r.ok(), "{:?}", r.outcome());
     assert!(r.energy_final <= r.energy_kinematic, "{} > {}", r.energy_final, r.energy_kinematic);
     // Every node on the tool's smooth patches, and so nearer the true sphere than the facets are
@@ -54,26 +61,49 @@ fn pressed_refinement_stays_on_the_tool_keeps_fibre_lengths_and_lowers_the_energ
             0.1 - ((c[0].coords + c[1].coords + c[2].coords) / 3.0).norm()
         })
         .fold(0.0, f64::max);
+    let rim_band = 2.0
+        * (0..tool.num_triangles() as u32)
+            .map(|t| {
+                let c = tool.corners(t);
+                (c[1] - c[0]).norm().max((c[2] - c[1]).norm()).max((c[0] - c[2]).norm())
+            })
+            .fold(0.0, f64::max);
     for k in 0..r.net.positions.len() {
         if r.net.status[k] == NodeStatus::Placed {
             let p = r.net.positions[k];
             assert!((smooth.project(&p).point - p).norm() < 1e-12, "node {k} off the tool");
-            assert!(
-                (p.coords.norm() - 0.1).abs() < facet_depth / 10.0,
-                "node {k}: {} from the sphere",
-                p.coords.norm() - 0.1
-            );
+            if p.z >= rim_band {
+                assert!(
+                    (p.coords.norm() - 0.1).abs() < facet_depth / 10.0,
+                    "node {k}: {} from the sphere",
+                    p.coords.norm() - 0.1
+                );
+            } else if p.z >= 0.0 {
+                // Within two facets of the open rim the smooth surface sees the tool on one side
+                // only (its vertex normals there lean inwards): 4.6 times closer to the sphere than
+                // the facets there, against 150 times inside (measured on this tool).
+                assert!(
+                    (p.coords.norm() - 0.1).abs() < facet_depth / 4.0,
+                    "node {k}: {} from the sphere",
+                    p.coords.norm() - 0.1
+                );
+            } else {
+                // Nodes the fabric pulls over the tool's open rim are held by it from the next
+                // step on, but one step (at most MAX_STEP_SPACINGS) can carry them past it, onto
+                // the smooth continuation of the surface (measured: 0.1 spacing here).
+                assert!(p.z > -MAX_STEP_SPACINGS * net.spacing, "node {k} is {} below the rim", -p.z);
+            }
         }
     }
     // Stiff fibres (8e6 N/m against a shear stiffness of 5 N/m): lengths stay within 1e-4.
     assert!(max_strain(&r.net) < 1e-4, "{}", max_strain(&r.net));
-    // The origin node is held.
+    // The origin node is held, where the kinematic net put it, moved onto the smooth surface.
     let k0 = net.index(net.origin_node.0, net.origin_node.1);
-    assert_eq!(r.net.positions[k0], net.positions[k0]);
+    assert_eq!(r.net.positions[k0], smooth.project(&net.positions[k0]).point);
     // Refining the refined net again finds it at equilibrium: the nodes stay and the energy
     // does not fall (its convergence was not measured against forces that only moving the
     // nodes onto the smooth tool created).
-    let again = refine(&r.net, &tool, &glass, &RefineSettings::default()).unwrap();
+    let again = refine(&r.net, &tool, &glass, &settings).unwrap();
     assert!(again.ok(), "{:?}", again.outcome());
     assert!(again.energy_final > r.energy_final * (1.0 - 1e-8), "{} -> {}", r.energy_final, again.energy_final);
     let moved = again.net.positions.iter().zip(&r.net.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);

@@ -1,57 +1,114 @@
-//! [`SmoothSurface`]: the tool's facets replaced by curved quadratic patches (Phong tessellation
-//! with shape factor 1/2) for pressed contact.
+//! [`SmoothSurface`]: the smooth part a faceted tool stands for, as an implicit surface whose
+//! normal turns continuously (G1, in fact C2) across the facets' edges, with the tool's sharp
+//! edges kept sharp.
 //!
-//! A faceted tool is a tessellation of a smooth part. Nodes pressed onto the facets themselves see
-//! a kink of about h/R at every edge (h the facet size, R the radius of curvature), and a net
-//! finer than the facets then crawls from crease to crease instead of settling (each node can
-//! lower the energy a little by sliding over an edge). The patches here interpolate the vertices
-//! and their normals, agree along shared edges (so the surface has no cracks) and leave a kink of
-//! only about (h/R)^2 between neighbouring patches. Edges sharper than [`CREASE_ANGLE_DEG`] stay
-//! straight and sharp, and vertex normals are averaged only within the smooth sector of each
-//! corner, so flat faces stay flat and sharp tool edges stay sharp.
+//! Why: a faceted tool is a tessellation of a smooth part. Nodes sliding on the facets see a kink
+//! of about h/R at every edge (h the facet size, R the radius of curvature), and curved patches
+//! through the vertices (Phong, PN, Nagata) still leave a kink of about (h/R)^2 between
+//! neighbours. A stiff fibre stretched over such a kink turns each step a node takes across it
+//! into an error of first order in the step, multiplied by the fibre's rigidity: the net crawls
+//! instead of settling (measured on the double dome, whose 70-degree walls are tessellated in
+//! steps of 27 degrees). A surface whose normal is continuous has no such kinks.
+//!
+//! The construction: every vertex has one *sector* per smooth fan of facets around it (facets
+//! joined across edges sharper than [`CREASE_ANGLE_DEG`] belong to different sectors), with the
+//! angle-weighted normal of its facets and a curvature tensor fitted to the normals of its
+//! neighbouring sectors (Weingarten: dn = K dx in the tangent plane). Each sector s carries the
+//! local quadric `q_s(p) = n_s . (p - x_s) + 1/2 (p - x_s)^T K_s (p - x_s)` (the signed distance to
+//! the surface to second order) and a compactly supported weight `w_s(p) = phi(|p - x_s| / h_s)`
+//! (Wendland's C2 function, h_s one and a half times the longest edge of its facets, so every
+//! point of a facet is inside the support of its three corners). The surface is the zero set of
+//! the partition of unity `f(p) = sum w_s q_s / sum w_s` over the sectors of one *region*: the
+//! facets joined by smooth edges. Flat regions are reproduced exactly (all quadrics are the same
+//! plane), a sphere to third order in h; a sharp edge is where two regions meet, each point
+//! taking the region of its closest facet.
 use super::surface::ToolSurface;
 use super::{Point, Vector, NO_NEIGHBOUR};
+use nalgebra::{Matrix2, Matrix3, Vector2};
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
-/// Edges whose facets meet at more than this angle (between normals) are sharp tool edges: they
-/// stay straight and the patches on either side do not share vertex normals across them.
+/// Edges whose facets meet at more than this angle (between normals) are sharp tool edges: the
+/// smooth surface keeps them sharp (the facets on either side belong to different regions).
 pub const CREASE_ANGLE_DEG: f64 = 35.0;
 
-/// Phong shape factor: 1/2 reproduces a circular arc's sagitta and end tangents to leading order
-/// (1 would bulge twice as far; 0 is the flat facet).
-pub const PATCH_SHAPE_FACTOR: f64 = 0.5;
+/// A sector's support radius over the longest edge of its facets (at least 1, so every point of
+/// a facet is inside the support of its corners; more overlap makes the blend smoother).
+const SUPPORT_OVER_EDGE: f64 = 1.5;
+/// The projection stops when |f| falls below this fraction of the tool's bounding-box diagonal.
+const PROJECTION_TOLERANCE_REL: f64 = 1e-14;
+/// At most this many Newton steps of the projection (it converges quadratically: 2-4 suffice).
+const PROJECTION_MAX_ITERATIONS: usize = 20;
+/// A query counts as beyond an open edge when it is off it outwards by more than this fraction
+/// of the tool's bounding-box diagonal.
+const BOUNDARY_TOLERANCE_REL: f64 = 1e-12;
+/// Relative ridge added to the curvature fit (sectors with too few neighbours fit flat).
+const CURVATURE_FIT_RIDGE: f64 = 1e-6;
 
-/// The projection's fixed-point iteration stops when the patch offset changes by less than this
-/// fraction of the tool's bounding-box diagonal.
-const PROJECTION_TOLERANCE_REL: f64 = 1e-13;
-/// At most this many fixed-point iterations (the contraction rate is about h/R, so 3-4 suffice).
-const PROJECTION_MAX_ITERATIONS: usize = 12;
-
-/// A point on the smooth surface: where it is, over which facet (and where on it), and the
+/// A point on the smooth surface: where it is, the facet nearest to it (and where on it), and the
 /// surface's unit normal there (on the tool's outer side, like the facet normals).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SmoothPoint {
-    /// The point on the patches.
+    /// The point on the smooth surface.
     pub point: Point,
-    /// The facet it lies over.
+    /// The facet closest to the point.
     pub triangle: u32,
-    /// Barycentric coordinates on the facet.
+    /// Barycentric coordinates of the point's foot on that facet.
     pub barycentric: [f64; 3],
-    /// Unit normal of the patch there.
+    /// Unit normal of the surface there.
     pub normal: Vector,
+    /// The region (facets joined by smooth edges) whose surface the point is on.
+    pub region: u32,
+    /// The query point lay beyond the tool's open boundary: its closest facet point is on an
+    /// open edge and it is off that edge outwards (the implicit surface runs on smoothly past
+    /// the edge; pressed nodes are held back by the edge, free contact ends there).
+    pub beyond_boundary: bool,
 }
 
-/// The tool with curved patches over its facets.
+/// One smooth fan of facets around a vertex, with its local quadric.
+#[derive(Debug, Clone)]
+struct Sector {
+    x: Point,
+    n: Vector,
+    /// Curvature tensor in the tangent plane, lifted to 3-D (K n = 0).
+    k: Matrix3<f64>,
+    /// Support radius.
+    h: f64,
+    region: u32,
+}
+
+/// The tool's smooth surface (see the module docs).
 pub struct SmoothSurface<'a> {
     tool: &'a ToolSurface,
-    /// Per facet, the offset vector of each edge (edge k runs between corners k+1 and k+2),
-    /// already multiplied by the shape factor; zero on sharp edges.
-    edge_offsets: Vec<[Vector; 3]>,
-    /// Number of sharp (crease) edges, each counted once.
+    sectors: Vec<Sector>,
+    /// Region of each facet.
+    regions: Vec<u32>,
+    /// Bounding boxes of the sectors' supports.
+    bvh: Bvh,
     creases: usize,
 }
 
+/// Wendland's C2 function on [0, 1] and its derivative: (1 - r)^4 (4 r + 1).
+#[inline]
+fn wendland(r: f64) -> (f64, f64) {
+    if r >= 1.0 {
+        return (0.0, 0.0);
+    }
+    let s = 1.0 - r;
+    let s3 = s * s * s;
+    (s3 * s * (4.0 * r + 1.0), -20.0 * r * s3)
+}
+
+fn root(parent: &mut [usize], mut a: usize) -> usize {
+    while parent[a] != a {
+        parent[a] = parent[parent[a]];
+        a = parent[a];
+    }
+    a
+}
+
 impl<'a> SmoothSurface<'a> {
-    /// Patches over every facet of `tool`.
+    /// The smooth surface of `tool`.
     pub fn new(tool: &'a ToolSurface) -> Self {
         let tris = tool.triangles();
         let verts = tool.vertices();
@@ -60,15 +117,10 @@ impl<'a> SmoothSurface<'a> {
             let n = tool.neighbours(t as u32)[k];
             (n != NO_NEIGHBOUR && tool.normal(t as u32).dot(&tool.normal(n)) >= cos_crease).then_some(n as usize)
         };
-        // Corners (3 t + k) joined across smooth edges share one vertex normal: union-find.
-        let mut parent: Vec<usize> = (0..3 * tris.len()).collect();
-        fn root(parent: &mut [usize], mut a: usize) -> usize {
-            while parent[a] != a {
-                parent[a] = parent[parent[a]];
-                a = parent[a];
-            }
-            a
-        }
+        // Corners (3 t + c) joined across smooth edges form a sector; facets joined across smooth
+        // edges form a region.
+        let mut corner_parent: Vec<usize> = (0..3 * tris.len()).collect();
+        let mut facet_parent: Vec<usize> = (0..tris.len()).collect();
         let mut creases = 0;
         for t in 0..tris.len() {
             for k in 0..3 {
@@ -79,49 +131,82 @@ impl<'a> SmoothSurface<'a> {
                     }
                     continue;
                 };
+                let (a, b) = (root(&mut facet_parent, t), root(&mut facet_parent, n));
+                facet_parent[a] = b;
                 for c in [(k + 1) % 3, (k + 2) % 3] {
                     let v = tris[t][c];
                     if let Some(cn) = tris[n].iter().position(|&w| w == v) {
-                        let (a, b) = (root(&mut parent, 3 * t + c), root(&mut parent, 3 * n + cn));
-                        parent[a] = b;
+                        let (a, b) = (root(&mut corner_parent, 3 * t + c), root(&mut corner_parent, 3 * n + cn));
+                        corner_parent[a] = b;
                     }
                 }
             }
         }
-        // Angle-weighted sums of facet normals per smooth sector.
-        let mut sums = vec![Vector::zeros(); 3 * tris.len()];
+        let mut region_id = vec![u32::MAX; tris.len()];
+        let mut regions = vec![0u32; tris.len()];
+        let mut next_region = 0;
+        for (t, region) in regions.iter_mut().enumerate() {
+            let r = root(&mut facet_parent, t);
+            if region_id[r] == u32::MAX {
+                region_id[r] = next_region;
+                next_region += 1;
+            }
+            *region = region_id[r];
+        }
+        // Sector ids, positions, angle-weighted normals and supports.
+        let mut sector_of_corner = vec![0usize; 3 * tris.len()];
+        let mut id_of_root = vec![usize::MAX; 3 * tris.len()];
+        let mut sum_normal: Vec<Vector> = Vec::new();
+        let mut sectors: Vec<Sector> = Vec::new();
         for (t, tri) in tris.iter().enumerate() {
             let n = tool.normal(t as u32);
+            let longest =
+                (0..3).map(|c| (verts[tri[(c + 1) % 3] as usize] - verts[tri[c] as usize]).norm()).fold(0.0, f64::max);
             for c in 0..3 {
+                let r = root(&mut corner_parent, 3 * t + c);
+                if id_of_root[r] == usize::MAX {
+                    id_of_root[r] = sectors.len();
+                    sectors.push(Sector {
+                        x: verts[tri[c] as usize],
+                        n: Vector::zeros(),
+                        k: Matrix3::zeros(),
+                        h: 0.0,
+                        region: regions[t],
+                    });
+                    sum_normal.push(Vector::zeros());
+                }
+                let s = id_of_root[r];
+                sector_of_corner[3 * t + c] = s;
                 let p = verts[tri[c] as usize];
                 let (u, v) = (verts[tri[(c + 1) % 3] as usize] - p, verts[tri[(c + 2) % 3] as usize] - p);
-                let angle = u.cross(&v).norm().atan2(u.dot(&v));
-                let r = root(&mut parent, 3 * t + c);
-                sums[r] += n * angle;
+                sum_normal[s] += n * u.cross(&v).norm().atan2(u.dot(&v));
+                sectors[s].h = sectors[s].h.max(SUPPORT_OVER_EDGE * longest);
             }
         }
-        let corner_normal = |parent: &mut [usize], t: usize, c: usize| -> Vector {
-            let r = root(parent, 3 * t + c);
-            sums[r].try_normalize(0.0).unwrap_or_else(|| tool.normal(t as u32))
-        };
-        let mut edge_offsets = Vec::with_capacity(tris.len());
-        for (t, tri) in tris.iter().enumerate() {
-            let normals = [0, 1, 2].map(|c| corner_normal(&mut parent, t, c));
-            let mut offsets = [Vector::zeros(); 3];
-            for (k, offset) in offsets.iter_mut().enumerate() {
-                let n = tool.neighbours(t as u32)[k];
-                if n != NO_NEIGHBOUR && smooth_edge(t, k).is_none() {
-                    continue; // sharp edge: straight
+        for (s, sum) in sectors.iter_mut().zip(&sum_normal) {
+            s.n = sum.try_normalize(0.0).unwrap_or_else(Vector::z);
+        }
+        // Neighbouring sectors: the other corners of each sector's facets.
+        let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); sectors.len()];
+        for t in 0..tris.len() {
+            for c in 0..3 {
+                let s = sector_of_corner[3 * t + c];
+                for o in [(c + 1) % 3, (c + 2) % 3] {
+                    let j = sector_of_corner[3 * t + o];
+                    if !neighbours[s].contains(&j) {
+                        neighbours[s].push(j);
+                    }
                 }
-                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                let e = verts[tri[j] as usize] - verts[tri[i] as usize];
-                // Phong: the two ends' tangent-plane projections of the other end, minus the chord.
-                // Symmetric in i and j, so both facets of an edge compute the same curve.
-                *offset = (normals[j] * e.dot(&normals[j]) - normals[i] * e.dot(&normals[i])) * PATCH_SHAPE_FACTOR;
             }
-            edge_offsets.push(offsets);
         }
-        SmoothSurface { tool, edge_offsets, creases }
+        let ks: Vec<Matrix3<f64>> = (0..sectors.len()).map(|s| fit_curvature(&sectors, s, &neighbours[s])).collect();
+        for (s, k) in sectors.iter_mut().zip(ks) {
+            s.k = k;
+        }
+        let boxes: Vec<Aabb> =
+            sectors.iter().map(|s| Aabb::new(s.x - Vector::repeat(s.h), s.x + Vector::repeat(s.h))).collect();
+        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
+        SmoothSurface { tool, sectors, regions, bvh, creases }
     }
 
     /// The faceted tool underneath.
@@ -129,61 +214,164 @@ impl<'a> SmoothSurface<'a> {
         self.tool
     }
 
-    /// Number of sharp edges kept straight.
+    /// Number of sharp edges kept sharp.
     pub fn creases(&self) -> usize {
         self.creases
     }
 
-    /// Offset of the patch over facet `t` from the facet at barycentric `l`.
-    pub fn offset(&self, t: u32, l: &[f64; 3]) -> Vector {
-        let d = &self.edge_offsets[t as usize];
-        d[0] * (l[1] * l[2]) + d[1] * (l[2] * l[0]) + d[2] * (l[0] * l[1])
+    /// The region (set of facets joined by smooth edges) of facet `t`.
+    pub fn region_of(&self, t: u32) -> u32 {
+        self.regions[t as usize]
     }
 
-    /// The patch point over facet `t` at barycentric `l`.
-    pub fn point(&self, t: u32, l: &[f64; 3]) -> Point {
-        let c = self.tool.corners(t);
-        Point::from(c[0].coords * l[0] + c[1].coords * l[1] + c[2].coords * l[2]) + self.offset(t, l)
+    /// The implicit function of region `region` at `p` and its gradient, or None where no
+    /// sector of the region reaches `p`.
+    pub fn value_and_gradient(&self, region: u32, p: &Point) -> Option<(f64, Vector)> {
+        self.evaluate(region, p, false).map(|(f, g, _)| (f, g))
     }
 
-    /// Unit normal of the patch over facet `t` at barycentric `l` (on the facet normal's side).
-    pub fn normal(&self, t: u32, l: &[f64; 3]) -> Vector {
-        let c = self.tool.corners(t);
-        let d = &self.edge_offsets[t as usize];
-        // Derivatives along l1 and l2 (l0 = 1 - l1 - l2).
-        let ds = (c[1] - c[0]) + d[0] * l[2] - d[1] * l[2] + d[2] * (l[0] - l[1]);
-        let dt = (c[2] - c[0]) + d[0] * l[1] + d[1] * (l[0] - l[2]) - d[2] * l[1];
-        let facet = self.tool.normal(t);
-        match ds.cross(&dt).try_normalize(0.0) {
-            Some(n) if n.dot(&facet) > 0.0 => n,
-            _ => facet,
-        }
+    /// The implicit function of region `region` at `p`, its gradient and its Hessian.
+    pub fn value_gradient_hessian(&self, region: u32, p: &Point) -> Option<(f64, Vector, Matrix3<f64>)> {
+        self.evaluate(region, p, true)
     }
 
-    /// The point of the smooth surface over `q`: the patch point p over facet point f such that
-    /// q - p is along the facet's normal (for q on the surface, q itself). A retraction onto the
-    /// surface, exact to first order, which is what sliding contact needs.
-    pub fn project(&self, q: &Point) -> SmoothPoint {
-        let tol = PROJECTION_TOLERANCE_REL * self.tool.diagonal();
-        let mut foot = self.tool.closest_point(q);
-        let mut l = self.tool.barycentric(foot.triangle, &foot.point);
-        let mut offset = self.offset(foot.triangle, &l);
-        // Fixed point: the facet point under q minus the patch offset there.
-        for _ in 0..PROJECTION_MAX_ITERATIONS {
-            foot = self.tool.closest_point(&(q - offset));
-            l = self.tool.barycentric(foot.triangle, &foot.point);
-            let next = self.offset(foot.triangle, &l);
-            let settled = (next - offset).norm() <= tol;
-            offset = next;
-            if settled {
-                break;
+    /// f = A / W with A = sum w_s q_s and W = sum w_s; derivatives by the quotient rule.
+    fn evaluate(&self, region: u32, p: &Point, hessian: bool) -> Option<(f64, Vector, Matrix3<f64>)> {
+        let (mut w_sum, mut a_sum) = (0.0, 0.0);
+        let (mut dw_sum, mut da_sum) = (Vector::zeros(), Vector::zeros());
+        let (mut hw_sum, mut ha_sum) = (Matrix3::zeros(), Matrix3::zeros());
+        let probe = Aabb::new(*p, *p);
+        for s in self.bvh.intersect_aabb(&probe) {
+            let sec = &self.sectors[s as usize];
+            if sec.region != region {
+                continue;
+            }
+            let d = p - sec.x;
+            let dist = d.norm();
+            let r = dist / sec.h;
+            if r >= 1.0 {
+                continue;
+            }
+            let (w, _) = wendland(r);
+            let kd = sec.k * d;
+            let q = sec.n.dot(&d) + 0.5 * d.dot(&kd);
+            let dq = sec.n + kd;
+            // w = phi(r): grad w = -20 (1 - r)^3 d / h^2 (finite at d = 0).
+            let one = 1.0 - r;
+            let dw = d * (-20.0 * one * one * one / (sec.h * sec.h));
+            w_sum += w;
+            a_sum += w * q;
+            dw_sum += dw;
+            da_sum += dw * q + dq * w;
+            if hessian {
+                // hess w = -20 (1 - r)^3 / h^2 I + 60 (1 - r)^2 / (h^3 |d|) d d^T.
+                let mut hw = Matrix3::identity() * (-20.0 * one * one * one / (sec.h * sec.h));
+                if dist > 0.0 {
+                    hw += d * d.transpose() * (60.0 * one * one / (sec.h * sec.h * sec.h * dist));
+                }
+                hw_sum += hw;
+                ha_sum += hw * q + dw * dq.transpose() + dq * dw.transpose() + sec.k * w;
             }
         }
-        let t = foot.triangle;
-        // Clamp rounding so the point is on the patch over the facet.
-        let l = clamp_barycentric(l);
-        SmoothPoint { point: self.point(t, &l), triangle: t, barycentric: l, normal: self.normal(t, &l) }
+        if w_sum <= 0.0 {
+            return None;
+        }
+        let f = a_sum / w_sum;
+        let grad = (da_sum - dw_sum * f) / w_sum;
+        let hess = if hessian {
+            (ha_sum - hw_sum * f - grad * dw_sum.transpose() - dw_sum * grad.transpose()) / w_sum
+        } else {
+            Matrix3::zeros()
+        };
+        Some((f, grad, hess))
     }
+
+    /// The curvature of the surface at `p` (on it, in region `region`): `C = hess f / |grad f|`,
+    /// so that a point moved by the tangent vector t stays on the surface by moving
+    /// `-1/2 t^T C t` along the normal.
+    pub fn curvature(&self, region: u32, p: &Point) -> Matrix3<f64> {
+        match self.value_gradient_hessian(region, p) {
+            Some((_, g, h)) if g.norm() > 0.0 => h / g.norm(),
+            _ => Matrix3::zeros(),
+        }
+    }
+
+    /// The point of the smooth surface over `q`: reached from `q` (or, far from the surface,
+    /// from its closest facet point) by Newton steps along the implicit function's gradient. For
+    /// `q` on the surface, `q` itself. A retraction onto the surface, exact to first order, which
+    /// is what sliding contact needs.
+    pub fn project(&self, q: &Point) -> SmoothPoint {
+        let foot = self.tool.closest_point(q);
+        let region = self.regions[foot.triangle as usize];
+        let l = self.tool.barycentric(foot.triangle, &foot.point);
+        let off = q - foot.point;
+        let beyond_boundary = self.tool.open_edges_at(foot.triangle, &l).iter().flatten().any(|m| {
+            let tangential = off - foot.normal * foot.normal.dot(&off);
+            tangential.dot(m) > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
+        });
+        let start = if self.value_and_gradient(region, q).is_some() { *q } else { foot.point };
+        let tol = PROJECTION_TOLERANCE_REL * self.tool.diagonal();
+        let mut p = start;
+        let mut normal = foot.normal;
+        for _ in 0..PROJECTION_MAX_ITERATIONS {
+            let Some((f, g)) = self.value_and_gradient(region, &p) else { break };
+            let g2 = g.norm_squared();
+            if g2 <= 0.0 {
+                break;
+            }
+            normal = g / g2.sqrt();
+            if f.abs() <= tol {
+                break;
+            }
+            p -= g * (f / g2);
+        }
+        let at = self.tool.closest_point(&p);
+        let l = self.tool.barycentric(at.triangle, &at.point);
+        SmoothPoint {
+            point: p,
+            triangle: at.triangle,
+            barycentric: clamp_barycentric(l),
+            normal,
+            region,
+            beyond_boundary,
+        }
+    }
+}
+
+/// The curvature tensor of sector `s` fitted to its neighbours' normals: in the tangent frame
+/// (t1, t2) of n_s, the tangential change of the normal to each neighbour j is K times the
+/// tangential offset (Weingarten), weighted least squares over the neighbours; lifted to 3-D.
+fn fit_curvature(sectors: &[Sector], s: usize, neighbours: &[usize]) -> Matrix3<f64> {
+    let sec = &sectors[s];
+    let n = sec.n;
+    let helper = if n.x.abs() < 0.6 { Vector::x() } else { Vector::y() };
+    let t1 = n.cross(&helper).normalize();
+    let t2 = n.cross(&t1);
+    // Unknowns (a, b, c) of K = [[a, b], [b, c]]: rows (u1, u2, 0) . = dn1 and (0, u1, u2) . = dn2.
+    let mut ata = Matrix3::<f64>::zeros();
+    let mut atb = nalgebra::Vector3::<f64>::zeros();
+    for &j in neighbours {
+        let o = &sectors[j];
+        let d = o.x - sec.x;
+        let u = Vector2::new(t1.dot(&d), t2.dot(&d));
+        let len2 = u.norm_squared();
+        if len2 <= 0.0 {
+            continue;
+        }
+        let dn = o.n - n;
+        let w = 1.0 / len2; // each neighbour counts as a direction, whatever its distance
+        for (row, rhs) in
+            [(nalgebra::Vector3::new(u.x, u.y, 0.0), t1.dot(&dn)), (nalgebra::Vector3::new(0.0, u.x, u.y), t2.dot(&dn))]
+        {
+            ata += row * row.transpose() * w;
+            atb += row * (rhs * w);
+        }
+    }
+    let ridge = CURVATURE_FIT_RIDGE * ata.trace().max(f64::MIN_POSITIVE);
+    let Some(abc) = (ata + Matrix3::identity() * ridge).lu().solve(&atb) else { return Matrix3::zeros() };
+    let k2 = Matrix2::new(abc.x, abc.y, abc.y, abc.z);
+    let frame = nalgebra::Matrix3x2::from_columns(&[t1, t2]);
+    frame * k2 * frame.transpose()
 }
 
 /// Barycentric coordinates made non-negative and summing to one.
@@ -206,67 +394,43 @@ mod tests {
     fn a_flat_plate_stays_flat() {
         let tool = shapes::plate(2.0, 1.0, 6, 3).into_surface().unwrap();
         let smooth = SmoothSurface::new(&tool);
-        for q in [Point::new(0.3, 0.2, 0.5), Point::new(-0.7, 0.1, -0.2)] {
+        for q in [Point::new(0.3, 0.2, 0.5), Point::new(-0.7, 0.1, -0.2), Point::new(0.31, -0.17, 0.0)] {
             let s = smooth.project(&q);
-            assert!((s.point - Point::new(q.x, q.y, 0.0)).norm() < 1e-14, "{}", s.point);
-            assert!((s.normal - tool.normal(s.triangle)).norm() < 1e-14);
+            assert!((s.point - Point::new(q.x, q.y, 0.0)).norm() < 1e-13, "{}", s.point);
+            assert!((s.normal - tool.normal(s.triangle)).norm() < 1e-13);
         }
     }
 
     #[test]
-    fn hemisphere_patches_follow_the_sphere_far_closer_than_the_facets() {
+    fn hemisphere_surface_follows_the_sphere_far_closer_than_the_facets() {
         let r = 1.0;
         let tool = shapes::hemisphere(r, 12).into_surface().unwrap();
         let smooth = SmoothSurface::new(&tool);
-        let (mut facet_err, mut patch_err, mut facet_angle, mut patch_angle) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        let (mut facet_err, mut smooth_err, mut facet_angle, mut smooth_angle) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         for i in 0..40 {
             for j in 0..40 {
-                let (theta, phi) = (1.4 * i as f64 / 39.0, std::f64::consts::TAU * j as f64 / 40.0);
+                let (theta, phi) = (1.3 * i as f64 / 39.0, std::f64::consts::TAU * j as f64 / 40.0);
                 let q = Point::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()) * r;
                 let f = tool.closest_point(&q);
                 let s = smooth.project(&q);
                 facet_err = facet_err.max(r - f.point.coords.norm());
-                patch_err = patch_err.max((s.point.coords.norm() - r).abs());
+                smooth_err = smooth_err.max((s.point.coords.norm() - r).abs());
                 facet_angle = facet_angle.max(f.normal.angle(&f.point.coords));
-                patch_angle = patch_angle.max(s.normal.angle(&s.point.coords));
+                smooth_angle = smooth_angle.max(s.normal.angle(&s.point.coords));
                 // Points on the surface project onto themselves.
                 let again = smooth.project(&s.point);
                 assert!((again.point - s.point).norm() < 1e-12, "{} vs {}", again.point, s.point);
             }
         }
-        assert!(patch_err < facet_err / 8.0, "patch {patch_err:e} facet {facet_err:e}");
-        assert!(patch_angle < facet_angle / 4.0, "patch {patch_angle:e} facet {facet_angle:e}");
-    }
-
-    /// Points at parameters along every shared edge, seen from both of its facets.
-    fn assert_no_cracks(tool: &ToolSurface, smooth: &SmoothSurface) {
-        let tris = tool.triangles();
-        for t in 0..tris.len() as u32 {
-            for k in 0..3 {
-                let Some(n) = tool.neighbour(t, k) else { continue };
-                let (a, b) = (tris[t as usize][(k + 1) % 3], tris[t as usize][(k + 2) % 3]);
-                for s in [0.25, 0.5, 0.8] {
-                    let bary = |tri: [u32; 3]| {
-                        tri.map(|v| {
-                            if v == a {
-                                1.0 - s
-                            } else if v == b {
-                                s
-                            } else {
-                                0.0
-                            }
-                        })
-                    };
-                    let p = smooth.point(t, &bary(tris[t as usize]));
-                    let q = smooth.point(n, &bary(tris[n as usize]));
-                    assert!((p - q).norm() < 1e-12 * tool.diagonal(), "crack between {t} and {n}");
-                }
-            }
-        }
+        println!("sphere: smooth {smooth_err:e} facet {facet_err:e} angles {smooth_angle:e} {facet_angle:e}");
+        assert!(smooth_err < facet_err / 8.0, "smooth {smooth_err:e} facet {facet_err:e}");
+        assert!(smooth_angle < facet_angle / 4.0, "smooth {smooth_angle:e} facet {facet_angle:e}");
     }
 
     #[test]
-    fn patches_meet_without_cracks() {
+    fn the_normal_turns_continuously_across_facet_edges() {
+        // Along a line crossing many edges of the double dome's coarse walls, the normal of the
+        // smooth surface changes by a small angle per small step: no kinks.
         let tool = crate::io::read_tool(
             std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/geometries/double-dome/double-dome.obj")),
             1.0,
@@ -274,11 +438,30 @@ mod tests {
         .unwrap();
         let smooth = SmoothSurface::new(&tool);
         assert_eq!(smooth.creases(), 0, "no edge of the double dome is sharper than the crease angle");
-        assert_no_cracks(&tool, &smooth);
+        let steps = 4000;
+        let mut worst_rate = 0.0f64;
+        let mut previous: Option<SmoothPoint> = None;
+        for k in 0..=steps {
+            // Across the wall and both fillets at the body's side (y from 0 to 0.12 m).
+            let y = 0.12 * k as f64 / steps as f64;
+            let q = Point::new(0.013, y, 0.1);
+            let s = smooth.project(&tool.closest_point(&q).point);
+            if let Some(p) = previous {
+                let ds = (s.point - p.point).norm();
+                if ds > 0.0 {
+                    worst_rate = worst_rate.max(s.normal.angle(&p.normal) / ds);
+                }
+            }
+            previous = Some(s);
+        }
+        // The fillets' radius is 0.015 m: the normal turns at about 1/0.015 = 67 rad/m there. A
+        // kink would show as a rate of (kink angle) / (step of 3e-5 m), thousands of rad/m.
+        println!("worst rate {worst_rate}");
+        assert!(worst_rate < 300.0, "the normal turns at up to {worst_rate} rad/m");
     }
 
     #[test]
-    fn sharp_edges_stay_straight_and_their_faces_flat() {
+    fn sharp_edges_stay_sharp_and_their_faces_flat() {
         // A plate folded by 90 degrees along y = 0 (an L in the x-z plane), 4 x 4 facets a side.
         let n = 4;
         let mut vertices = Vec::new();
@@ -299,12 +482,16 @@ mod tests {
         let tool = ToolSurface::from_triangles(vertices, triangles).unwrap();
         let smooth = SmoothSurface::new(&tool);
         assert_eq!(smooth.creases(), n, "the fold's edges are sharp");
-        assert_no_cracks(&tool, &smooth);
-        for q in [Point::new(-0.01, 0.37, 0.3), Point::new(-0.6, 0.5, 0.1), Point::new(0.2, 0.3, 0.5)] {
+        for q in [
+            Point::new(-0.01, 0.37, 0.3),
+            Point::new(-0.6, 0.5, 0.1),
+            Point::new(0.2, 0.3, 0.5),
+            Point::new(-0.001, 0.5, 0.002),
+        ] {
             let s = smooth.project(&q);
             let f = tool.closest_point(&q);
-            assert!((s.point - f.point).norm() < 1e-14, "{} vs {}", s.point, f.point);
-            assert!((s.normal - f.normal).norm() < 1e-14);
+            assert!((s.point - f.point).norm() < 1e-13, "{} vs {}", s.point, f.point);
+            assert!((s.normal - f.normal).norm() < 1e-13);
         }
     }
 }
