@@ -95,9 +95,9 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         let refined = pool.install(|| refine(&net, &tool, &material, &refine_settings)).map_err(input)?;
         let total = t.elapsed().as_secs_f64();
         let iterations: Vec<_> = refined.steps.iter().flat_map(|s| s.iterations.iter()).collect();
-        let qp: u32 = iterations.iter().map(|i| i.qp_iterations).sum();
+        let qp: u32 = iterations.iter().map(|i| i.subproblems).sum();
         println!(
-            "refinement (pressed, {}): {} placed nodes, {:?} after {} iterations ({} Clarabel iterations) in {:.2} s, {:.0} ms per iteration; |F-P|/|P| {:.1e}",
+            "refinement (pressed, {}): {} placed nodes, {:?} after {} iterations ({} Clarabel subproblems) in {:.2} s, {:.0} ms per iteration; |F-P|/|P| {:.1e}",
             card.display(),
             placed_nodes(&net),
             refined.outcome(),

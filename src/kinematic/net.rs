@@ -36,11 +36,15 @@ pub enum NodeStatus {
     ParentMissing = 7,
     /// Outside the ply outline: dropped.
     OutsideOutline = 8,
+    /// Placed by the kinematic drape, but joined to the body of the net by no more than a
+    /// corner (a mechanism: it could swing about that corner at no cost): left out of the
+    /// mechanical result.
+    Detached = 9,
 }
 
 impl NodeStatus {
     /// All statuses, in code order.
-    pub const ALL: [NodeStatus; 9] = [
+    pub const ALL: [NodeStatus; 10] = [
         NodeStatus::Placed,
         NodeStatus::Pending,
         NodeStatus::OffTool,
@@ -50,6 +54,7 @@ impl NodeStatus {
         NodeStatus::SheetJump,
         NodeStatus::ParentMissing,
         NodeStatus::OutsideOutline,
+        NodeStatus::Detached,
     ];
     /// Snake-case name used in files and summaries.
     pub fn name(self) -> &'static str {
@@ -63,6 +68,7 @@ impl NodeStatus {
             NodeStatus::SheetJump => "sheet_jump",
             NodeStatus::ParentMissing => "parent_missing",
             NodeStatus::OutsideOutline => "outside_outline",
+            NodeStatus::Detached => "detached",
         }
     }
     /// Status from its numeric code.

@@ -1,5 +1,6 @@
-//! Contact with the tool and fixed nodes, as per-node bases of allowed motion (pressed contact
-//! and fixed directions) and linearised one-sided constraints (free contact).
+//! Contact with the tool and fixed nodes, as per-node bases of allowed motion: pressed nodes slide
+//! on the tool, free nodes touching it and pushed into it slide on it for a step (one-sided
+//! contact as an active set), held nodes keep some directions fixed.
 use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use nalgebra::Matrix3;
 
@@ -13,26 +14,77 @@ pub struct Foot {
     pub normal: Vector,
     /// Outward directions of the tool's open (boundary) edges the point lies on.
     pub open_edges: [Option<Vector>; 2],
+    /// Signed distance of the query point from the surface along `normal` (negative inside).
+    pub gap: f64,
+    /// The surface's curvature there: a point moved by a tangent vector t stays on the surface
+    /// by moving `-1/2 t^T curvature t` along the normal (zero on flat facets).
+    pub curvature: Matrix3<f64>,
 }
 
 /// A surface the nodes are held against (pressed) or kept out of (free).
 pub trait ContactSurface: Sync {
     /// Where `p` meets the surface.
     fn locate(&self, p: &Point) -> Foot;
+    /// Where `p` meets the surface if it is within `range` of it (a cheap test first).
+    fn locate_near(&self, p: &Point, range: f64) -> Option<Foot>;
 }
 
 impl ContactSurface for ToolSurface {
     fn locate(&self, p: &Point) -> Foot {
         let s = self.closest_point(p);
         let l = self.barycentric(s.triangle, &s.point);
-        Foot { point: s.point, normal: s.normal, open_edges: self.open_edges_at(s.triangle, &l) }
+        Foot {
+            point: s.point,
+            normal: s.normal,
+            open_edges: self.open_edges_at(s.triangle, &l),
+            gap: s.normal.dot(&(p - s.point)),
+            curvature: Matrix3::zeros(),
+        }
+    }
+    fn locate_near(&self, p: &Point, range: f64) -> Option<Foot> {
+        let foot = self.locate(p);
+        ((p - foot.point).norm() <= range).then_some(foot)
     }
 }
 
 impl ContactSurface for SmoothSurface<'_> {
     fn locate(&self, p: &Point) -> Foot {
         let s = self.project(p);
-        Foot { point: s.point, normal: s.normal, open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric) }
+        Foot {
+            point: s.point,
+            normal: s.normal,
+            open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric),
+            gap: s.normal.dot(&(p - s.point)),
+            curvature: self.curvature(s.region, &s.point),
+        }
+    }
+    fn locate_near(&self, p: &Point, range: f64) -> Option<Foot> {
+        // The surface stays within a sagitta of the facets: test against the facets first.
+        let facet = self.tool().closest_point(p);
+        if facet.distance > 2.0 * range {
+            return None;
+        }
+        let s = self.project(p);
+        if s.beyond_boundary {
+            // Past the tool's open edge the nearest tool is the edge itself: the point is
+            // outside, at its distance from the edge.
+            let normal = (p - facet.point).try_normalize(0.0).unwrap_or(facet.normal);
+            let l = self.tool().barycentric(facet.triangle, &facet.point);
+            return Some(Foot {
+                point: facet.point,
+                normal,
+                open_edges: self.tool().open_edges_at(facet.triangle, &l),
+                gap: facet.distance,
+                curvature: Matrix3::zeros(),
+            });
+        }
+        Some(Foot {
+            point: s.point,
+            normal: s.normal,
+            open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric),
+            gap: s.normal.dot(&(p - s.point)),
+            curvature: self.curvature(s.region, &s.point),
+        })
     }
 }
 
@@ -51,9 +103,9 @@ pub enum ContactMode {
 /// `basis`); 0 = fixed, 2 = sliding on the tool, 3 = free.
 #[derive(Debug, Clone, Copy)]
 pub struct NodeBasis {
-    /// How many directions: 0 fixed, 2 sliding, 3 free.
+    /// How many directions: 0 fixed, 1 a line, 2 a plane, 3 free.
     pub dofs: usize,
-    /// The directions, as columns.
+    /// The directions, as columns (the first `dofs` are free).
     pub basis: Matrix3<f64>,
 }
 
@@ -78,6 +130,30 @@ impl NodeBasis {
         let t = t.normalize();
         let (a, b) = tangent_pair(&t);
         NodeBasis { dofs: 1, basis: Matrix3::from_columns(&[t, a, b]) }
+    }
+
+    /// The directions of this basis that do not move along `n` (unit): the basis with `n`
+    /// projected out (a free node on the tool's tangent plane, a node in a plane on the line
+    /// where that plane meets the tangent plane, a line along the normal: fixed).
+    pub fn without(&self, n: &Vector) -> NodeBasis {
+        let mut kept: Vec<Vector> = Vec::with_capacity(3);
+        for k in 0..self.dofs {
+            let mut v = self.dir(k) - n * n.dot(&self.dir(k));
+            for u in &kept {
+                v -= u * u.dot(&v);
+            }
+            if let Some(v) = v.try_normalize(1e-9) {
+                kept.push(v);
+            }
+        }
+        match kept.as_slice() {
+            [] => NodeBasis::FIXED,
+            [t] => NodeBasis::line(t),
+            [a, b, ..] => {
+                let c = a.cross(b);
+                NodeBasis { dofs: 2, basis: Matrix3::from_columns(&[*a, *b, c]) }
+            }
+        }
     }
 
     /// Column k of the basis.
@@ -126,8 +202,15 @@ impl Freedom {
     /// along the edge, or stays put at a corner): the tool ends, and a pressed ply does not
     /// leave it.
     pub fn basis(&self, foot: Option<&Foot>, descent: &Vector) -> NodeBasis {
-        let foot =
-            || foot.copied().unwrap_or(Foot { point: Point::origin(), normal: Vector::z(), open_edges: [None; 2] });
+        let foot = || {
+            foot.copied().unwrap_or(Foot {
+                point: Point::origin(),
+                normal: Vector::z(),
+                open_edges: [None; 2],
+                gap: 0.0,
+                curvature: Matrix3::zeros(),
+            })
+        };
         // The open edges the node is pushed over, as outward directions in the tangent plane.
         let held = |f: &Foot| -> Vec<Vector> {
             f.open_edges
@@ -167,37 +250,4 @@ pub fn tangent_pair(n: &Vector) -> (Vector, Vector) {
     let t1 = n.cross(&helper).normalize();
     let t2 = n.cross(&t1);
     (t1, t2)
-}
-
-/// A linearised one-sided contact constraint: `normal . (x + delta - point) >= 0`.
-#[derive(Debug, Clone, Copy)]
-pub struct ContactRow {
-    /// The node.
-    pub node: usize,
-    /// Unit normal of the tool at the contact point.
-    pub normal: Vector,
-    /// Signed gap `normal . (x - point)` at the current state (>= 0 when outside the tool).
-    pub gap: f64,
-}
-
-/// Nodes within this many spacings of the tool get a contact row in free drape.
-pub const CONTACT_RANGE: f64 = 2.0;
-
-/// Linearised contact rows for the free-drape nodes near the tool.
-pub fn contact_rows(tool: &dyn ContactSurface, x: &[Point], movable: &[bool], spacing: f64) -> Vec<ContactRow> {
-    use rayon::prelude::*;
-    x.par_iter()
-        .enumerate()
-        .filter(|(k, _)| movable[*k])
-        .filter_map(|(k, p)| {
-            let Foot { point: foot, normal, .. } = tool.locate(p);
-            // On the tool or outside: the tool's outward normal; a node found inside gets a row
-            // that pushes it back out.
-            ((p - foot).norm() <= CONTACT_RANGE * spacing).then(|| ContactRow {
-                node: k,
-                normal,
-                gap: normal.dot(&(p - foot)),
-            })
-        })
-        .collect()
 }

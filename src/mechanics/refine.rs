@@ -2,12 +2,14 @@
 //! kinematic state with the tool as contact, under load steps of gravity.
 use super::contact::{ContactMode, ContactSurface, Freedom};
 use super::energy::{Grid, HessianKind, Laws, Model};
-use super::solver::{solve, Constraints, Evaluation, HessianBlocks, Objective, Outcome, SolveReport, SolverSettings};
+use super::qp::HessianBlocks;
+use super::solver::{solve, Constraints, Evaluation, Objective, Outcome, SolveReport, SolverSettings};
 use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
-/// Which Hessian the quadratic models use.
-const HESSIAN: HessianKind = HessianKind::Convex;
+/// Which Hessian the quadratic models use: the exact one (the solver's shift handles its
+/// negative curvature).
+const HESSIAN: HessianKind = HessianKind::Exact;
 
 /// Standard gravity, m/s^2.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
@@ -17,6 +19,7 @@ pub const STANDARD_GRAVITY: f64 = 9.80665;
 pub struct NetObjective<'a> {
     model: Model<'a>,
     loads: Vec<Vector>,
+    masses: Vec<f64>,
     pairs: Vec<(usize, usize)>,
 }
 
@@ -24,11 +27,11 @@ impl<'a> NetObjective<'a> {
     /// Stretch, shear and bending of `laws` on `grid`, loaded by `gravity` (m/s^2) times
     /// `load_factor`.
     pub fn new<L: Laws + ?Sized>(grid: Grid, laws: &'a L, gravity: Vector) -> Self {
-        let areas = grid.nodal_areas();
-        let loads = areas.iter().map(|a| gravity * (a * laws.areal_mass())).collect();
+        let masses: Vec<f64> = grid.nodal_areas().iter().map(|a| a * laws.areal_mass()).collect();
+        let loads = masses.iter().map(|m| gravity * *m).collect();
         let model = Model::new(grid, laws, Vector::zeros());
         let pairs = model.pattern().coupled_pairs();
-        NetObjective { model, loads, pairs }
+        NetObjective { model, loads, masses, pairs }
     }
 
     /// Scale the loads (load stepping).
@@ -68,8 +71,27 @@ impl Objective for NetObjective<'_> {
             hessian: ev.hessian.map(|h| Box::new(h) as Box<dyn HessianBlocks>),
         }
     }
+    fn energy(&self, x: &[Point]) -> f64 {
+        self.model.energy(x) - self.work(x)
+    }
+    fn convex_hessian(&self, x: &[Point]) -> Option<Box<dyn HessianBlocks>> {
+        let h = self.model.evaluate(x, Some(HessianKind::Convex)).hessian?;
+        Some(Box::new(h))
+    }
     fn coupled_pairs(&self) -> Vec<(usize, usize)> {
         self.pairs.clone()
+    }
+    fn masses(&self) -> Vec<f64> {
+        self.masses.clone()
+    }
+    fn second_order_forces(&self, x: &[Point], trial: &[Point]) -> Option<Vec<Vector>> {
+        Some(self.model.second_order_forces(x, trial))
+    }
+    fn term_forces(&self, x: &[Point]) -> Vec<(&'static str, Vec<Vector>)> {
+        let mut terms = self.model.term_gradients(x);
+        terms.retain(|(name, _)| *name != "gravity");
+        terms.push(("gravity", self.loads.iter().map(|l| -l).collect()));
+        terms
     }
 }
 
@@ -87,7 +109,7 @@ pub enum PressedSurface {
 /// How to refine.
 #[derive(Debug, Clone)]
 pub struct RefineSettings {
-    /// How the term moves: pressed, free or none.
+    /// How the ply meets the tool: pressed or free.
     pub mode: ContactMode,
     /// What pressed nodes slide on.
     pub pressed_surface: PressedSurface,
@@ -95,7 +117,7 @@ pub struct RefineSettings {
     pub gravity: Vector,
     /// Gravity is applied in this many equal steps.
     pub load_steps: usize,
-    /// The solver's settings.
+    /// The solver's settings (per load step).
     pub solver: SolverSettings,
 }
 
@@ -144,11 +166,11 @@ impl Refined {
 /// Why a refinement could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum RefineError {
-    /// The net has no placed node.
     #[error("the net has no placed nodes to refine")]
+    /// The net has no placed node.
     Empty,
-    /// No load step was asked for.
     #[error("load steps must be at least 1")]
+    /// No load step was asked for.
     LoadSteps,
 }
 
@@ -166,60 +188,46 @@ pub fn refine<L: Laws + ?Sized>(
     if settings.load_steps == 0 {
         return Err(RefineError::LoadSteps);
     }
-    let active: Vec<bool> = kinematic.status.iter().map(|s| *s == NodeStatus::Placed).collect();
+    let active = connected_body(kinematic);
     if !active.iter().any(|a| *a) {
         return Err(RefineError::Empty);
     }
     let grid = Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone());
-    // Pressed nodes slide on the smooth patches: on the facets themselves a net finer than them
-    // crawls from edge to edge (see the module doc of `geometry::smooth`). Free contact keeps the
-    // nodes out of the facets as given.
-    let on_patches = settings.mode == ContactMode::Pressed && settings.pressed_surface == PressedSurface::Smooth;
+    // Nodes meet the smooth patches: on the facets themselves a net finer than them crawls from
+    // edge to edge (see the module doc of `geometry::smooth`).
+    let on_patches = settings.pressed_surface == PressedSurface::Smooth;
     let smooth = on_patches.then(|| SmoothSurface::new(tool));
     let surface: &dyn ContactSurface = match &smooth {
         Some(s) => s,
         None => tool,
     };
     let mut x = kinematic.positions.clone();
-    if let Some(smooth) = &smooth {
+    if let (Some(smooth), ContactMode::Pressed) = (&smooth, settings.mode) {
         use rayon::prelude::*;
         x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);
     }
+    // The ply is held at its seed: the origin node keeps its place and its warp neighbour stays
+    // in the plane of the initial warp direction and the tool's normal there, so the ply keeps
+    // its orientation at the seed while everything else, shear at the seed included, relaxes.
     let (i0, j0) = kinematic.origin_node;
     let origin = kinematic.index(i0, j0);
-    let warp_neighbour = if i0 + 1 < kinematic.nu { Some(kinematic.index(i0 + 1, j0)) } else { None };
+    let warp_neighbour = (i0 + 1 < kinematic.nu).then(|| kinematic.index(i0 + 1, j0)).filter(|&k| active[k]);
     let n0 = surface.locate(&x[origin]).normal;
-    let plane_normal =
-        warp_neighbour.filter(|&k| active[k]).and_then(|k| (x[k] - x[origin]).cross(&n0).try_normalize(1e-12));
+    let plane_normal = warp_neighbour.and_then(|k| (x[k] - x[origin]).cross(&n0).try_normalize(1e-12));
     let freedom: Vec<Freedom> = (0..active.len())
-        .map(|k| {
-            if !active[k] || k == origin {
-                Freedom::Fixed
-            } else if Some(k) == warp_neighbour && plane_normal.is_some() {
-                match settings.mode {
-                    ContactMode::Pressed => Freedom::OnToolInPlane(plane_normal.unwrap()),
-                    _ => Freedom::InPlane(plane_normal.unwrap()),
-                }
-            } else {
-                match settings.mode {
-                    ContactMode::Pressed => Freedom::OnTool,
-                    _ => Freedom::Free,
-                }
-            }
+        .map(|k| match (active[k] && k != origin, settings.mode, plane_normal.filter(|_| Some(k) == warp_neighbour)) {
+            (false, _, _) => Freedom::Fixed,
+            (true, ContactMode::Pressed, Some(m)) => Freedom::OnToolInPlane(m),
+            (true, ContactMode::Pressed, None) => Freedom::OnTool,
+            (true, _, Some(m)) => Freedom::InPlane(m),
+            (true, _, None) => Freedom::Free,
         })
         .collect();
-    // The residual is measured against the kinematic net's forces as given (on the facets).
-    let facet_cons =
-        Constraints { freedom: freedom.clone(), mode: settings.mode, tool: Some(tool), spacing: kinematic.spacing };
-    let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing };
+    let cons =
+        Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing, stitched: None };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
-    let mut solver_settings = settings.solver.clone();
-    if solver_settings.force_scale.is_none() {
-        // At the full load: the one the last step must balance.
-        let full = NetObjective::new(objective.grid().clone(), laws, settings.gravity);
-        solver_settings.force_scale = Some(super::solver::force_scale(&full, &kinematic.positions, &facet_cons));
-    }
+    let solver_settings = settings.solver.clone();
     // Energies under the full load, for comparison with the result. The first step carries 1/S
     // of the load, so the full load does (S - 1) times more work.
     let full_load = |objective: &NetObjective, x: &[Point]| {
@@ -245,9 +253,75 @@ pub fn refine<L: Laws + ?Sized>(
         if active[k] {
             net.positions[k] = *p;
             net.triangles[k] = tool.closest_point(p).triangle;
+        } else if net.status[k] == NodeStatus::Placed {
+            net.status[k] = NodeStatus::Detached;
         }
     }
     Ok(Refined { net, steps, energy_kinematic, energy_start, energy_final })
+}
+
+/// The nodes of the net's body: the corners of the complete cells joined by shared edges to the
+/// cell at the origin node (or, without one, to the largest such group). Cells that hang on the
+/// rest by a single corner, and placed nodes in no complete cell, are mechanisms the energy does
+/// not hold (they would swing about their corner): the mechanical model leaves them out.
+pub fn connected_body(net: &DrapeNet) -> Vec<bool> {
+    let (nu, nv) = (net.nu, net.nv);
+    let mut body = vec![false; nu * nv];
+    if nu < 2 || nv < 2 {
+        return body;
+    }
+    let (cu, cv) = (nu - 1, nv - 1);
+    let placed = |i: usize, j: usize| net.status[net.index(i, j)] == NodeStatus::Placed;
+    let complete = |i: usize, j: usize| placed(i, j) && placed(i + 1, j) && placed(i, j + 1) && placed(i + 1, j + 1);
+    let cells: Vec<bool> = (0..cu * cv).map(|c| complete(c / cv, c % cv)).collect();
+    let mut parent: Vec<usize> = (0..cells.len()).collect();
+    fn root(parent: &mut [usize], mut a: usize) -> usize {
+        while parent[a] != a {
+            parent[a] = parent[parent[a]];
+            a = parent[a];
+        }
+        a
+    }
+    for i in 0..cu {
+        for j in 0..cv {
+            let c = i * cv + j;
+            if !cells[c] {
+                continue;
+            }
+            for other in [(i + 1 < cu).then(|| c + cv), (j + 1 < cv).then(|| c + 1)].into_iter().flatten() {
+                if cells[other] {
+                    let (a, b) = (root(&mut parent, c), root(&mut parent, other));
+                    parent[a] = b;
+                }
+            }
+        }
+    }
+    let mut size = vec![0usize; cells.len()];
+    for (c, _) in cells.iter().enumerate().filter(|(_, &complete)| complete) {
+        size[root(&mut parent, c)] += 1;
+    }
+    // The group at the origin node, else the largest.
+    let (i0, j0) = net.origin_node;
+    let at_origin =
+        [(i0, j0), (i0.wrapping_sub(1), j0), (i0, j0.wrapping_sub(1)), (i0.wrapping_sub(1), j0.wrapping_sub(1))]
+            .into_iter()
+            .filter(|&(i, j)| i < cu && j < cv && cells[i * cv + j])
+            .map(|(i, j)| root(&mut parent, i * cv + j))
+            .max_by_key(|&r| size[r]);
+    let Some(chosen) = at_origin
+        .or_else(|| (0..cells.len()).filter(|&c| cells[c]).map(|c| root(&mut parent, c)).max_by_key(|&r| size[r]))
+    else {
+        return body;
+    };
+    for (c, _) in cells.iter().enumerate().filter(|(_, &complete)| complete) {
+        if root(&mut parent, c) == chosen {
+            let (i, j) = (c / cv, c % cv);
+            for (a, b) in [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)] {
+                body[net.index(a, b)] = true;
+            }
+        }
+    }
+    body
 }
 
 /// Per-cell change from `before` to `after` (same grid): (shear difference, angle between the

@@ -1,29 +1,61 @@
-//! Sequential convex subproblems: at each iterate a quadratic model of the energy (convexified
-//! Hessian plus Levenberg-Marquardt damping) with the linearised contact constraints is solved by
-//! Clarabel; the step is accepted if the energy falls as predicted, else the damping grows.
-use super::contact::{contact_rows, ContactMode, ContactRow, ContactSurface, Foot, Freedom, NodeBasis};
+//! Equilibrium of a net: Newton steps on the energy over each node's free directions,
+//! regularised by pseudo-transient continuation and kept on the curved valley of stiff fibres by
+//! second-order corrections. Every subproblem is a quadratic model solved by Clarabel
+//! ([`super::qp::QpEngine`]).
+//!
+//! One iteration at the state x with forces g = F - P:
+//! 1. Each node's basis of motion B (fixed, a line, the tool's tangent plane, free) from its
+//!    freedom and contact; the residual is B^T g (the tool's and the held nodes' reactions are
+//!    not residual). Converged when |B^T g| <= tolerance |P| (seed 000 eq. 20).
+//! 2. The model uses the exact Hessian H of the energy plus a shift `sigma M` (M the lumped
+//!    nodal masses): an implicit pseudo-time step of the fabric's own dynamics with
+//!    `sigma = 1/dt^2`. Far from equilibrium the shift keeps the model convex and the step
+//!    physical (a hanging sheet falls as it would, a wrinkle picks a stable side); as the
+//!    residual falls the step grows (sigma -> 0) and the iteration becomes Newton's, with its
+//!    quadratic convergence. A step that is not a descent direction of a convex model (negative
+//!    curvature) raises the shift.
+//! 3. The trial state moves pressed nodes back onto the tool and free nodes that would enter it
+//!    onto its surface. It is accepted when the energy falls by a fair part of the model's
+//!    prediction. If not, a second-order correction (a Newton step from the trial state with the
+//!    same model) is tried first: stiff, nearly inextensible fibres make the energy a narrow
+//!    curved valley, a straight step leaves it to second order and the fibres' stiffness
+//!    multiplies that error; the correction steps back into the valley. Only then is the shift
+//!    raised (a shorter, more cautious step).
+use super::contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
+pub use super::qp::HessianBlocks;
+use super::qp::{QpEngine, QpFailure, Reduction};
 use crate::geometry::{Point, Vector};
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, SupportedConeT,
-};
-use nalgebra::Matrix3;
 use rayon::prelude::*;
 use serde::Serialize;
 
 /// The energy of a net and its derivatives, as the solver needs them.
 pub trait Objective: Sync {
-    /// Energy, gradient of the internal energy, external loads P, and (if asked) the convexified
-    /// Hessian of the total energy.
+    /// Energy, internal forces, external loads P, and (if asked) the exact Hessian.
     fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation;
-    /// Node pairs (a <= b) that may couple in the Hessian.
+    /// A positive semidefinite approximation of the Hessian at `x` (each element's curvature
+    /// with its negative parts dropped), for steps where the exact one curves down; None: the
+    /// objective has none (the shift alone then handles negative curvature).
+    fn convex_hessian(&self, _x: &[Point]) -> Option<Box<dyn HessianBlocks>> {
+        None
+    }
+    /// The total energy only (line searches).
+    fn energy(&self, x: &[Point]) -> f64 {
+        self.evaluate(x, false).energy
+    }
+    /// Node pairs (a <= b) that may couple in the Hessian, (k, k) included.
     fn coupled_pairs(&self) -> Vec<(usize, usize)>;
-}
-
-/// Hessian storage the solver reads block by block.
-pub trait HessianBlocks {
-    /// The 3x3 block coupling nodes `a` and `b` (a <= b).
-    fn block(&self, a: usize, b: usize) -> Matrix3<f64>;
+    /// Lumped mass of each node (kg): the metric of the pseudo-time steps.
+    fn masses(&self) -> Vec<f64>;
+    /// The forces that the stiff, constraint-like terms (fibre stretch) gain to second order
+    /// between `x` and `trial`: what a second-order correction must undo (None: no correction).
+    fn second_order_forces(&self, _x: &[Point], _trial: &[Point]) -> Option<Vec<Vector>> {
+        None
+    }
+    /// The internal forces split by energy term, for naming what dominates where a solve
+    /// fails (empty if the objective cannot split them).
+    fn term_forces(&self, _x: &[Point]) -> Vec<(&'static str, Vec<Vector>)> {
+        Vec::new()
+    }
 }
 
 /// One evaluation of the objective.
@@ -34,32 +66,25 @@ pub struct Evaluation {
     pub internal: Vec<Vector>,
     /// External loads per node (P).
     pub external: Vec<Vector>,
-    /// Hessian blocks of the internal energy, when asked for.
+    /// The exact Hessian of the energy, when asked for.
     pub hessian: Option<Box<dyn HessianBlocks>>,
 }
 
 /// Settings of the solver (builder style: `SolverSettings::default().max_iterations(80)`).
 #[derive(Debug, Clone)]
 pub struct SolverSettings {
-    /// Iteration limit per solve.
+    /// Most iterations of one solve.
     pub max_iterations: usize,
-    /// Converged when |F - P| / max(|P|, |F|, |F at the start|) <= tolerance (seed 000 eq. 20:
-    /// |F - P| / |P| <= 1e-4).
+    /// Converged when |F - P| <= tolerance |P| over the free directions (seed 000 eq. 20).
     pub tolerance: f64,
-    /// Converged too when the energy changes by less than this (relative) over `stall_window`
-    /// accepted steps.
-    pub stall_tolerance: f64,
-    /// Accepted steps over which the energy must stall.
-    pub stall_window: usize,
-    /// Initial Levenberg-Marquardt damping, relative to the Hessian's mean diagonal.
-    pub initial_damping: f64,
-    /// Largest damping before the solver gives up (stalled line search).
-    pub max_damping: f64,
-    /// The force the residual is measured against (N); default: the larger of the loads and the
-    /// internal forces at the start. Refinement passes the kinematic net's, as given, so that
-    /// moving its nodes onto a smooth tool (which stretches the fibres a little) does not
-    /// loosen the test.
+    /// The force |F - P| is measured against when there are no loads (|P| = 0), in N; default:
+    /// the internal forces over the free directions at the start.
     pub force_scale: Option<f64>,
+    /// Initial pseudo-transient shift, relative to the model's mean stiffness over the mean
+    /// nodal mass (0 starts with Newton's step).
+    pub initial_shift: f64,
+    /// Try a second-order correction before shortening a rejected step.
+    pub second_order_correction: bool,
 }
 
 impl Default for SolverSettings {
@@ -67,22 +92,20 @@ impl Default for SolverSettings {
         SolverSettings {
             max_iterations: 100,
             tolerance: 1e-4,
-            stall_tolerance: 1e-13,
-            stall_window: 3,
-            initial_damping: 1e-6,
-            max_damping: 1e12,
             force_scale: None,
+            initial_shift: 1e-6,
+            second_order_correction: true,
         }
     }
 }
 
 impl SolverSettings {
-    /// Set the iteration limit.
+    /// Sets the iteration limit.
     pub fn max_iterations(mut self, n: usize) -> Self {
         self.max_iterations = n;
         self
     }
-    /// Set the residual tolerance.
+    /// Sets the relative residual tolerance.
     pub fn tolerance(mut self, t: f64) -> Self {
         self.tolerance = t;
         self
@@ -94,21 +117,23 @@ impl SolverSettings {
 pub struct IterationLog {
     /// Iteration number, from 1.
     pub iteration: usize,
-    /// Energy after the iteration.
+    /// Energy after the iteration (J).
     pub energy: f64,
-    /// Relative residual |F - P| after it.
+    /// |F - P| / |P| after the iteration.
     pub residual: f64,
-    /// Length of the step taken.
+    /// Largest node displacement of the accepted step, in spacings.
     pub step: f64,
-    /// Levenberg-Marquardt damping used.
-    pub damping: f64,
-    /// Nodes in contact.
+    /// The pseudo-transient shift used, relative (see [`SolverSettings::initial_shift`]).
+    pub shift: f64,
+    /// Nodes held against the tool by free contact.
     pub active_contacts: usize,
-    /// Whether the step was accepted.
+    /// Whether a step was taken.
     pub accepted: bool,
-    /// Interior-point iterations of the subproblem.
-    pub qp_iterations: u32,
-    /// Wall-clock time, ms.
+    /// Whether the accepted step needed a second-order correction.
+    pub corrected: bool,
+    /// Clarabel subproblems solved in the iteration.
+    pub subproblems: u32,
+    /// Wall-clock time of the iteration.
     pub time_ms: f64,
 }
 
@@ -118,37 +143,68 @@ pub struct IterationLog {
 pub enum Outcome {
     /// |F - P| / |P| below the tolerance.
     Converged,
-    /// The energy stopped changing.
+    /// The energy stopped falling (at rounding) with the residual above the tolerance.
     Stalled,
     /// Iteration limit reached.
     IterationLimit,
-    /// The damping grew past its limit without an acceptable step.
+    /// No step lowered the energy, however short.
     LineSearchFailed,
-    /// Clarabel could not solve a subproblem (infeasible constraints).
+    /// Clarabel could not solve a subproblem.
     SubproblemFailed,
+}
+
+impl Outcome {
+    /// What the outcome means, for people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Outcome::Converged => "converged",
+            Outcome::Stalled => "stalled: the energy stopped falling before the forces balanced",
+            Outcome::IterationLimit => "iteration limit reached before the forces balanced",
+            Outcome::LineSearchFailed => "no step lowered the energy, however short",
+            Outcome::SubproblemFailed => "a quadratic subproblem could not be solved",
+        }
+    }
+}
+
+/// A node where the forces do not balance, for the failure report.
+#[derive(Debug, Clone, Serialize)]
+pub struct UnbalancedNode {
+    /// Node index (`i * nv + j` on a grid).
+    pub node: usize,
+    /// |F - P| over the node's free directions (N).
+    pub force: f64,
+    /// The energy term with the largest force over the node's free directions there.
+    pub dominant_term: Option<&'static str>,
 }
 
 /// What a solve did.
 #[derive(Debug, Clone, Serialize)]
 pub struct SolveReport {
-    /// How the solve ended.
+    /// How it ended.
     pub outcome: Outcome,
-    /// Energy at the start.
+    /// Energy at the start (J).
     pub energy_start: f64,
-    /// Energy at the end.
+    /// Energy at the end (J).
     pub energy_end: f64,
-    /// Relative residual at the end.
+    /// |F - P| / |P| at the end.
     pub residual: f64,
+    /// The force the residual is measured against (N): |P|, or the force scale without loads.
+    pub force_scale: f64,
     /// One entry per iteration.
     pub iterations: Vec<IterationLog>,
-    /// Wall-clock time, ms.
+    /// Wall-clock time of the solve.
     pub time_ms: f64,
+    /// Where the forces are furthest from balance, largest first (empty when converged).
+    pub unbalanced: Vec<UnbalancedNode>,
+    /// What Clarabel said of the last subproblem that failed, if the solve ended on one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subproblem_status: Option<String>,
 }
 
 impl SolveReport {
-    /// Whether the final state is an equilibrium (converged or stalled at a minimum).
+    /// Whether the final state is an equilibrium to the tolerance.
     pub fn ok(&self) -> bool {
-        matches!(self.outcome, Outcome::Converged | Outcome::Stalled)
+        self.outcome == Outcome::Converged
     }
 }
 
@@ -156,142 +212,540 @@ impl SolveReport {
 pub struct Constraints<'a> {
     /// How each node may move.
     pub freedom: Vec<Freedom>,
-    /// Pressed, free or no contact.
+    /// How the net meets the tool.
     pub mode: ContactMode,
     /// Pressed nodes slide on it; free nodes stay out of it.
     pub tool: Option<&'a dyn ContactSurface>,
-    /// Length scale for contact search (the net's spacing).
+    /// Length scale for contact search and step sizes (the net's spacing).
     pub spacing: f64,
+    /// Per node, the node whose freedoms it shares (stitched seams); None: each its own.
+    pub stitched: Option<Vec<usize>>,
 }
 
-/// Reduced (free) variables: node k's components start at `offset[k]` and number `bases[k].dofs`.
-struct Reduction {
-    offset: Vec<usize>,
-    n: usize,
-    /// Upper-triangular CSC pattern over the reduced variables.
-    colptr: Vec<usize>,
-    rowval: Vec<usize>,
-    /// For each stored entry: (node a, node b, component p of a, component q of b).
-    source: Vec<(u32, u32, u8, u8)>,
-    /// Position of each column's diagonal entry.
-    diag: Vec<usize>,
+/// A step is accepted when the energy falls by at least this fraction of the predicted fall.
+const ACCEPT_RATIO: f64 = 1e-4;
+/// Steps whose energy change agrees with the model this well let the shift fall.
+const GOOD_RATIO: f64 = 0.5;
+/// Relative size of rounding in energies.
+const ENERGY_ROUNDING: f64 = 1e-13;
+/// Energy changes within this many times the rounding are not told from it: there steps are
+/// judged by the forces instead.
+const ROUNDING_BAND: f64 = 100.0;
+/// A contact is active (the tool takes the node's push into it) when its gap is below this
+/// fraction of the spacing.
+const ACTIVE_GAP: f64 = 1e-9;
+/// Steps whose gain is lost in rounding are shortened at most this many times, each time
+/// without balancing the forces better, before the solve is called stalled.
+const ROUNDING_RETRIES: usize = 4;
+/// Curvature along a step below this fraction of the shifted model's (negative beyond rounding:
+/// a positive semidefinite Hessian along a direction it barely stiffens sums to about zero).
+const CURVATURE_ROUNDING: f64 = 1e-9;
+/// Free nodes within this many spacings of the tool are checked for contact.
+pub const CONTACT_RANGE: f64 = 2.0;
+/// No node moves further than this many spacings in one step (a cap, not a line search).
+pub const MAX_STEP_SPACINGS: f64 = 1.0;
+/// The shift never falls below this (relative): Newton's step to rounding.
+const MIN_SHIFT: f64 = 1e-14;
+/// A shift above this (relative) makes steps too short to matter: give up.
+const MAX_SHIFT: f64 = 1e12;
+/// Nodes listed in a failure report.
+const UNBALANCED_REPORTED: usize = 5;
+
+/// Per node, where it touches the tool (on-tool nodes always; free nodes near the tool).
+type Feet = Vec<Option<Foot>>;
+
+/// The state of the solve at one configuration.
+struct State {
+    eval: Evaluation,
+    feet: Feet,
+    bases: Vec<NodeBasis>,
+    /// Nodes that slide on the tool (pressed, or held against it in free contact).
+    sliding: Vec<bool>,
 }
 
-impl Reduction {
-    fn new(freedom: &[Freedom], pairs: &[(usize, usize)]) -> Self {
-        let mut offset = Vec::with_capacity(freedom.len());
-        let mut n = 0;
-        for f in freedom {
-            offset.push(n);
-            n += f.dofs();
-        }
-        let dofs: Vec<usize> = freedom.iter().map(Freedom::dofs).collect();
-        // Column-wise lists of (row variable, source).
-        let mut columns: Vec<Vec<(usize, (u32, u32, u8, u8))>> = vec![Vec::new(); n];
-        for &(a, b) in pairs {
-            let (a, b) = if a <= b { (a, b) } else { (b, a) };
-            for p in 0..dofs[a] {
-                for q in 0..dofs[b] {
-                    let (r, c) = (offset[a] + p, offset[b] + q);
-                    if a == b && p > q {
-                        continue;
-                    }
-                    // Upper triangle: row <= column.
-                    let (r, c, src) = if r <= c {
-                        (r, c, (a as u32, b as u32, p as u8, q as u8))
-                    } else {
-                        (c, r, (a as u32, b as u32, p as u8, q as u8))
-                    };
-                    columns[c].push((r, src));
-                }
-            }
-        }
-        let mut colptr = vec![0];
-        let mut rowval = Vec::new();
-        let mut source = Vec::new();
-        let mut diag = vec![usize::MAX; n];
-        for (c, mut col) in columns.into_iter().enumerate() {
-            col.sort_by_key(|e| e.0);
-            col.dedup_by_key(|e| e.0);
-            for (r, src) in col {
-                if r == c {
-                    diag[c] = rowval.len();
-                }
-                rowval.push(r);
-                source.push(src);
-            }
-            colptr.push(rowval.len());
-        }
-        Reduction { offset, n, colptr, rowval, source, diag }
+/// Minimise the objective from `x` (modified in place to the last accepted state).
+pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, settings: &SolverSettings) -> SolveReport {
+    let start = std::time::Instant::now();
+    let n = x.len();
+    let rep: Vec<usize> = cons.stitched.clone().unwrap_or_else(|| (0..n).collect());
+    let pairs = objective.coupled_pairs();
+    let masses = {
+        let m = objective.masses();
+        // Nodes without fabric area of their own (a lone segment at the net's edge) still move
+        // with some inertia: a quarter of the mean.
+        let movable: Vec<f64> = m.iter().zip(&cons.freedom).filter(|(_, f)| f.dofs() > 0).map(|(m, _)| *m).collect();
+        let mean = movable.iter().sum::<f64>() / movable.len().max(1) as f64;
+        let floor = if mean > 0.0 { 0.25 * mean } else { 1.0 };
+        m.iter().map(|&mk| mk.max(floor)).collect::<Vec<f64>>()
+    };
+    let mean_mass = masses.iter().sum::<f64>() / n.max(1) as f64;
+    if cons.mode == ContactMode::Free {
+        // Start outside the tool: nodes given inside it (a net draped on the facets is inside
+        // the smooth surface wherever that bulges out) are put on its surface.
+        let zero = vec![Vector::zeros(); n];
+        let (outside, _) = moved(cons, x, &zero, &vec![false; n]);
+        x.copy_from_slice(&outside);
     }
-
-    /// Reduced Hessian values B^T H B.
-    fn values(&self, h: &dyn HessianBlocks, bases: &[NodeBasis]) -> Vec<f64> {
-        let mut cache: Option<((u32, u32), Matrix3<f64>)> = None;
-        self.source
-            .iter()
-            .map(|&(a, b, p, q)| {
-                let blk = match cache {
-                    Some((key, m)) if key == (a, b) => m,
-                    _ => {
-                        let m = bases[a as usize].basis.transpose()
-                            * h.block(a as usize, b as usize)
-                            * bases[b as usize].basis;
-                        cache = Some(((a, b), m));
-                        m
-                    }
+    let mut state = {
+        let eval = objective.evaluate(x, true);
+        let feet = feet_at(cons, x, None);
+        let (bases, sliding) = bases_at(cons, &rep, &eval, &feet);
+        State { eval, feet, bases, sliding }
+    };
+    let movable = |k: usize| cons.freedom[rep[k]].dofs() > 0;
+    let load = (0..n).filter(|&k| movable(k)).map(|k| state.eval.external[k].norm_squared()).sum::<f64>().sqrt();
+    let mut red = Reduction::new(dofs_of(&state.bases, &rep), rep.clone(), &pairs);
+    let force_scale = if load > 0.0 {
+        load
+    } else {
+        settings
+            .force_scale
+            .unwrap_or_else(|| norm(&red.reduce(&state.eval.internal, &state.bases)))
+            .max(f64::MIN_POSITIVE)
+    };
+    let energy_start = state.eval.energy;
+    let mut engine = QpEngine::new();
+    let mut shift = settings.initial_shift;
+    let mut iterations = Vec::new();
+    let mut outcome = Outcome::IterationLimit;
+    let mut residual = residual_of(&red, &state, force_scale);
+    let mut last_failure: Option<QpFailure> = None;
+    for it in 0..settings.max_iterations {
+        if residual <= settings.tolerance || red.is_empty() {
+            outcome = Outcome::Converged;
+            break;
+        }
+        let t_it = std::time::Instant::now();
+        let g = red.reduce(&unbalanced(&state.eval), &state.bases);
+        let hess = state.eval.hessian.as_deref().expect("the Hessian is evaluated with every accepted state");
+        let mut base_values = red.values(hess, &state.bases);
+        add_contact_curvature(cons, &rep, &red, &state, &mut base_values, false);
+        let exact_values = base_values.clone();
+        let mut convex = false;
+        let stiffness = red.mean_diagonal(&base_values).max(f64::MIN_POSITIVE);
+        let unit_shift = stiffness / mean_mass.max(f64::MIN_POSITIVE);
+        let noise = ENERGY_ROUNDING * state.eval.energy.abs().max(f64::MIN_POSITIVE);
+        // What to do when the model turns out indefinite: take the elements' convex parts, which
+        // still descend along a saddle; then only a larger shift helps.
+        let fallback = |shift: &mut f64, values: &mut Vec<f64>, convex: &mut bool| {
+            if !*convex {
+                if let Some(h) = objective.convex_hessian(x) {
+                    *values = red.values(h.as_ref(), &state.bases);
+                    add_contact_curvature(cons, &rep, &red, &state, values, true);
+                    *convex = true;
+                    return;
+                }
+            }
+            *shift = (*shift * 10.0).max(1e-8);
+        };
+        let mut subproblems = 0;
+        let mut rounding_tries = 0;
+        let mut accepted = None;
+        let mut failure = None;
+        while shift <= MAX_SHIFT {
+            let mut values = base_values.clone();
+            red.add_diagonal(&mut values, &masses, shift * unit_shift);
+            subproblems += 1;
+            let y = match engine.solve(&red, &values, &g) {
+                Ok(y) => y,
+                Err(e) => {
+                    // Clarabel finds no minimum of an indefinite model: as below.
+                    failure = Some(e);
+                    fallback(&mut shift, &mut base_values, &mut convex);
+                    continue;
+                }
+            };
+            failure = None;
+            let gy = dot(&g, &y);
+            let y_model = red.quad(&values, &y);
+            let y_hess = red.quad(&base_values, &y);
+            if gy >= 0.0 || y_model <= 0.0 || y_hess < -CURVATURE_ROUNDING * y_model {
+                // Not a descent direction of a convex model, or the Hessian curves down along
+                // the step (a saddle's direction).
+                fallback(&mut shift, &mut base_values, &mut convex);
+                continue;
+            }
+            let y = cap_step(&red, y, &state.bases, cons.spacing);
+            let gy = dot(&g, &y);
+            // The decrease the unshifted model predicts (the shifted one's if that is not
+            // positive: the Hessian alone is indefinite along y).
+            let y_hess = red.quad(&base_values, &y);
+            let predicted = {
+                let p = -(gy + 0.5 * y_hess);
+                if p > 0.0 {
+                    p
+                } else {
+                    -(gy + 0.5 * red.quad(&values, &y))
+                }
+            };
+            let delta = red.expand(&y, &state.bases);
+            let (trial, trial_feet) = moved(cons, x, &delta, &state.sliding);
+            let e1 = objective.energy(&trial);
+            let fall = state.eval.energy - e1;
+            if acceptable(fall, predicted, noise) {
+                // Where the model is stiffer along the step than the energy (the shift, or the
+                // convex parts standing in for an indefinite Hessian, limited it: a slow drift
+                // down a nearly flat direction, such as a symmetric ply twisting off a saddle),
+                // the energy may keep falling further along it: go on while it does.
+                let y_exact = if convex { red.quad(&exact_values, &y) } else { y_hess };
+                let (trial, trial_feet, fall) = if y_exact < EXTEND_CURVATURE * y_model && fall > ROUNDING_BAND * noise
+                {
+                    extend_step(objective, cons, x, &state, &red, &y, (trial, trial_feet, fall))
+                } else {
+                    (trial, trial_feet, fall)
                 };
-                blk[(p as usize, q as usize)]
-            })
-            .collect()
-    }
-
-    fn reduce(&self, v: &[Vector], bases: &[NodeBasis]) -> Vec<f64> {
-        let mut out = vec![0.0; self.n];
-        for (k, b) in bases.iter().enumerate() {
-            for p in 0..b.dofs {
-                out[self.offset[k] + p] = b.dir(p).dot(&v[k]);
+                accepted = Some((trial, trial_feet, fall / predicted, false));
+                break;
             }
+            if predicted <= ROUNDING_BAND * noise {
+                // The energy cannot tell this step from rounding: take it if the forces balance
+                // better (stiff fibres hold forces far above what their energy shows); else try
+                // shorter steps a few times before calling it a stall.
+                if fall >= -ROUNDING_BAND * noise {
+                    let e_trial = objective.evaluate(&trial, false);
+                    let (bases, _) = bases_at(cons, &rep, &e_trial, &trial_feet);
+                    if residual_at(&red, &e_trial, &bases, force_scale) < residual {
+                        accepted = Some((trial, trial_feet, 1.0, false));
+                        break;
+                    }
+                }
+                rounding_tries += 1;
+                if rounding_tries > ROUNDING_RETRIES {
+                    break;
+                }
+            }
+            if settings.second_order_correction && predicted > ROUNDING_BAND * noise {
+                // Back into the curved valley of the stiff fibres: undo the strain the straight
+                // step added to second order, with the same model.
+                if let Some(f2) = objective.second_order_forces(x, &trial) {
+                    let g2 = red.reduce(&f2, &state.bases);
+                    subproblems += 1;
+                    if let Ok(z) = engine.solve(&red, &values, &g2) {
+                        let z = cap_step(&red, z, &state.bases, cons.spacing);
+                        let dz = red.expand(&z, &state.bases);
+                        let (trial2, feet2) = moved(cons, &trial, &dz, &state.sliding);
+                        let e2 = objective.energy(&trial2);
+                        let fall2 = state.eval.energy - e2;
+                        if acceptable(fall2, predicted, noise) {
+                            accepted = Some((trial2, feet2, fall2 / predicted, true));
+                            break;
+                        }
+                    }
+                }
+            }
+            shift = (shift * 4.0).max(1e-8);
         }
-        out
+        let (accepted_flag, corrected, step) = match accepted {
+            Some((trial, feet, ratio, corrected)) => {
+                let step = x.iter().zip(&trial).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max) / cons.spacing;
+                x.copy_from_slice(&trial);
+                let eval = objective.evaluate(x, true);
+                let feet = feet_at(cons, x, Some(feet));
+                let (bases, sliding) = bases_at(cons, &rep, &eval, &feet);
+                state = State { eval, feet, bases, sliding };
+                let dofs = dofs_of(&state.bases, &rep);
+                if dofs.as_slice() != red.key() {
+                    red = Reduction::new(dofs, rep.clone(), &pairs);
+                }
+                if ratio >= GOOD_RATIO && !corrected {
+                    shift = (shift / 8.0).max(MIN_SHIFT);
+                } else if ratio < 0.1 {
+                    shift *= 2.0;
+                }
+                (true, corrected, step)
+            }
+            None => (false, false, 0.0),
+        };
+        residual = residual_of(&red, &state, force_scale);
+        iterations.push(IterationLog {
+            iteration: it + 1,
+            energy: state.eval.energy,
+            residual,
+            step,
+            shift,
+            active_contacts: active_contacts(cons, &state),
+            accepted: accepted_flag,
+            corrected,
+            subproblems,
+            time_ms: t_it.elapsed().as_secs_f64() * 1e3,
+        });
+        if residual <= settings.tolerance {
+            outcome = Outcome::Converged;
+            break;
+        }
+        if !accepted_flag {
+            outcome = match &failure {
+                Some(_) => Outcome::SubproblemFailed,
+                None if shift > MAX_SHIFT => Outcome::LineSearchFailed,
+                None => Outcome::Stalled,
+            };
+            last_failure = failure;
+            break;
+        }
     }
-
-    fn expand(&self, y: &[f64], bases: &[NodeBasis]) -> Vec<Vector> {
-        bases
-            .iter()
-            .enumerate()
-            .map(|(k, b)| (0..b.dofs).fold(Vector::zeros(), |s, p| s + b.dir(p) * y[self.offset[k] + p]))
-            .collect()
+    let unbalanced =
+        if outcome == Outcome::Converged { Vec::new() } else { unbalanced_nodes(objective, x, &red, &state) };
+    let subproblem_status = match (&outcome, last_failure) {
+        (Outcome::SubproblemFailed, Some(QpFailure::NotSolved(status))) => Some(status),
+        (Outcome::SubproblemFailed, Some(QpFailure::Setup)) => Some("Clarabel could not be set up".into()),
+        _ => None,
+    };
+    SolveReport {
+        outcome,
+        energy_start,
+        energy_end: state.eval.energy,
+        residual,
+        force_scale,
+        iterations,
+        time_ms: start.elapsed().as_secs_f64() * 1e3,
+        unbalanced,
+        subproblem_status,
     }
 }
 
-/// The larger of the internal forces and the loads over the free directions.
-fn start_forces(r: &Reduction, e: &Evaluation, bases: &[NodeBasis]) -> f64 {
-    norm(&r.reduce(&e.internal, bases)).max(norm(&r.reduce(&e.external, bases)))
+/// The accepted step `y` doubled while the energy keeps falling and no node moves further than
+/// [`MAX_STEP_SPACINGS`]; returns the best trial (state, feet, fall).
+fn extend_step(
+    objective: &dyn Objective,
+    cons: &Constraints,
+    x: &[Point],
+    s: &State,
+    red: &Reduction,
+    y: &[f64],
+    mut best: (Vec<Point>, Feet, f64),
+) -> (Vec<Point>, Feet, f64) {
+    let reach = red.expand(y, &s.bases).iter().map(|d| d.norm()).fold(0.0, f64::max);
+    let mut factor = 1.0;
+    while reach * factor * 2.0 <= MAX_STEP_SPACINGS * cons.spacing {
+        factor *= 2.0;
+        let step: Vec<f64> = y.iter().map(|v| v * factor).collect();
+        let (trial, feet) = moved(cons, x, &red.expand(&step, &s.bases), &s.sliding);
+        let fall = s.eval.energy - objective.energy(&trial);
+        if fall <= best.2 {
+            break;
+        }
+        best = (trial, feet, fall);
+    }
+    best
 }
 
-/// The force scale [`solve`] would use at `x` by default: the larger of the internal forces and
-/// the loads over the free directions of `cons` there.
-pub fn force_scale(objective: &dyn Objective, x: &[Point], cons: &Constraints) -> f64 {
-    let e = objective.evaluate(x, false);
-    start_forces(&Reduction::new(&cons.freedom, &[]), &e, &bases_at(cons, x, &e, None))
+/// A step whose curvature under the exact Hessian is below this fraction of the model's (shift
+/// or convex parts included) was limited by the model, not the energy: it is extended while the
+/// energy keeps falling.
+const EXTEND_CURVATURE: f64 = 0.5;
+
+/// Whether a step that lowered the energy by `fall` where the model predicted `predicted` is
+/// good enough. Where the prediction is lost in rounding, any step that does not raise the
+/// energy is.
+fn acceptable(fall: f64, predicted: f64, noise: f64) -> bool {
+    if predicted <= ROUNDING_BAND * noise {
+        fall >= 0.0
+    } else {
+        fall >= ACCEPT_RATIO * predicted
+    }
 }
 
-/// Each node's basis of motion at `x`, for the pushes of the evaluation there (on-tool nodes
-/// pushed over the tool's open edge are held by it). `feet`: the on-tool nodes' feet when the
-/// caller has just found them, else they are located here.
-fn bases_at(cons: &Constraints, x: &[Point], e: &Evaluation, feet: Option<&[Option<Foot>]>) -> Vec<NodeBasis> {
-    let (internal, external) = (&e.internal, &e.external);
+/// Scales `y` so that no node moves further than [`MAX_STEP_SPACINGS`] spacings.
+fn cap_step(red: &Reduction, y: Vec<f64>, bases: &[NodeBasis], spacing: f64) -> Vec<f64> {
+    let delta = red.expand(&y, bases);
+    let largest = delta.iter().map(|d| d.norm()).fold(0.0, f64::max);
+    let cap = MAX_STEP_SPACINGS * spacing;
+    if largest > cap {
+        let s = cap / largest;
+        y.into_iter().map(|v| v * s).collect()
+    } else {
+        y
+    }
+}
+
+/// F - P per node.
+fn unbalanced(e: &Evaluation) -> Vec<Vector> {
+    e.internal.iter().zip(&e.external).map(|(f, p)| f - p).collect()
+}
+
+/// |B^T (F - P)| / scale.
+fn residual_of(red: &Reduction, s: &State, scale: f64) -> f64 {
+    residual_at(red, &s.eval, &s.bases, scale)
+}
+
+fn residual_at(red: &Reduction, e: &Evaluation, bases: &[NodeBasis], scale: f64) -> f64 {
+    norm(&red.reduce(&unbalanced(e), bases)) / scale
+}
+
+fn dofs_of(bases: &[NodeBasis], rep: &[usize]) -> Vec<u8> {
+    bases.iter().enumerate().map(|(k, b)| if rep[k] == k { b.dofs as u8 } else { 0 }).collect()
+}
+
+/// Where each node meets the tool: on-tool nodes always (their feet from the last move when
+/// given), free nodes in free contact when within [`CONTACT_RANGE`] spacings of it.
+fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
+    let Some(tool) = cons.tool else { return vec![None; x.len()] };
+    let range = CONTACT_RANGE * cons.spacing;
+    let known = known.unwrap_or_else(|| vec![None; x.len()]);
+    cons.freedom
+        .par_iter()
+        .zip(known)
+        .enumerate()
+        .map(|(k, (f, known))| match (cons.mode, f) {
+            (ContactMode::Pressed, f) if f.on_tool() => known.or_else(|| Some(tool.locate(&x[k]))),
+            (ContactMode::Free, f) if f.dofs() > 0 => known.or_else(|| tool.locate_near(&x[k], range)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Each node's basis of motion for the pushes of the evaluation `e`, and whether it slides on
+/// the tool: from its freedom, and in free contact without the tool's normal where a node
+/// touches the tool and is pushed into it.
+fn bases_at(cons: &Constraints, rep: &[usize], e: &Evaluation, feet: &Feet) -> (Vec<NodeBasis>, Vec<bool>) {
+    // Pushes summed over stitched nodes onto their representative.
+    let mut descent: Vec<Vector> = vec![Vector::zeros(); rep.len()];
+    for (k, r) in rep.iter().enumerate() {
+        descent[*r] += e.external[k] - e.internal[k];
+    }
     cons.freedom
         .par_iter()
         .enumerate()
         .map(|(k, f)| {
-            let foot = match (f.on_tool(), feet.and_then(|feet| feet[k]), cons.tool) {
-                (false, _, _) => None,
-                (true, Some(known), _) => Some(known),
-                (true, None, tool) => tool.map(|t| t.locate(&x[k])),
-            };
-            f.basis(foot.as_ref(), &(external[k] - internal[k]))
+            if rep[k] != k {
+                return (NodeBasis::FIXED, false);
+            }
+            let foot = feet[k].as_ref();
+            match (cons.mode, foot) {
+                (ContactMode::Free, Some(foot)) if f.dofs() > 0 => {
+                    let own = f.basis(None, &descent[k]);
+                    if foot.gap <= ACTIVE_GAP * cons.spacing && descent[k].dot(&foot.normal) < 0.0 {
+                        (own.without(&foot.normal), true)
+                    } else {
+                        (own, false)
+                    }
+                }
+                (ContactMode::Pressed, foot) => (f.basis(foot, &descent[k]), f.on_tool()),
+                (_, foot) => (f.basis(foot, &descent[k]), false),
+            }
+        })
+        .unzip()
+}
+
+/// Adds the tool's curvature to the model of every node that slides on it: moving a node by a
+/// tangent vector t keeps it on the tool only if it also moves by `-1/2 t^T C t` along the normal
+/// n, so the energy's second derivative along the tool gains `-(g . n) B^T C B` (g the node's
+/// force F - P, B its basis). With `convex`, only the block's non-negative part is kept.
+fn add_contact_curvature(
+    cons: &Constraints,
+    rep: &[usize],
+    red: &Reduction,
+    s: &State,
+    values: &mut [f64],
+    convex: bool,
+) {
+    if cons.tool.is_none() {
+        return;
+    }
+    let mut g: Vec<Vector> = vec![Vector::zeros(); rep.len()];
+    for (k, r) in rep.iter().enumerate() {
+        g[*r] += s.eval.internal[k] - s.eval.external[k];
+    }
+    for k in 0..rep.len() {
+        let (basis, Some(foot)) = (&s.bases[k], s.feet[k].as_ref()) else { continue };
+        if !s.sliding[k] || basis.dofs == 0 || rep[k] != k {
+            continue;
+        }
+        let b = basis.basis;
+        let mut m = b.transpose() * foot.curvature * b * (-g[k].dot(&foot.normal));
+        if convex {
+            m = clamp_to_psd(&m, basis.dofs);
+        }
+        red.add_node_block(values, k, &m);
+    }
+}
+
+/// The non-negative part of the leading `dofs x dofs` block of a symmetric matrix.
+fn clamp_to_psd(m: &nalgebra::Matrix3<f64>, dofs: usize) -> nalgebra::Matrix3<f64> {
+    let mut out = nalgebra::Matrix3::zeros();
+    match dofs {
+        1 => out[(0, 0)] = m[(0, 0)].max(0.0),
+        2 => {
+            let eig = nalgebra::Matrix2::new(m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]).symmetric_eigen();
+            let clamped = eig.eigenvectors
+                * nalgebra::Matrix2::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0)))
+                * eig.eigenvectors.transpose();
+            out.fixed_view_mut::<2, 2>(0, 0).copy_from(&clamped);
+        }
+        _ => {
+            let eig = m.symmetric_eigen();
+            out = eig.eigenvectors
+                * nalgebra::Matrix3::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0)))
+                * eig.eigenvectors.transpose();
+        }
+    }
+    out
+}
+
+/// Nodes held against the tool by free contact.
+fn active_contacts(cons: &Constraints, s: &State) -> usize {
+    if cons.mode != ContactMode::Free {
+        return 0;
+    }
+    s.sliding.iter().filter(|&&sl| sl).count()
+}
+
+/// The state `x + delta` with the nodes that slide on the tool moved back onto it and free
+/// nodes that would enter it put on its surface; returns the feet found.
+fn moved(cons: &Constraints, x: &[Point], delta: &[Vector], sliding: &[bool]) -> (Vec<Point>, Feet) {
+    let range = CONTACT_RANGE * cons.spacing;
+    let mut out: Vec<Point> = x.iter().zip(delta).map(|(p, d)| p + d).collect();
+    let Some(tool) = cons.tool else { return (out, vec![None; x.len()]) };
+    let new_feet: Feet = out
+        .par_iter_mut()
+        .zip(&cons.freedom)
+        .zip(sliding)
+        .map(|((p, f), &sliding)| match cons.mode {
+            ContactMode::Pressed if f.on_tool() => {
+                let foot = tool.locate(p);
+                *p = foot.point;
+                Some(Foot { gap: 0.0, ..foot })
+            }
+            ContactMode::Free if f.dofs() > 0 => {
+                let foot = tool.locate_near(p, range)?;
+                if sliding || foot.gap < 0.0 {
+                    *p = foot.point;
+                    Some(Foot { gap: 0.0, ..foot })
+                } else {
+                    Some(foot)
+                }
+            }
+            _ => None,
+        })
+        .collect();
+    (out, new_feet)
+}
+
+/// The nodes with the largest unbalanced force over their free directions, and the energy term
+/// that dominates there.
+fn unbalanced_nodes(objective: &dyn Objective, x: &[Point], red: &Reduction, s: &State) -> Vec<UnbalancedNode> {
+    let r = red.reduce(&unbalanced(&s.eval), &s.bases);
+    let mut per: Vec<(f64, usize)> = (0..x.len())
+        .filter(|&k| red.rep(k) == k)
+        .map(|k| {
+            let (o, m) = red.vars(k);
+            (r[o..o + m].iter().map(|v| v * v).sum::<f64>().sqrt(), k)
+        })
+        .filter(|(f, _)| *f > 0.0)
+        .collect();
+    per.sort_by(|a, b| b.0.total_cmp(&a.0));
+    per.truncate(UNBALANCED_REPORTED);
+    let terms = objective.term_forces(x);
+    per.into_iter()
+        .map(|(force, node)| {
+            let basis = &s.bases[node];
+            let along = |f: &Vector| (0..basis.dofs).map(|p| basis.dir(p).dot(f).powi(2)).sum::<f64>().sqrt();
+            let dominant_term = terms
+                .iter()
+                .map(|(name, f)| (*name, along(&f[node])))
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(name, _)| name);
+            UnbalancedNode { node, force, dominant_term }
         })
         .collect()
 }
@@ -300,270 +754,15 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Minimise the objective from `x` (modified in place to the last accepted state).
-pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, settings: &SolverSettings) -> SolveReport {
-    let start = std::time::Instant::now();
-    let reduction = Reduction::new(&cons.freedom, &objective.coupled_pairs());
-    let movable: Vec<bool> = cons.freedom.iter().map(|f| f.dofs() > 0).collect();
-    let rows_at = |x: &[Point]| -> Vec<ContactRow> {
-        match (cons.mode, cons.tool) {
-            (ContactMode::Free, Some(tool)) => contact_rows(tool, x, &movable, cons.spacing),
-            _ => Vec::new(),
-        }
-    };
-    let mut eval = objective.evaluate(x, true);
-    let mut bases = bases_at(cons, x, &eval, None);
-    let mut rows = rows_at(x);
-    let energy_start = eval.energy;
-    let mut iterations = Vec::new();
-    let mut damping = settings.initial_damping;
-    let mut history = vec![eval.energy];
-    // Force scale: the larger of the loads and the internal forces at the start, so that a net
-    // relaxing towards zero force with no load (P = 0) still measures its progress.
-    // ... and never below the rounding noise of the forces: what would move the nodes by a
-    // FORCE_NOISE fraction of the spacing through the model's mean stiffness.
-    let mean_stiffness = {
-        let h = reduction.values(eval.hessian.as_deref().expect("hessian requested"), &bases);
-        reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| h[k].abs()).sum::<f64>()
-            / reduction.n.max(1) as f64
-    };
-    let noise = FORCE_NOISE * mean_stiffness * cons.spacing * (reduction.n as f64).sqrt();
-    let force_scale = settings.force_scale.unwrap_or_else(|| start_forces(&reduction, &eval, &bases)).max(noise);
-    let energy_noise = FORCE_NOISE * mean_stiffness * cons.spacing * cons.spacing * reduction.n as f64;
-    let mut residual = residual(&reduction, &eval, &bases, &rows, cons.spacing, force_scale);
-    let mut outcome = Outcome::IterationLimit;
-    for it in 0..settings.max_iterations {
-        if residual <= settings.tolerance || reduction.n == 0 {
-            outcome = Outcome::Converged;
-            break;
-        }
-        let t_it = std::time::Instant::now();
-        let grad: Vec<Vector> = eval.internal.iter().zip(&eval.external).map(|(f, p)| f - p).collect();
-        let g = reduction.reduce(&grad, &bases);
-        let mut pvals = reduction.values(eval.hessian.as_deref().expect("hessian requested"), &bases);
-        let mean_diag = reduction.diag.iter().filter(|&&k| k != usize::MAX).map(|&k| pvals[k].abs()).sum::<f64>()
-            / reduction.n.max(1) as f64;
-        let scale = mean_diag.max(f64::MIN_POSITIVE);
-        // Try steps with growing damping until one lowers the energy.
-        let mut accepted = false;
-        let mut stationary = false;
-        let mut qp_iterations = 0;
-        let mut step_norm = 0.0;
-        let mut qp_failed = false;
-        while damping <= settings.max_damping {
-            for &k in reduction.diag.iter() {
-                if k != usize::MAX {
-                    pvals[k] += damping * scale;
-                }
-            }
-            let qp = solve_qp(&reduction, &pvals, &g, &rows, &bases);
-            let predicted = qp.as_ref().map(|(y, _)| -(dot(&g, y) + 0.5 * quad(&reduction, &pvals, y)));
-            for &k in reduction.diag.iter() {
-                if k != usize::MAX {
-                    pvals[k] -= damping * scale;
-                }
-            }
-            let (Some((y, iters)), Some(predicted)) = (qp, predicted) else {
-                // A failed subproblem: more damping conditions it better.
-                qp_failed = true;
-                damping *= 10.0;
-                continue;
-            };
-            qp_failed = false;
-            qp_iterations += iters;
-            let floor = ENERGY_ROUNDING * eval.energy.abs().max(energy_noise).max(f64::MIN_POSITIVE);
-            if predicted <= floor {
-                stationary = true; // the model sees nothing left to gain
-                break;
-            }
-            let delta = reduction.expand(&y, &bases);
-            let mut trial: Vec<Point> = x.iter().zip(&delta).map(|(p, d)| p + d).collect();
-            // Pressed nodes back onto the tool; their feet also give the next bases.
-            let feet: Option<Vec<Option<Foot>>> = match (cons.mode, cons.tool) {
-                (ContactMode::Pressed, Some(tool)) => Some(
-                    trial
-                        .par_iter_mut()
-                        .zip(&cons.freedom)
-                        .map(|(p, f)| {
-                            f.on_tool().then(|| {
-                                let foot = tool.locate(p);
-                                *p = foot.point;
-                                foot
-                            })
-                        })
-                        .collect(),
-                ),
-                _ => None,
-            };
-            let trial_eval = objective.evaluate(&trial, true);
-            let actual = eval.energy - trial_eval.energy;
-            if actual >= ACCEPT_RATIO * predicted || (actual >= 0.0 && predicted <= 100.0 * floor) {
-                step_norm = norm(&y);
-                x.copy_from_slice(&trial);
-                eval = trial_eval;
-                bases = bases_at(cons, x, &eval, feet.as_deref());
-                rows = rows_at(x);
-                if actual >= 0.75 * predicted {
-                    damping = (damping / 4.0).max(1e-12);
-                }
-                accepted = true;
-                break;
-            }
-            damping *= 5.0;
-        }
-        residual = self::residual(&reduction, &eval, &bases, &rows, cons.spacing, force_scale);
-        iterations.push(IterationLog {
-            iteration: it + 1,
-            energy: eval.energy,
-            residual,
-            step: step_norm,
-            damping,
-            active_contacts: rows.iter().filter(|r| r.gap <= ACTIVE_GAP * cons.spacing).count(),
-            accepted,
-            qp_iterations,
-            time_ms: t_it.elapsed().as_secs_f64() * 1e3,
-        });
-        if stationary {
-            outcome = if residual <= settings.tolerance { Outcome::Converged } else { Outcome::Stalled };
-            break;
-        }
-        if !accepted {
-            outcome = if qp_failed { Outcome::SubproblemFailed } else { Outcome::LineSearchFailed };
-            break;
-        }
-        history.push(eval.energy);
-        if residual <= settings.tolerance {
-            outcome = Outcome::Converged;
-            break;
-        }
-        if history.len() > settings.stall_window {
-            let old = history[history.len() - 1 - settings.stall_window];
-            if (old - eval.energy).abs() <= settings.stall_tolerance * old.abs().max(eval.energy.abs()) {
-                outcome = Outcome::Stalled;
-                break;
-            }
-        }
-    }
-    SolveReport {
-        outcome,
-        energy_start,
-        energy_end: eval.energy,
-        residual,
-        iterations,
-        time_ms: start.elapsed().as_secs_f64() * 1e3,
-    }
-}
-
-/// A step is accepted when the energy falls by at least this fraction of the predicted fall.
-const ACCEPT_RATIO: f64 = 0.1;
-/// Relative energy changes below this are rounding.
-const ENERGY_ROUNDING: f64 = 1e-14;
-/// Relative size of the rounding noise in forces and energies (see `solve`).
-const FORCE_NOISE: f64 = 1e-10;
-/// Subproblems with at least this many variables are factorised on all threads.
-const PARALLEL_FACTORISATION_MIN: usize = 20_000;
-/// A contact is active (the tool takes the node's push into it) when its gap is below this
-/// fraction of the spacing: the interior-point subproblems leave touching nodes 1e-7..1e-5
-/// spacings off the tool (measured on a free drape of a 21 x 21 net), and a node a ten-thousandth
-/// of a cell off the tool touches it for any purpose of drape.
-const ACTIVE_GAP: f64 = 1e-4;
-
-/// |F - P - R| / max(|F|, |P|, `floor`) over the free directions, where R are the contact
-/// reactions (the part of F - P pushing active contact nodes into the tool, which the tool takes)
-/// and `floor` the force scale at the start of the solve.
-fn residual(r: &Reduction, e: &Evaluation, bases: &[NodeBasis], rows: &[ContactRow], spacing: f64, floor: f64) -> f64 {
-    let mut unbalanced: Vec<Vector> = e.internal.iter().zip(&e.external).map(|(f, p)| f - p).collect();
-    for row in rows.iter().filter(|row| row.gap <= ACTIVE_GAP * spacing) {
-        let g = &mut unbalanced[row.node];
-        let push = row.normal.dot(g);
-        if push > 0.0 {
-            *g -= row.normal * push;
-        }
-    }
-    let num = norm(&r.reduce(&unbalanced, bases));
-    let den = norm(&r.reduce(&e.internal, bases)).max(norm(&r.reduce(&e.external, bases))).max(floor);
-    num / den.max(f64::MIN_POSITIVE)
-}
-
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// y^T P y for the upper-triangular CSC P.
-fn quad(r: &Reduction, p: &[f64], y: &[f64]) -> f64 {
-    let mut s = 0.0;
-    for c in 0..r.n {
-        for k in r.colptr[c]..r.colptr[c + 1] {
-            let row = r.rowval[k];
-            let v = p[k] * y[row] * y[c];
-            s += if row == c { v } else { 2.0 * v };
-        }
-    }
-    s
-}
-
-/// Solve min 1/2 y^T P y + g^T y subject to the linearised contact rows, with Clarabel.
-/// Returns the step and Clarabel's iteration count, or None if it failed.
-fn solve_qp(
-    r: &Reduction,
-    pvals: &[f64],
-    g: &[f64],
-    rows: &[ContactRow],
-    bases: &[NodeBasis],
-) -> Option<(Vec<f64>, u32)> {
-    let p = CscMatrix::new(r.n, r.n, r.colptr.clone(), r.rowval.clone(), pvals.to_vec());
-    // Contact: normal . (B_k y_k) + gap >= 0  ->  -normal^T B_k y_k + s = gap, s >= 0.
-    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); r.n];
-    let mut b = Vec::with_capacity(rows.len());
-    for (m, row) in rows.iter().enumerate() {
-        let basis = &bases[row.node];
-        for q in 0..basis.dofs {
-            let a = -row.normal.dot(&basis.dir(q));
-            if a != 0.0 {
-                cols[r.offset[row.node] + q].push((m, a));
-            }
-        }
-        b.push(row.gap);
-    }
-    let mut colptr = vec![0];
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    for col in cols {
-        for (m, a) in col {
-            rowval.push(m);
-            nzval.push(a);
-        }
-        colptr.push(rowval.len());
-    }
-    let a = CscMatrix::new(rows.len(), r.n, colptr, rowval, nzval);
-    let cones: Vec<SupportedConeT<f64>> = if rows.is_empty() { vec![] } else { vec![NonnegativeConeT(rows.len())] };
-    let settings = DefaultSettingsBuilder::default()
-        .verbose(false)
-        .max_iter(100)
-        // Ruiz equilibration makes these subproblems (stiff fibres beside soft shear, a few
-        // directions per node) far harder: 10-30 interior-point iterations instead of one
-        // factorisation for a pressed net (measured with `drape bench --refine`).
-        .equilibrate_enable(false)
-        .direct_solve_method("faer".to_string())
-        // Threads only pay for large factorisations; on small ones they cost more in switching
-        // than they save (`perf` on a 21 x 21 free drape: a quarter of the time in the kernel).
-        .max_threads(if r.n >= PARALLEL_FACTORISATION_MIN { 0 } else { 1 })
-        .build()
-        .ok()?;
-    let mut solver = DefaultSolver::new(&p, g, &a, &b, &cones, settings).ok()?;
-    solver.solve();
-    match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => {
-            Some((solver.solution.x.clone(), solver.solution.iterations))
-        }
-        _ => None,
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::geometry::shapes;
+    use nalgebra::Matrix3;
 
     /// 1/2 sum k |x - target|^2: each node pulled to its target by a spring.
     struct Springs {
@@ -594,6 +793,18 @@ mod tests {
         fn coupled_pairs(&self) -> Vec<(usize, usize)> {
             (0..self.targets.len()).map(|k| (k, k)).collect()
         }
+        fn masses(&self) -> Vec<f64> {
+            vec![1.0; self.targets.len()]
+        }
+    }
+
+    fn cons<'a>(
+        freedom: Vec<Freedom>,
+        mode: ContactMode,
+        tool: Option<&'a dyn ContactSurface>,
+        spacing: f64,
+    ) -> Constraints<'a> {
+        Constraints { freedom, mode, tool, spacing, stitched: None }
     }
 
     #[test]
@@ -602,13 +813,30 @@ mod tests {
         let obj = Springs { targets: targets.clone(), k: 100.0 };
         let mut x = vec![Point::origin(); 3];
         let freedom = vec![Freedom::Free, Freedom::Fixed, Freedom::Line(Vector::z())];
-        let cons = Constraints { freedom, mode: ContactMode::None, tool: None, spacing: 1.0 };
-        let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
+        let report = solve(
+            &obj,
+            &mut x,
+            &cons(freedom, ContactMode::None, None, 1.0),
+            &SolverSettings::default().tolerance(1e-10),
+        );
         assert!(report.ok(), "{report:?}");
         assert!((x[0] - targets[0]).norm() < 1e-6);
         assert_eq!(x[1], Point::origin());
         assert!((x[2] - Point::new(0.0, 0.0, 1.0)).norm() < 1e-6);
         assert!(report.energy_end <= report.energy_start);
+    }
+
+    #[test]
+    fn stitched_nodes_move_together() {
+        // Two nodes sharing their freedoms, pulled to two targets: they meet at the midpoint.
+        let obj = Springs { targets: vec![Point::new(1.0, 0.0, 0.0), Point::new(3.0, 2.0, 0.0)], k: 1.0 };
+        let mut x = vec![Point::origin(); 2];
+        let c =
+            Constraints { stitched: Some(vec![0, 0]), ..cons(vec![Freedom::Free; 2], ContactMode::None, None, 1.0) };
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10));
+        assert!(report.ok(), "{report:?}");
+        assert!((x[0] - Point::new(2.0, 1.0, 0.0)).norm() < 1e-8, "{}", x[0]);
+        assert_eq!(x[0], x[1]);
     }
 
     #[test]
@@ -618,31 +846,33 @@ mod tests {
         let targets = vec![Point::new(0.2, 0.1, -1.0), Point::new(-0.5, 0.3, -0.5), Point::new(0.1, 0.1, 2.0)];
         let obj = Springs { targets, k: 10.0 };
         let mut x = vec![Point::new(0.0, 0.0, 0.5), Point::new(0.0, 0.0, 0.3), Point::new(0.0, 0.0, 0.1)];
-        let cons =
-            Constraints { freedom: vec![Freedom::Free; 3], mode: ContactMode::Free, tool: Some(&tool), spacing: 1.0 };
-        let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
+        let c = cons(vec![Freedom::Free; 3], ContactMode::Free, Some(&tool), 1.0);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10));
         assert!(report.ok(), "{report:?}");
-        assert!(x[0].z.abs() < 1e-6 && (x[0].x - 0.2).abs() < 1e-6, "{}", x[0]);
-        assert!(x[1].z.abs() < 1e-6);
+        assert!(x[0].z.abs() < 1e-9 && (x[0].x - 0.2).abs() < 1e-6, "{}", x[0]);
+        assert!(x[1].z.abs() < 1e-9);
         assert!((x[2].z - 2.0).abs() < 1e-6);
     }
 
     #[test]
-    fn pressed_nodes_slide_on_the_tool() {
+    fn pressed_nodes_slide_on_the_facets() {
         let tool = shapes::hemisphere(1.0, 20).into_surface().unwrap();
         // A target off the sphere: the pressed node ends at the closest point of the tool to it.
         let target = Point::new(0.6, 0.0, 1.2);
         let obj = Springs { targets: vec![target], k: 1.0 };
         let start = tool.closest_point(&Point::new(0.0, 0.0, 1.0));
         let mut x = vec![start.point];
-        let cons =
-            Constraints { freedom: vec![Freedom::OnTool], mode: ContactMode::Pressed, tool: Some(&tool), spacing: 0.1 };
-        let report = solve(&obj, &mut x, &cons, &SolverSettings::default());
-        assert!(report.ok(), "{report:?}");
+        let c = cons(vec![Freedom::OnTool], ContactMode::Pressed, Some(&tool), 0.1);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-8));
         assert!(tool.closest_point(&x[0]).distance < 1e-12);
         // The closest point of the (faceted) sphere to the target: along the target's direction.
+        // It lies on a facet edge, where the facets' tangent planes do not hold the spring's pull
+        // (a kink has a cone of normals): the solve stops there without calling it equilibrium,
+        // because no step, however short, lowers the energy.
         let expected = tool.closest_point(&target).point;
         assert!((x[0] - expected).norm() < 1e-4, "{} vs {}", x[0], expected);
+        assert!(report.energy_end < report.energy_start);
+        assert!(matches!(report.outcome, Outcome::LineSearchFailed | Outcome::Stalled), "{:?}", report.outcome);
     }
 
     #[test]
@@ -652,18 +882,12 @@ mod tests {
         let target = Point::new(0.6, 0.0, 1.2);
         let obj = Springs { targets: vec![target], k: 1.0 };
         let mut x = vec![smooth.project(&Point::new(0.0, 0.0, 1.0)).point];
-        let cons = Constraints {
-            freedom: vec![Freedom::OnTool],
-            mode: ContactMode::Pressed,
-            tool: Some(&smooth),
-            spacing: 0.1,
-        };
-        let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
+        let c = cons(vec![Freedom::OnTool], ContactMode::Pressed, Some(&smooth), 0.1);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10));
         assert!(report.ok(), "{report:?}");
         let s = smooth.project(&x[0]);
         assert!((s.point - x[0]).norm() < 1e-12);
         // At the constrained minimum the spring pulls along the surface normal...
-        // (to the energy's rounding: the solve stalls at |F - P| / |P| ~ 5e-8).
         let misalignment = (target - x[0]).normalize().cross(&s.normal).norm();
         assert!(misalignment < 1e-6, "{misalignment:e}");
         // ... which, on patches following the sphere, is near the sphere's answer: closer than
@@ -682,13 +906,8 @@ mod tests {
         let targets = vec![Point::new(1.5, 0.3, 0.0), Point::new(1.4, 1.6, 0.0)];
         let obj = Springs { targets, k: 1.0 };
         let mut x = vec![Point::new(0.2, 0.0, 0.0), Point::new(0.5, 0.5, 0.0)];
-        let cons = Constraints {
-            freedom: vec![Freedom::OnTool; 2],
-            mode: ContactMode::Pressed,
-            tool: Some(&tool),
-            spacing: 0.1,
-        };
-        let report = solve(&obj, &mut x, &cons, &SolverSettings::default().tolerance(1e-10));
+        let c = cons(vec![Freedom::OnTool; 2], ContactMode::Pressed, Some(&tool), 0.1);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10));
         assert_eq!(report.outcome, Outcome::Converged, "{report:?}");
         assert!((x[0] - Point::new(1.0, 0.3, 0.0)).norm() < 1e-9, "{}", x[0]);
         assert!((x[1] - Point::new(1.0, 1.0, 0.0)).norm() < 1e-9, "{}", x[1]);

@@ -111,13 +111,13 @@ impl Grid {
         let active = net.status.iter().map(|s| *s == NodeStatus::Placed).collect();
         Self::with_active(net.nu, net.nv, net.spacing, active)
     }
-    /// Nodes of the grid, `nu * nv`.
     #[inline]
+    /// Nodes of the grid, `nu * nv`.
     pub fn num_nodes(&self) -> usize {
         self.nu * self.nv
     }
-    /// Linear index of node (i, j): `i * nv + j`.
     #[inline]
+    /// Linear index of node (i, j): `i * nv + j`.
     pub fn index(&self, i: usize, j: usize) -> usize {
         i * self.nv + j
     }
@@ -279,6 +279,11 @@ pub trait EnergyTerm: Sync {
     /// skipped ([`Sink::element_rows`]). `x` has one position per node (inactive nodes'
     /// positions are ignored).
     fn add(&self, grid: &Grid, x: &[Point], base: Range<usize>, sink: &mut Sink<'_>);
+    /// For terms that act as stiff constraints (fibre stretch): adds to `out` the forces
+    /// `sum_e W''(e) (e(trial) - e(x) - grad e(x) . (trial - x)) grad e(x)` that the term's
+    /// measures gain to second order between `x` and `trial`, so that a correction step can
+    /// return a trial state to the term's curved valley. Other terms add nothing.
+    fn add_second_order(&self, _grid: &Grid, _x: &[Point], _trial: &[Point], _out: &mut [Vector]) {}
 }
 
 /// Energy, gradient and (optionally) Hessian at one configuration.
@@ -374,7 +379,7 @@ impl<'a> Model<'a> {
             (Some(_), _) => out.hessian = Some(SymmetricMatrix::zeros(self.pattern.clone())),
         }
         let values: Option<&mut [f64]> = out.hessian.as_mut().map(|h| &mut h.values[..]);
-        let per_term = self.run(x, Some(&mut out.gradient), values, want);
+        let per_term = self.run(x, Some(&mut out.gradient), values, want, None);
         out.terms = self.terms.iter().zip(&per_term).map(|(t, e)| (t.name(), *e)).collect();
         out.energy = per_term.iter().sum();
     }
@@ -382,16 +387,39 @@ impl<'a> Model<'a> {
     /// The total energy only (for line searches).
     pub fn energy(&self, x: &[Point]) -> f64 {
         assert_eq!(x.len(), self.grid.num_nodes(), "one position per node");
-        self.run(x, None, None, None).iter().sum()
+        self.run(x, None, None, None, None).iter().sum()
     }
 
-    /// Runs every term over every strip; returns the energy per term.
+    /// The second-order forces of the terms that act as stiff constraints between `x` and
+    /// `trial` (see [`EnergyTerm::add_second_order`]).
+    pub fn second_order_forces(&self, x: &[Point], trial: &[Point]) -> Vec<Vector> {
+        let mut out = vec![Vector::zeros(); x.len()];
+        for t in &self.terms {
+            t.add_second_order(&self.grid, x, trial, &mut out);
+        }
+        out
+    }
+
+    /// The gradient of each term on its own, by name (for reports of where a solve fails).
+    pub fn term_gradients(&self, x: &[Point]) -> Vec<(&'static str, Vec<Vector>)> {
+        assert_eq!(x.len(), self.grid.num_nodes(), "one position per node");
+        (0..self.terms.len())
+            .map(|t| {
+                let mut g = vec![Vector::zeros(); x.len()];
+                self.run(x, Some(&mut g), None, None, Some(t));
+                (self.terms[t].name(), g)
+            })
+            .collect()
+    }
+
+    /// Runs every term (or only term `only`) over every strip; returns the energy per term.
     fn run(
         &self,
         x: &[Point],
         grad: Option<&mut [Vector]>,
         values: Option<&mut [f64]>,
         want: Option<HessianKind>,
+        only: Option<usize>,
     ) -> Vec<f64> {
         let grid = &self.grid;
         let (nu, nv) = (grid.nu, grid.nv);
@@ -451,7 +479,10 @@ impl<'a> Model<'a> {
                             zeroed = upto;
                         }
                     }
-                    for (t, et) in self.terms.iter().zip(e.iter_mut()) {
+                    for (index, (t, et)) in self.terms.iter().zip(e.iter_mut()).enumerate() {
+                        if only.is_some_and(|o| o != index) {
+                            continue;
+                        }
                         sink.energy = 0.0;
                         t.add(grid, x, g0..g1, &mut sink);
                         *et += sink.energy;

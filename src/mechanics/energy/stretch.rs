@@ -50,7 +50,58 @@ impl<'a, L: Laws + ?Sized> Stretch<'a, L> {
     }
 }
 
+impl<'a, L: Laws + ?Sized> Stretch<'a, L> {
+    /// The second-order force of one segment between `x` and `trial` (see
+    /// [`EnergyTerm::add_second_order`]): Green strain is quadratic in the positions, so its
+    /// second-order change is exactly `|dy_b - dy_a|^2 / (2 d^2)`.
+    #[allow(clippy::too_many_arguments)]
+    fn segment_second_order(
+        &self,
+        fibre: Fibre,
+        d2: f64,
+        width: f64,
+        a: usize,
+        b: usize,
+        x: &[Point],
+        trial: &[Point],
+        out: &mut [Vector],
+    ) {
+        let r = x[b] - x[a];
+        let e = (r.norm_squared() - d2) / (2.0 * d2);
+        let (_, _, w2) = self.material.tension(fibre, e);
+        let dy = (trial[b] - x[b]) - (trial[a] - x[a]);
+        let de = dy.norm_squared() / (2.0 * d2);
+        // d(energy d^2 w W)/dx = w W' r (grad e = r / d^2 on b): the force of the extra strain.
+        let f = r * (width * w2 * de);
+        out[b] += f;
+        out[a] -= f;
+    }
+}
+
 impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
+    fn add_second_order(&self, grid: &Grid, x: &[Point], trial: &[Point], out: &mut [Vector]) {
+        let (nu, nv) = (grid.nu, grid.nv);
+        let d2 = grid.spacing * grid.spacing;
+        let act = &grid.active;
+        for i in 0..nu {
+            for j in 0..nv {
+                let a = i * nv + j;
+                if i + 1 < nu {
+                    let width = grid.warp_segment_width(i, j);
+                    if act[a] && act[a + nv] && width > 0.0 {
+                        self.segment_second_order(Fibre::Warp, d2, width, a, a + nv, x, trial, out);
+                    }
+                }
+                if j + 1 < nv {
+                    let width = grid.weft_segment_width(i, j);
+                    if act[a] && act[a + 1] && width > 0.0 {
+                        self.segment_second_order(Fibre::Weft, d2, width, a, a + 1, x, trial, out);
+                    }
+                }
+            }
+        }
+    }
+
     fn name(&self) -> &'static str {
         "stretch"
     }

@@ -1,0 +1,358 @@
+//! The subproblem engine: quadratic models over the nodes' free directions, solved by Clarabel.
+//!
+//! Each node moves in `dofs` orthonormal directions (its [`NodeBasis`]); stitched nodes (seams)
+//! share the directions of their representative. A [`Reduction`] maps the grid's 3x3 Hessian
+//! blocks and force vectors onto these reduced variables. A [`QpEngine`] keeps one Clarabel
+//! solver per sparsity pattern of the reduced matrix and only updates its values between
+//! iterations (Clarabel's data updating), so the symbolic analysis of the factorisation is done
+//! once per pattern, not once per subproblem.
+use super::contact::NodeBasis;
+use crate::geometry::Vector;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use nalgebra::Matrix3;
+
+/// Hessian storage read block by block.
+pub trait HessianBlocks: Sync {
+    /// The 3x3 block coupling nodes `a` and `b` (rows of `a`, columns of `b`).
+    fn block(&self, a: usize, b: usize) -> Matrix3<f64>;
+}
+
+/// Where a reduced entry's value comes from: the grid blocks (node a, node b) and components (p
+/// of a, q of b).
+type Source = (u32, u32, u8, u8);
+
+/// Subproblems with at least this many variables are factorised on all threads.
+const PARALLEL_FACTORISATION_MIN: usize = 20_000;
+
+/// The reduced variables: node k's components start at `offset[rep[k]]` and number
+/// `dofs[rep[k]]`, in the directions of its basis.
+pub struct Reduction {
+    /// Per node: the node whose variables it uses (itself unless stitched to another).
+    rep: Vec<usize>,
+    /// Per node: its number of variables (0 for non-representatives).
+    dofs: Vec<u8>,
+    offset: Vec<usize>,
+    n: usize,
+    /// Upper-triangular CSC pattern over the reduced variables.
+    colptr: Vec<usize>,
+    rowval: Vec<usize>,
+    /// Per stored entry: the grid blocks (node a, node b) and components (p of a, q of b) whose
+    /// reduced values add up into it.
+    sources: Vec<Vec<Source>>,
+    /// Position of each column's diagonal entry.
+    diag: Vec<usize>,
+}
+
+impl Reduction {
+    /// The reduction for node bases with `dofs` directions each (representatives only),
+    /// `rep` the representative of each node, over the coupled node pairs `pairs`.
+    pub fn new(dofs: Vec<u8>, rep: Vec<usize>, pairs: &[(usize, usize)]) -> Self {
+        let mut offset = vec![0; dofs.len()];
+        let mut n = 0;
+        for (k, &d) in dofs.iter().enumerate() {
+            offset[k] = n;
+            n += d as usize;
+        }
+        let mut columns: Vec<Vec<(usize, Source)>> = vec![Vec::new(); n];
+        for &(a, b) in pairs {
+            let (ra, rb) = (rep[a], rep[b]);
+            for p in 0..dofs[ra] as usize {
+                for q in 0..dofs[rb] as usize {
+                    let (r, c) = (offset[ra] + p, offset[rb] + q);
+                    // Each grid pair is listed once (a <= b). Within one node's diagonal
+                    // block the upper triangle keeps p <= q; a pair of distinct nodes sharing a
+                    // representative adds its mirror there ([`Reduction::values`]).
+                    if ra == rb && p > q {
+                        continue;
+                    }
+                    let src = (a as u32, b as u32, p as u8, q as u8);
+                    if r <= c {
+                        columns[c].push((r, src));
+                    } else {
+                        columns[r].push((c, src));
+                    }
+                }
+            }
+        }
+        let mut colptr = vec![0];
+        let mut rowval = Vec::new();
+        let mut sources: Vec<Vec<Source>> = Vec::new();
+        let mut diag = vec![usize::MAX; n];
+        for (c, mut col) in columns.into_iter().enumerate() {
+            col.sort_by_key(|e| e.0);
+            let mut last = usize::MAX;
+            for (r, src) in col {
+                if r != last {
+                    if r == c {
+                        diag[c] = rowval.len();
+                    }
+                    rowval.push(r);
+                    sources.push(Vec::with_capacity(1));
+                    last = r;
+                }
+                sources.last_mut().expect("an entry was pushed").push(src);
+            }
+            colptr.push(rowval.len());
+        }
+        // Every variable gets a diagonal slot (the shift goes there even without coupling).
+        if diag.contains(&usize::MAX) {
+            return Self::with_diagonals(dofs, rep, offset, n, colptr, rowval, sources);
+        }
+        Reduction { rep, dofs, offset, n, colptr, rowval, sources, diag }
+    }
+
+    /// Rebuilds the pattern with a diagonal entry added to every column that lacks one.
+    #[allow(clippy::too_many_arguments)]
+    fn with_diagonals(
+        dofs: Vec<u8>,
+        rep: Vec<usize>,
+        offset: Vec<usize>,
+        n: usize,
+        colptr: Vec<usize>,
+        rowval: Vec<usize>,
+        sources: Vec<Vec<Source>>,
+    ) -> Self {
+        let mut new_colptr = vec![0];
+        let mut new_rowval = Vec::with_capacity(rowval.len() + n);
+        let mut new_sources = Vec::with_capacity(rowval.len() + n);
+        let mut diag = vec![usize::MAX; n];
+        for c in 0..n {
+            let mut has = false;
+            for k in colptr[c]..colptr[c + 1] {
+                if rowval[k] == c {
+                    has = true;
+                    diag[c] = new_rowval.len();
+                }
+                new_rowval.push(rowval[k]);
+                new_sources.push(sources[k].clone());
+            }
+            if !has {
+                diag[c] = new_rowval.len();
+                new_rowval.push(c);
+                new_sources.push(Vec::new());
+            }
+            new_colptr.push(new_rowval.len());
+        }
+        Reduction { rep, dofs, offset, n, colptr: new_colptr, rowval: new_rowval, sources: new_sources, diag }
+    }
+
+    /// Number of reduced variables.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Whether there is nothing to move.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// The key of the sparsity pattern (equal keys, equal patterns).
+    pub fn key(&self) -> &[u8] {
+        &self.dofs
+    }
+
+    /// The representative of node `k`.
+    pub fn rep(&self, k: usize) -> usize {
+        self.rep[k]
+    }
+
+    /// The reduced variables of node `k`: (first index, count).
+    pub fn vars(&self, k: usize) -> (usize, usize) {
+        let r = self.rep[k];
+        (self.offset[r], self.dofs[r] as usize)
+    }
+
+    /// Reduced matrix values B^T H B (upper triangle, in the pattern's order).
+    pub fn values(&self, h: &dyn HessianBlocks, bases: &[NodeBasis]) -> Vec<f64> {
+        use rayon::prelude::*;
+        self.sources
+            .par_iter()
+            .map(|srcs| {
+                let mut v = 0.0;
+                let mut cache: Option<((u32, u32), Matrix3<f64>)> = None;
+                for &(a, b, p, q) in srcs {
+                    let blk = match cache {
+                        Some((key, m)) if key == (a, b) => m,
+                        _ => {
+                            let (ra, rb) = (self.rep[a as usize], self.rep[b as usize]);
+                            let m = bases[ra].basis.transpose() * h.block(a as usize, b as usize) * bases[rb].basis;
+                            cache = Some(((a, b), m));
+                            m
+                        }
+                    };
+                    v += blk[(p as usize, q as usize)];
+                    // A pair of distinct grid nodes sharing one representative lands on the
+                    // diagonal block twice (a, b) and (b, a): add the mirror.
+                    if a != b && self.rep[a as usize] == self.rep[b as usize] {
+                        v += blk[(q as usize, p as usize)];
+                    }
+                }
+                v
+            })
+            .collect()
+    }
+
+    /// Adds `s * weight[k]` to the diagonal of every variable of node k (representatives: the
+    /// weights of the nodes they stand for are summed).
+    pub fn add_diagonal(&self, values: &mut [f64], weight: &[f64], s: f64) {
+        let mut per = vec![0.0; self.dofs.len()];
+        for (k, w) in weight.iter().enumerate() {
+            per[self.rep[k]] += w;
+        }
+        for (k, w) in per.iter().enumerate() {
+            for p in 0..self.dofs[k] as usize {
+                values[self.diag[self.offset[k] + p]] += s * w;
+            }
+        }
+    }
+
+    /// Adds the symmetric block `m` (its leading `dofs x dofs` part) to the diagonal block of
+    /// node `k`'s variables.
+    pub fn add_node_block(&self, values: &mut [f64], k: usize, m: &Matrix3<f64>) {
+        let (o, dofs) = self.vars(k);
+        for qq in 0..dofs {
+            for p in 0..=qq {
+                let (r, c) = (o + p, o + qq);
+                let col = &self.rowval[self.colptr[c]..self.colptr[c + 1]];
+                if let Ok(at) = col.binary_search(&r) {
+                    values[self.colptr[c] + at] += m[(p, qq)];
+                }
+            }
+        }
+    }
+
+    /// The mean absolute diagonal entry of `values`.
+    pub fn mean_diagonal(&self, values: &[f64]) -> f64 {
+        if self.n == 0 {
+            return 0.0;
+        }
+        self.diag.iter().map(|&k| values[k].abs()).sum::<f64>() / self.n as f64
+    }
+
+    /// Per-node vectors reduced onto the free directions (summed over stitched nodes).
+    pub fn reduce(&self, v: &[Vector], bases: &[NodeBasis]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n];
+        for (k, vk) in v.iter().enumerate() {
+            let r = self.rep[k];
+            for p in 0..self.dofs[r] as usize {
+                out[self.offset[r] + p] += bases[r].dir(p).dot(vk);
+            }
+        }
+        out
+    }
+
+    /// The displacement of every node for reduced variables `y`.
+    pub fn expand(&self, y: &[f64], bases: &[NodeBasis]) -> Vec<Vector> {
+        (0..self.rep.len())
+            .map(|k| {
+                let r = self.rep[k];
+                (0..self.dofs[r] as usize).fold(Vector::zeros(), |s, p| s + bases[r].dir(p) * y[self.offset[r] + p])
+            })
+            .collect()
+    }
+
+    /// y^T P y for the upper-triangular `values`.
+    pub fn quad(&self, values: &[f64], y: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for c in 0..self.n {
+            let entries = self.colptr[c]..self.colptr[c + 1];
+            for (&r, &value) in self.rowval[entries.clone()].iter().zip(&values[entries]) {
+                let v = value * y[r] * y[c];
+                s += if r == c { v } else { 2.0 * v };
+            }
+        }
+        s
+    }
+
+    fn matrix(&self, values: &[f64]) -> CscMatrix<f64> {
+        CscMatrix::new(self.n, self.n, self.colptr.clone(), self.rowval.clone(), values.to_vec())
+    }
+}
+
+/// Why a subproblem gave no step.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum QpFailure {
+    /// Clarabel could not be set up on the data.
+    Setup,
+    /// Clarabel ended without a solution (e.g. an indefinite or singular model): its status.
+    NotSolved(String),
+}
+
+/// One Clarabel solver per sparsity pattern, its data updated between subproblems.
+#[derive(Default)]
+pub struct QpEngine {
+    cached: Option<(Vec<u8>, DefaultSolver<f64>)>,
+    /// Solvers built (patterns seen), for the log.
+    pub builds: usize,
+    /// Subproblems solved.
+    pub solves: usize,
+}
+
+impl QpEngine {
+    /// A new engine with no solver yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn settings(n: usize) -> DefaultSettings<f64> {
+        DefaultSettingsBuilder::default()
+            .verbose(false)
+            .max_iter(50)
+            // Ruiz equilibration makes these subproblems (stiff fibres beside soft shear) far
+            // harder, and data updates need the problem as given: no presolve, no dropped zeros.
+            .equilibrate_enable(false)
+            .presolve_enable(false)
+            .input_sparse_dropzeros(false)
+            .direct_solve_method("faer".to_string())
+            // Threads only pay for large factorisations; on small ones they cost more in
+            // switching than they save.
+            .max_threads(if n >= PARALLEL_FACTORISATION_MIN { 0 } else { 1 })
+            .build()
+            .expect("valid Clarabel settings")
+    }
+
+    /// Minimise 1/2 y^T P y + q^T y (P positive definite on the reduced variables, upper
+    /// triangle `values` in `red`'s pattern). Returns y.
+    pub fn solve(&mut self, red: &Reduction, values: &[f64], q: &[f64]) -> Result<Vec<f64>, QpFailure> {
+        let n = red.len();
+        if n == 0 {
+            return Ok(Vec::new());
+        }
+        let reuse = matches!(&self.cached, Some((key, _)) if key.as_slice() == red.key());
+        if reuse {
+            let (_, solver) = self.cached.as_mut().expect("checked");
+            solver.update_P(&values.to_vec()).map_err(|_| QpFailure::Setup)?;
+            solver.update_q(&q.to_vec()).map_err(|_| QpFailure::Setup)?;
+        } else {
+            let p = red.matrix(values);
+            let a = CscMatrix::new(0, n, vec![0; n + 1], Vec::new(), Vec::new());
+            let cones: Vec<SupportedConeT<f64>> = Vec::new();
+            let solver = DefaultSolver::new(&p, q, &a, &[], &cones, Self::settings(n)).map_err(|_| QpFailure::Setup)?;
+            self.cached = Some((red.key().to_vec(), solver));
+            self.builds += 1;
+        }
+        let (_, solver) = self.cached.as_mut().expect("a solver is cached");
+        solver.solve();
+        self.solves += 1;
+        match solver.solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {
+                let y = solver.solution.x.clone();
+                if y.iter().all(|v| v.is_finite()) {
+                    Ok(y)
+                } else {
+                    Err(QpFailure::NotSolved("non-finite solution".into()))
+                }
+            }
+            status => {
+                let status = format!("{status:?}");
+                // A failed solve can leave the solver's state unusable for the next data:
+                // start afresh next time.
+                self.cached = None;
+                Err(QpFailure::NotSolved(status))
+            }
+        }
+    }
+}
