@@ -6,4 +6,7 @@ pub mod ply;
 pub mod stack;
 pub mod table;
 
-pub use ply::{Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, DEFAULT_LOCKING_ANGLE_DEG};
+pub use ply::{
+    Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_LOCKING_ANGLE_DEG,
+    DEFAULT_SOLVER_ITERATIONS, MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
+};
