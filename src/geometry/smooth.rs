@@ -42,6 +42,9 @@ const PROJECTION_MAX_ITERATIONS: usize = 20;
 /// A query counts as beyond an open edge when it is off it outwards by more than this fraction
 /// of the tool's bounding-box diagonal.
 const BOUNDARY_TOLERANCE_REL: f64 = 1e-12;
+/// A projected point lies across a facet's sharp edge when its barycentric coordinate is below
+/// minus this (rounding on the edge itself stays within it).
+const CREASE_OVERSHOOT_BARYCENTRIC: f64 = 1e-9;
 /// Relative ridge added to the curvature fit (sectors with too few neighbours fit flat).
 const CURVATURE_FIT_RIDGE: f64 = 1e-6;
 
@@ -64,6 +67,10 @@ pub struct SmoothPoint {
     /// open edge and it is off that edge outwards (the implicit surface runs on smoothly past
     /// the edge; pressed nodes are held back by the edge, free contact ends there).
     pub beyond_boundary: bool,
+    /// The query point lay beyond a sharp edge or corner of its region: the region's surface
+    /// would carry it across the edge (a table's top runs on as a plane past its rim), so the
+    /// nearest tool is the edge itself.
+    pub beyond_region: bool,
 }
 
 /// One smooth fan of facets around a vertex, with its local quadric.
@@ -338,6 +345,20 @@ impl<'a> SmoothSurface<'a> {
             }
             p -= g * (f / g2);
         }
+        // A region's implicit surface runs on past its sharp edges (a table's top continues as a
+        // plane beyond the rim): where the point found lies across such an edge of the facet under
+        // the query, the query is beyond the region and the nearest tool is that edge.
+        let lp = self.tool.barycentric(foot.triangle, &p);
+        let beyond_crease = (0..3).any(|k| {
+            lp[k] < -CREASE_OVERSHOOT_BARYCENTRIC
+                && self.tool.neighbour(foot.triangle, k).is_some_and(|n| self.regions[n as usize] != region)
+        });
+        // Off a region's smooth part the query lies within the normals of its facets (which
+        // differ by less than the crease angle): a query off its facet at a steeper angle is
+        // beyond a sharp edge or corner (a sheet's node beside a table's corner).
+        let (off_n, off_t) = (foot.normal.dot(&off), (off - foot.normal * foot.normal.dot(&off)).norm());
+        let beyond_edge_or_corner = off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
+            && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
         SmoothPoint {
             point: p,
             triangle: foot.triangle,
@@ -345,6 +366,7 @@ impl<'a> SmoothSurface<'a> {
             normal,
             region,
             beyond_boundary,
+            beyond_region: beyond_crease || beyond_edge_or_corner,
         }
     }
 }
@@ -503,6 +525,27 @@ mod tests {
             let f = tool.closest_point(&q);
             assert!((s.point - f.point).norm() < 1e-13, "{} vs {}", s.point, f.point);
             assert!((s.normal - f.normal).norm() < 1e-13);
+        }
+    }
+
+    #[cfg(feature = "shapes")]
+    #[test]
+    fn beside_a_sharp_rim_or_corner_the_nearest_tool_is_the_edge_itself() {
+        // A square table 0.1 m wide, its top at z = 0: the top's plane runs on past the rim, but
+        // a point beside the rim or beside a corner is off the table, at its distance from the
+        // edge; points over the top and beside the walls are on the faces.
+        let mesh = crate::geometry::shapes::table_box(0.1, 0.1, 0.1, 10);
+        let tool = ToolSurface::from_triangles(mesh.vertices, mesh.triangles).unwrap();
+        let smooth = SmoothSurface::new(&tool);
+        for q in [Point::new(0.06, 0.01, 0.0), Point::new(-0.05, 0.065, 0.0), Point::new(0.07, 0.08, 0.003)] {
+            let s = smooth.project(&q);
+            assert!(s.beyond_region, "{q} is beyond the rim");
+        }
+        for q in [Point::new(0.01, 0.02, 0.004), Point::new(0.058, 0.01, -0.03), Point::new(0.049, 0.0, 1e-12)] {
+            let s = smooth.project(&q);
+            assert!(!s.beyond_region, "{q} is over a face");
+            let f = tool.closest_point(&q);
+            assert!((s.point - f.point).norm() < 1e-12, "flat faces stay flat: {} vs {}", s.point, f.point);
         }
     }
 }

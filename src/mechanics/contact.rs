@@ -70,8 +70,8 @@ impl ContactSurface for SmoothSurface<'_> {
         }
         let s = self.project_from(p, &facet);
         let open_edges = self.tool().open_edges_at(s.triangle, &s.barycentric);
-        if s.beyond_boundary {
-            // Past the tool's open edge the nearest tool is the edge itself: the point is
+        if s.beyond_boundary || s.beyond_region {
+            // Past the tool's open edge, or past a sharp edge of the region the nearest tool is the edge itself: the point is
             // outside, at its distance from the edge.
             let normal = (p - facet.point).try_normalize(0.0).unwrap_or(facet.normal);
             return Some(Foot {
