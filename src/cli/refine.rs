@@ -46,6 +46,10 @@ pub struct RefineArgs {
     /// Gravity is applied in this many steps.
     #[arg(long, default_value_t = 1)]
     pub load_steps: usize,
+    /// Free drape: nodes the tool holds up stay where they touch instead of sliding on it
+    /// (seed 000's tables restrain the nodes on them).
+    #[arg(long)]
+    pub stick: bool,
     /// Solver iteration limit per load step.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
@@ -78,6 +82,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         load_steps: a.load_steps,
         solver: SolverSettings::default().max_iterations(a.max_iterations),
         sheet: Default::default(),
+        stick: a.stick,
     };
     let t = Instant::now();
     let refined = refine(&net, &tool, &material, &settings).map_err(input)?;

@@ -88,6 +88,8 @@ pub struct Refinement {
     pub max_iterations: usize,
     /// Reinforcements, seam, fold, cuts.
     pub sheet: SheetFeatures,
+    /// Free drape: nodes the tool holds up stay where they touch.
+    pub stick: bool,
 }
 
 /// Where a mechanical ply starts.

@@ -269,6 +269,7 @@ pub fn drape_layup(
                 load_steps: r.load_steps,
                 solver: SolverSettings::default().max_iterations(r.max_iterations),
                 sheet: r.sheet.clone(),
+                stick: r.stick,
                 ..RefineSettings::default()
             };
             let result = refine(&net, surface, &r.material, &settings).map_err(|source| LayupError::Refine {

@@ -44,6 +44,15 @@ pub struct LayupRow {
     /// `kinematic` or `mechanical`.
     #[serde(default)]
     pub method: Option<String>,
+    /// For a mechanical ply: whether the solver reached equilibrium (|F - P| / |P| within its
+    /// tolerance in every load step). A ply with `false` here is the last accepted state, not
+    /// a drape.
+    #[serde(default)]
+    pub converged: Option<bool>,
+    /// For a mechanical ply that did not converge: why, and where the forces are furthest from
+    /// balance.
+    #[serde(default)]
+    pub solver_failure: Option<String>,
     /// Thickness as laid flat, m.
     #[serde(default)]
     pub thickness_m: Option<f64>,
@@ -122,6 +131,8 @@ impl LayupRow {
             angle_deg: ply.angle_deg(),
             warp: Some([w.x, w.y, w.z]),
             method: Some(if ply.refinement.is_some() { "mechanical" } else { "kinematic" }.into()),
+            converged: result.refined.as_ref().map(|r| r.ok()),
+            solver_failure: result.refined.as_ref().filter(|r| !r.ok()).map(|r| r.describe_failure()),
             thickness_m: ply.thickness,
             locking_angle_deg: Some(ply.locking_angle.to_degrees()),
             max_abs_shear_deg: Some(s.max_abs_shear.to_degrees()),

@@ -122,6 +122,8 @@ pub struct RefineSettings {
     pub solver: SolverSettings,
     /// The sheet's features (reinforcements, seam, fold, cuts), laid out on the net's grid.
     pub sheet: SheetFeatures,
+    /// Free drape: nodes the tool holds up stay where they touch (see [`Constraints::stick`]).
+    pub stick: bool,
 }
 
 impl Default for RefineSettings {
@@ -133,6 +135,7 @@ impl Default for RefineSettings {
             load_steps: 1,
             solver: SolverSettings::default(),
             sheet: SheetFeatures::default(),
+            stick: false,
         }
     }
 }
@@ -263,7 +266,14 @@ pub fn refine<L: Laws + ?Sized>(
             (true, _, None) => Freedom::Free,
         })
         .collect();
-    let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing, stitched };
+    let cons = Constraints {
+        freedom,
+        mode: settings.mode,
+        tool: Some(surface),
+        spacing: kinematic.spacing,
+        stitched,
+        stick: settings.stick,
+    };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
     let solver_settings = settings.solver.clone();

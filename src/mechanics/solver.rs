@@ -227,6 +227,9 @@ pub struct Constraints<'a> {
     pub spacing: f64,
     /// Per node, the node whose freedoms it shares (stitched seams); None: each its own.
     pub stitched: Option<Vec<usize>>,
+    /// Free contact only: a node the tool holds up stays where it touches (no sliding; seed
+    /// 000's tables restrain the nodes on them) until the fabric pulls it off again.
+    pub stick: bool,
 }
 
 /// Below this residual the exact model is tried first even if the last step needed the convex
@@ -656,7 +659,11 @@ fn bases_at(cons: &Constraints, rep: &[usize], e: &Evaluation, feet: &Feet) -> (
                 (ContactMode::Free, Some(foot)) if f.dofs() > 0 => {
                     let own = f.basis(None, &descent[k]);
                     if foot.gap <= ACTIVE_GAP * cons.spacing && descent[k].dot(&foot.normal) < 0.0 {
-                        (own.without(&foot.normal), true)
+                        if cons.stick {
+                            (NodeBasis::FIXED, false)
+                        } else {
+                            (own.without(&foot.normal), true)
+                        }
                     } else {
                         (own, false)
                     }
@@ -727,6 +734,14 @@ fn clamp_to_psd(m: &nalgebra::Matrix3<f64>, dofs: usize) -> nalgebra::Matrix3<f6
 fn active_contacts(cons: &Constraints, s: &State) -> usize {
     if cons.mode != ContactMode::Free {
         return 0;
+    }
+    if cons.stick {
+        let touching = |k: usize| {
+            s.bases[k].dofs == 0
+                && cons.freedom[k].dofs() > 0
+                && s.feet[k].is_some_and(|f| f.gap <= ACTIVE_GAP * cons.spacing)
+        };
+        return (0..s.bases.len()).filter(|&k| touching(k)).count();
     }
     s.sliding.iter().filter(|&&sl| sl).count()
 }
@@ -845,7 +860,7 @@ mod tests {
         tool: Option<&'a dyn ContactSurface>,
         spacing: f64,
     ) -> Constraints<'a> {
-        Constraints { freedom, mode, tool, spacing, stitched: None }
+        Constraints { freedom, mode, tool, spacing, stitched: None, stick: false }
     }
 
     #[test]

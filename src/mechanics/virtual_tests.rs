@@ -93,7 +93,7 @@ pub fn cantilever<L: Laws + ?Sized>(laws: &L, fibre: Fibre, length: f64, nodes: 
     let grid = Grid::full(nu, nv, d);
     let gravity = Vector::new(0.0, 0.0, -STANDARD_GRAVITY);
     let mut objective = NetObjective::new(grid, laws, gravity / CANTILEVER_LOAD_STEPS as f64);
-    let cons = Constraints { freedom, mode: ContactMode::None, tool: None, spacing: d, stitched: None };
+    let cons = Constraints { freedom, mode: ContactMode::None, tool: None, spacing: d, stitched: None, stick: false };
     let settings = SolverSettings::default().max_iterations(200);
     let mut steps = Vec::new();
     for step in 1..=CANTILEVER_LOAD_STEPS {
@@ -562,6 +562,7 @@ fn run_rig<L: Laws + ?Sized>(
         tool: None,
         spacing: rig.grid.spacing,
         stitched: None,
+        stick: false,
     };
     let mut settings = SolverSettings::default().max_iterations(300).tolerance(SHEAR_TEST_TOLERANCE);
     settings.force_scale = Some(shear_force_scale(laws, sample.0));

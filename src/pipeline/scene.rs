@@ -42,6 +42,8 @@
 //! # sheet_normal = [0, 0, 1]  # with start = "flat": the sheet plane's normal (default +z)
 //! # load_steps = 1            # gravity applied in this many steps (default 1)
 //! # max_iterations = 500      # solver iterations per load step (default 500)
+//! # stick = false             # free drape: nodes the tool holds up stay where they touch
+//!                             # (seed 000's tables restrain the nodes on them; default: slide)
 //! # [[ply.reinforcement]]     # regions with multiplied properties (seed 000's bands):
 //! # edges = 0.03              #   a band this wide along the edges; or axes = W (bands along
 //! #                           #   the fibres through the origin node); or u = [u0, u1],
@@ -166,6 +168,7 @@ struct PlyFile {
     sheet_normal: Option<[f64; 3]>,
     load_steps: Option<usize>,
     max_iterations: Option<usize>,
+    stick: Option<bool>,
     #[serde(default)]
     reinforcement: Vec<ReinforcementFile>,
     seam: Option<SeamFile>,
@@ -359,6 +362,12 @@ fn refinement(
         load_steps,
         max_iterations,
         sheet,
+        stick: match (p.stick, mode) {
+            (Some(true), m) if m != ContactMode::Free => {
+                return Err(("stick", "only a free drape sticks to the tool: give mode = \"free\"".into()))
+            }
+            (s, _) => s.unwrap_or(false),
+        },
     })
 }
 
@@ -553,6 +562,7 @@ impl Scene {
                         ("sheet_normal", p.sheet_normal.is_some()),
                         ("load_steps", p.load_steps.is_some()),
                         ("max_iterations", p.max_iterations.is_some()),
+                        ("stick", p.stick.is_some()),
                         ("reinforcement", !p.reinforcement.is_empty()),
                         ("seam", p.seam.is_some()),
                         ("fold", p.fold.is_some()),
