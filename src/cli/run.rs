@@ -147,7 +147,11 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
             "{:<12} {:>7} {:<10} {:<20} {:>9.2} {:>9.2} {:>12.3e} {:>8.1} {:>11.4} {:>9} {:>10.3}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
-            if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
+            match &r.refined {
+                Some(refined) if !refined.ok() => "UNCONVERGED",
+                Some(_) => "mechanical",
+                None => "kinematic",
+            },
             ply.material.as_ref().map_or("-", |m| m.name.as_str()),
             s.max_abs_shear.to_degrees(),
             s.mean_abs_shear.to_degrees(),
@@ -157,6 +161,15 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
             s.fabric_mass.map_or("-".to_string(), |m| format!("{m:.4}")),
             r.offset.max_distance * 1e3,
         );
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if let Some(refined) = r.refined.as_ref().filter(|r| !r.ok()) {
+            out += &format!(
+                "UNCONVERGED: ply '{}' is the solver's last accepted state, not an equilibrium: {}\n",
+                ply.settings.name,
+                refined.describe_failure()
+            );
+        }
     }
     out.trim_end().to_string()
 }

@@ -49,6 +49,10 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
     }
     if let Some(s) = &m.solver {
         f.push(("solver outcome".to_string(), s.outcome.clone()));
+        if !s.converged {
+            let why = s.reason.clone().unwrap_or_else(|| s.outcome.clone());
+            f.push(("NOT CONVERGED".to_string(), format!("the last accepted state, not an equilibrium: {why}")));
+        }
     }
     if let Some(c) = &m.change_from_kinematic {
         let max = c
@@ -147,7 +151,10 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             escape(&r.name),
             escape(material.as_deref().unwrap_or("—")),
             num(r.angle_deg, 1),
-            escape(r.method.as_deref().unwrap_or("—")),
+            match r.converged {
+                Some(false) => format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or(""))),
+                _ => escape(r.method.as_deref().unwrap_or("—")),
+            },
             num(r.locking_angle_deg, 1),
             num(r.max_abs_shear_deg, 1),
             num(r.mean_abs_shear_deg, 1),

@@ -296,6 +296,8 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
             coverage: (net.num_cells() > 0).then(|| st.coverage()),
             draped_area_m2: Some(st.area),
             offset_m: net.meta.stack_offset_max_m,
+            converged: net.meta.solver.as_ref().map(|s| s.converged),
+            solver_failure: net.meta.solver.as_ref().and_then(|s| s.reason.clone()),
             ..LayupRow::default()
         });
         let recorded = net.meta.tool.clone().or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
@@ -382,6 +384,11 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         .and_then(|l| l.scene.clone())
         .map(|s| format!("Drape report: {s}"))
         .unwrap_or_else(|| format!("Drape report: {}", dir.display()));
+    let unconverged: Vec<&str> = rows.iter().filter(|r| r.converged == Some(false)).map(|r| r.name.as_str()).collect();
+    let title = match unconverged.as_slice() {
+        [] => title,
+        names => format!("NOT CONVERGED ({}): {title}", names.join(", ")),
+    };
     let page = Page { title, layup, rows, plies, patterns, notes, extra };
     bar.set_message("writing index.html");
     let index = out.join("index.html");
