@@ -19,6 +19,7 @@ mod flowmesh_readers;
 mod layup;
 mod material_cli;
 mod mechanics_cantilever;
+mod mechanics_drapes;
 mod mechanics_properties;
 mod mechanics_references;
 mod mechanics_refine;

@@ -1,0 +1,226 @@
+//! Seed 000's drapes end to end: free drapes from a flat sheet over the bundled tables and sphere
+//! (at sizes the suite can afford; the bundled scenes run the seed's sizes), the sheet variants,
+//! pressed plies on the double dome, and how a ply that did not converge is shown.
+use assert_cmd::Command;
+use drape::geometry::{Point, ToolSurface};
+use drape::io::read_tool;
+use drape::layup::stack::{drape_layup, PlyResult};
+use drape::pipeline::Scene;
+use std::path::{Path, PathBuf};
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// Drapes the scene text (tool and cards given relative to the repository) and returns the tool
+/// and the plies.
+fn drape_text(text: &str) -> (ToolSurface, Vec<PlyResult>) {
+    let dir = tempfile::tempdir().unwrap();
+    let text = text.replace("@/", &format!("{}/", env!("CARGO_MANIFEST_DIR")));
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    drape_file(&path)
+}
+
+fn drape_file(path: &Path) -> (ToolSurface, Vec<PlyResult>) {
+    let scene = Scene::load(path).unwrap();
+    let tool = read_tool(&scene.tool, scene.scale).unwrap();
+    let results = drape_layup(&scene.layup, &tool, |_, _| {}).unwrap();
+    (tool, results)
+}
+
+fn converged(r: &PlyResult) -> bool {
+    let refined = r.refined.as_ref().expect("a mechanical ply");
+    if !refined.ok() {
+        eprintln!("{}", refined.describe_failure());
+    }
+    refined.ok()
+}
+
+/// The sphere scene's sheet (1.8 m, centre over the pole of the R = 0.4 m sphere at the origin)
+/// at `n` x `n` nodes, with `extra` TOML lines for the ply.
+fn sphere_sheet(n: usize, extra: &str) -> String {
+    format!(
+        r#"tool = "@/geometries/sphere/sphere.obj"
+[[ply]]
+name = "sheet"
+origin = [0.0, 0.0, 1.0]
+warp = [1.0, 0.0, 0.0]
+material = "@/materials/sze-liu-table1.toml"
+spacing = {}
+grid = [{n}, {n}]
+method = "mechanical"
+mode = "free"
+start = "flat"
+{extra}
+"#,
+        1.8 / (n - 1) as f64
+    )
+}
+
+const SPHERE_RADIUS: f64 = 0.4;
+/// The sphere's facets lie inside the sphere by up to their sagitta; nodes rest on the smooth
+/// surface through the vertices, within this of the true sphere.
+const SPHERE_FACET_SAGITTA: f64 = 2e-4;
+
+/// Largest |p(i, j) - mirror(p(mirror i, j))| over the net, mirroring x (i along the warp).
+fn mirror_gap(r: &PlyResult, along_warp: bool) -> f64 {
+    let net = &r.net;
+    let mut worst: f64 = 0.0;
+    for i in 0..net.nu {
+        for j in 0..net.nv {
+            let (a, b) = if along_warp {
+                (net.node(i, j), net.node(net.nu - 1 - i, j))
+            } else {
+                (net.node(i, j), net.node(i, net.nv - 1 - j))
+            };
+            if let (Some(a), Some(b)) = (a, b) {
+                let m = if along_warp { Point::new(-b.x, b.y, b.z) } else { Point::new(b.x, -b.y, b.z) };
+                worst = worst.max((a - m).norm());
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn the_square_table_scene_drapes_the_whole_sheet_and_converges_with_the_mesh() {
+    // The bundled scene (41 x 41 at 5 mm) and the same sheet at 4 mm: both converge, no node is
+    // inside the table, and the corners drop alike (the seed finds its 21 x 21 and 51 x 51
+    // quarter models indistinguishable).
+    let (_, fine) = drape_file(&repo("geometries/square-table/scene.toml"));
+    assert!(converged(&fine[0]));
+    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
+        .unwrap()
+        .replace("\"square-table.obj\"", "\"@/geometries/square-table/square-table.obj\"")
+        .replace("../../materials", "@/materials")
+        .replace("spacing = 0.005", "spacing = 0.004")
+        .replace("grid = [41, 41]", "grid = [51, 51]");
+    let (_, coarse) = drape_text(&text);
+    assert!(converged(&coarse[0]));
+    for r in [&fine[0], &coarse[0]] {
+        for p in r.net.positions.iter() {
+            let inside = p.x.abs() < 0.05 - 1e-9 && p.y.abs() < 0.05 - 1e-9 && p.z < -1e-9 && p.z > -0.1;
+            assert!(!inside, "node {p} inside the table");
+        }
+    }
+    // The corners fold to one side or the other (equilibria of equal standing: the seed's
+    // experiment is "slightly nonsymmetric" too), so the mean drop of the four is compared.
+    let drop = |r: &PlyResult| {
+        let (nu, nv) = (r.net.nu, r.net.nv);
+        let corners = [(0, 0), (0, nv - 1), (nu - 1, 0), (nu - 1, nv - 1)];
+        -corners.iter().map(|&(i, j)| r.net.node(i, j).unwrap().z).sum::<f64>() / 4.0
+    };
+    let (d_fine, d_coarse) = (drop(&fine[0]), drop(&coarse[0]));
+    assert!(d_fine > 0.02 && d_fine < 0.05, "the corners hang {d_fine} m below the top");
+    assert!((d_fine - d_coarse).abs() < 3e-3, "corner drop {d_fine} m at 5 mm, {d_coarse} m at 4 mm");
+}
+
+#[test]
+fn a_flat_sheet_over_the_sphere_drapes_symmetrically_outside_it() {
+    let (_, r) = drape_text(&sphere_sheet(31, ""));
+    let r = &r[0];
+    assert!(converged(r));
+    for p in &r.net.positions {
+        assert!(p.coords.norm() > SPHERE_RADIUS - SPHERE_FACET_SAGITTA, "node {p} inside the sphere");
+    }
+    assert!(r.refined.as_ref().unwrap().steps[0].energy_end < r.refined.as_ref().unwrap().steps[0].energy_start);
+    // The pole stays where the sheet touched it; the sheet hangs well below the equator.
+    let centre = r.net.node(15, 15).unwrap();
+    assert!((centre - Point::new(0.0, 0.0, SPHERE_RADIUS)).norm() < 1e-3, "centre at {centre}");
+    assert!(r.net.node(0, 0).unwrap().z < -0.2);
+    assert!(mirror_gap(r, true) < 5e-3 && mirror_gap(r, false) < 5e-3);
+}
+
+#[test]
+fn sheet_variants_over_the_sphere_converge_and_do_what_they_say() {
+    let n = 31;
+    let (_, plain) = drape_text(&sphere_sheet(n, ""));
+    // Reinforced edges: heavier and far stiffer in bending, the border hangs differently (the
+    // seed's edges flare out instead of hanging straight down).
+    let (_, edges) = drape_text(&sphere_sheet(
+        n,
+        "[[ply.reinforcement]]\nedges = 0.12\ntension = 5.0\nshear = 5.0\nbending = 20.0\nweight = 2.0",
+    ));
+    assert!(converged(&edges[0]));
+    let mid = |r: &PlyResult| r.net.node(0, n / 2).unwrap();
+    assert!((mid(&edges[0]) - mid(&plain[0])).norm() > 0.01, "the reinforced edge hangs as the plain one");
+    // A cut across the weft links near an edge: the two lips part.
+    let (_, cut) = drape_text(&sphere_sheet(n, "[[ply.cut]]\npoints = [[-0.45, 0.81], [0.45, 0.81]]"));
+    assert!(converged(&cut[0]));
+    let net = &cut[0].net;
+    let lips: f64 = (8..23).map(|i| (net.node(i, 28).unwrap() - net.node(i, 29).unwrap()).norm()).fold(0.0, f64::max);
+    assert!(lips > 1.5 * net.spacing, "the cut's lips are {lips} m apart");
+    // A seam: two sheets stitched along a weft line; stitched nodes coincide.
+    let (_, seam) = drape_text(
+        &sphere_sheet(n, "[ply.seam]\nrows = [16, 16]\nallowance = 1")
+            .replace(&format!("grid = [{n}, {n}]"), &format!("grid = [32, {n}]")),
+    );
+    assert!(converged(&seam[0]));
+    // A fold along the weft through the middle, starting unfolded.
+    let (_, fold) = drape_text(&sphere_sheet(n, "[ply.fold]\nrow = 15\nstiffness = 98.0"));
+    assert!(converged(&fold[0]));
+}
+
+#[test]
+fn the_double_dome_presses_to_equilibrium_at_0_and_45_degrees() {
+    let scene = |angle: f64| {
+        format!(
+            r#"tool = "@/geometries/double-dome/double-dome.obj"
+[[ply]]
+name = "p"
+origin = [0.0, 0.0, 0.06]
+angle_deg = {angle}
+material = "@/materials/carbon-twill.toml"
+spacing = 0.01
+grid = [51, 41]
+method = "mechanical"
+mode = "pressed"
+"#
+        )
+    };
+    for angle in [0.0, 45.0] {
+        let (tool, r) = drape_text(&scene(angle));
+        let r = &r[0];
+        assert!(converged(r), "{angle} deg");
+        let refined = r.refined.as_ref().unwrap();
+        assert!(refined.steps[0].energy_end <= refined.steps[0].energy_start);
+        // On the tool, or (a known limit: a node carried past the tool's open edge in one step
+        // stays on the smooth surface's continuation) within a spacing of its edge.
+        let placed = r.net.positions.iter().zip(&r.net.status);
+        for p in placed.filter(|(_, s)| **s == drape::kinematic::NodeStatus::Placed).map(|(p, _)| p) {
+            assert!(tool.closest_point(p).distance < r.net.spacing, "{angle} deg: node {p} off the tool");
+        }
+    }
+}
+
+#[test]
+fn a_ply_that_did_not_converge_is_marked_everywhere_and_the_run_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
+        .unwrap()
+        .replace("\"square-table.obj\"", &format!("\"{}\"", repo("geometries/square-table/square-table.obj").display()))
+        .replace("../../materials", &repo("materials").display().to_string())
+        .replace("max_iterations = 2000", "max_iterations = 2");
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.path().join("out");
+    let run = Command::cargo_bin("drape").unwrap().arg("run").arg(&scene).arg("--out").arg(&out).output().unwrap();
+    assert_eq!(run.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("UNCONVERGED"), "{stdout}");
+    assert!(stdout.contains("largest unbalanced force"), "{stdout}");
+    let layup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("layup.json")).unwrap()).unwrap();
+    assert_eq!(layup["plies"][0]["converged"], serde_json::json!(false));
+    assert!(layup["plies"][0]["solver_failure"].as_str().unwrap().contains("iteration limit"));
+    let net: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sheet.drape.json")).unwrap()).unwrap();
+    assert_eq!(net["meta"]["solver"]["converged"], serde_json::json!(false));
+    assert!(!net["meta"]["solver"]["unbalanced"].as_array().unwrap().is_empty());
+    let report = Command::cargo_bin("drape").unwrap().arg("report").arg(&out).output().unwrap();
+    assert!(report.status.success(), "{}", String::from_utf8_lossy(&report.stderr));
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    assert!(html.contains("<title>NOT CONVERGED (sheet)"));
+    assert!(html.contains("<strong>NOT CONVERGED</strong>"));
+}
