@@ -151,7 +151,14 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
     let good = "units = \"mm\"\ntool = \"plate.obj\"\n\n[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.02\ngrid = [11, 11]\nthickness = 0.5\n\n[[ply]]\nname = \"b\"\norigin = [0, 0, 0]\nwarp = [1, 1, 0]\nspacing = 0.02\ngrid = [11, 11]\n";
     std::fs::write(&scene, good).unwrap();
     let out = dir.path().join("out");
-    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
+    let ran = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
+    // No locking angle in the plies and no card: the table says which default judged them.
+    let stdout = String::from_utf8_lossy(&ran.get_output().stdout).to_string();
+    assert!(stdout.contains("a, b give(s) no locking_angle_deg") && stdout.contains("default 45 deg"), "{stdout}");
+    let layup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("layup.json")).unwrap()).unwrap();
+    assert_eq!(layup["plies"][0]["locking_angle_source"], "default");
+    assert_eq!(layup["plies"][0]["locking_angle_deg"], 45.0);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("b.drape.json")).unwrap()).unwrap();
     // Millimetres in, metres out.

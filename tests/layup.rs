@@ -57,6 +57,9 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
         assert_eq!(p["material"], "glass");
         assert_eq!(p["method"], if k == 0 { "mechanical" } else { "kinematic" });
         assert!((p["thickness_m"].as_f64().unwrap() - GLASS_T).abs() < 1e-15);
+        // The scene gives no locking angle: the glass card's two-slope law does (30 deg).
+        assert!((p["locking_angle_deg"].as_f64().unwrap() - 30.0).abs() < 1e-12, "{}", p["locking_angle_deg"]);
+        assert_eq!(p["locking_angle_source"], "card");
         // Each ply sits on the ones below: at the pole (no shear) k plies of t0.
         let net = read_json(&out.join(format!("{}.drape.json", names[k])));
         let o = origin_node(&net);

@@ -6,4 +6,7 @@ pub mod ply;
 pub mod stack;
 pub mod table;
 
-pub use ply::{Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, DEFAULT_LOCKING_ANGLE_DEG};
+pub use ply::{
+    locking_angle_deg, Layup, LockingSource, Orientation, Ply, PlyMaterial, Refinement, StackSide,
+    DEFAULT_LOCKING_ANGLE_DEG,
+};

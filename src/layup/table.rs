@@ -3,7 +3,7 @@
 //! ([`crate::io::layup_json`]); `drape report` reads that file into the same type.
 use super::nest::Nesting;
 use super::stack::PlyResult;
-use super::Ply;
+use super::{LockingSource, Ply};
 use serde::{Deserialize, Serialize};
 
 /// `layup.json`: the layup table of a run. Every field but a row's name may be missing in a file
@@ -50,6 +50,9 @@ pub struct LayupRow {
     /// Locking angle, degrees.
     #[serde(default)]
     pub locking_angle_deg: Option<f64>,
+    /// Where the locking angle comes from: `ply`, `card` or `default`.
+    #[serde(default)]
+    pub locking_angle_source: Option<LockingSource>,
     /// Largest |shear| over the complete cells, degrees.
     #[serde(default)]
     pub max_abs_shear_deg: Option<f64>,
@@ -124,6 +127,7 @@ impl LayupRow {
             method: Some(if ply.refinement.is_some() { "mechanical" } else { "kinematic" }.into()),
             thickness_m: ply.thickness,
             locking_angle_deg: Some(ply.locking_angle.to_degrees()),
+            locking_angle_source: Some(ply.locking_source),
             max_abs_shear_deg: Some(s.max_abs_shear.to_degrees()),
             mean_abs_shear_deg: Some(s.mean_abs_shear.to_degrees()),
             area_over_locking_m2: Some(s.area_over_locking),

@@ -148,7 +148,11 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             escape(material.as_deref().unwrap_or("—")),
             num(r.angle_deg, 1),
             escape(r.method.as_deref().unwrap_or("—")),
-            num(r.locking_angle_deg, 1),
+            match r.locking_angle_source {
+                Some(source) if source != crate::layup::LockingSource::Ply =>
+                    format!("{} <span class=\"small\">({})</span>", num(r.locking_angle_deg, 1), source.tag()),
+                _ => num(r.locking_angle_deg, 1),
+            },
             num(r.max_abs_shear_deg, 1),
             num(r.mean_abs_shear_deg, 1),
             num(r.area_over_locking_m2, 4),

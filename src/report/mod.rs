@@ -26,7 +26,8 @@ use crate::io::read_tool_mesh;
 use crate::io::{read_net, write_atomic, ExportError};
 use crate::kinematic::{DrapeNet, Method};
 use crate::layup::table::{LayupRow, LayupTable};
-use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::layup::{locking_angle_deg, LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
+use crate::material::MaterialCard;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use render::{Mark, ToolLayer};
@@ -151,7 +152,7 @@ struct RawTool {
     hi: Point,
 }
 
-/// Where a net's tool OBJ is: as recorded (relative to the run's working folder), else
+/// Where a net's tool (or material card) file is: as recorded (relative to the run's working folder), else
 /// relative to the run folder, else its file name in the run folder.
 fn locate_tool(recorded: &str, dir: &Path) -> Option<PathBuf> {
     let p = PathBuf::from(recorded);
@@ -278,11 +279,25 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for stem in order {
         let net = nets.remove(&stem).expect("ordered from the map's keys");
         let given = layup.as_ref().and_then(|l| l.plies.iter().find(|r| r.name == stem)).cloned();
-        let locking_deg = given
-            .as_ref()
-            .and_then(|r| r.locking_angle_deg)
-            .filter(|a| a.is_finite() && *a > 0.0)
-            .unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
+        let recorded_locking = given.as_ref().and_then(|r| r.locking_angle_deg).filter(|a| a.is_finite() && *a > 0.0);
+        let (locking_deg, locking_source) = match recorded_locking {
+            Some(a) => (a, given.as_ref().and_then(|r| r.locking_angle_source).unwrap_or(LockingSource::Ply)),
+            None => {
+                // The card the net records, found as the tool is.
+                let card = net
+                    .meta
+                    .material
+                    .as_deref()
+                    .and_then(|m| locate_tool(m, dir))
+                    .and_then(|p| MaterialCard::load(&p).ok());
+                locking_angle_deg(None, card.as_ref())
+            }
+        };
+        if locking_source == LockingSource::Default {
+            notes.push(format!(
+                "ply '{stem}': neither {LAYUP_FILE} nor a material card gives a locking angle: judged against the default {DEFAULT_LOCKING_ANGLE_DEG}°"
+            ));
+        }
         let st = net.shear_stats(locking_deg.to_radians());
         let row = given.unwrap_or_else(|| LayupRow {
             name: stem.clone(),
@@ -290,6 +305,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
             angle_deg: net.meta.angle_deg,
             method: Some(method_name(net.method).into()),
             locking_angle_deg: Some(locking_deg),
+            locking_angle_source: Some(locking_source),
             max_abs_shear_deg: Some(st.max_abs.to_degrees()),
             mean_abs_shear_deg: Some(st.mean_abs.to_degrees()),
             area_over_locking_m2: Some(st.area_over_locking),
