@@ -8,6 +8,7 @@ use super::summary::summary;
 use super::{compute, input, Failure};
 use crate::io::Format;
 use crate::layup::stack::PlyResult;
+use crate::layup::table::CoverageOf;
 use crate::layup::{LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
 use crate::pipeline::run::{run as run_scene, Event, RunError};
 use crate::pipeline::Scene;
@@ -123,7 +124,7 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
 /// The layup table: one row per ply in stacking order.
 fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     let mut out = format!(
-        "layup: {} plies on {}\n{:<12} {:>7} {:<10} {:<20} {:>7} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
+        "layup: {} plies on {}\n{:<12} {:>7} {:<10} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
         scene.layup.plies.len(),
         scene.tool.display(),
         "ply",
@@ -140,13 +141,13 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         "offset"
     );
     out += &format!(
-        "{:<12} {:>7} {:<10} {:<20} {:>7} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
-        "", "deg", "", "", "deg", "deg", "deg", "m^2", "%", "m^2", "kg", "mm"
+        "{:<12} {:>7} {:<10} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm"
     );
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         let s = &r.stats;
         out += &format!(
-            "{:<12} {:>7} {:<10} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>8.1} {:>11.4} {:>9} {:>10.3}\n",
+            "{:<12} {:>7} {:<10} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
             if ply.refinement.is_some() { "mechanical" } else { "kinematic" },
@@ -159,7 +160,7 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
             s.max_abs_shear.to_degrees(),
             s.mean_abs_shear.to_degrees(),
             s.area_over_locking,
-            100.0 * s.coverage,
+            format!("{:.1} {}", 100.0 * s.coverage.share(), CoverageOf::of(&s.coverage).name()),
             s.fabric_area,
             s.fabric_mass.map_or("-".to_string(), |m| format!("{m:.4}")),
             r.offset.max_distance * 1e3,

@@ -4,6 +4,7 @@
 use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
+use crate::kinematic::coverage::SurfaceCoverage;
 use serde::{Deserialize, Serialize};
 
 /// `layup.json`: the layup table of a run. Every field but a row's name may be missing in a file
@@ -62,9 +63,16 @@ pub struct LayupRow {
     /// Draped area of the cells sheared past the locking angle, m^2.
     #[serde(default)]
     pub area_over_locking_m2: Option<f64>,
-    /// Complete cells over the cells the ply asked for.
+    /// Share of the surface the ply covers: of the tool it lies on (offset by the plies below),
+    /// or of the part of it inside the ply's outline (see `coverage_of`).
     #[serde(default)]
     pub coverage: Option<f64>,
+    /// What `coverage` is a share of: `tool` or `outline`.
+    #[serde(default)]
+    pub coverage_of: Option<CoverageOf>,
+    /// Area of the tool (or the outline) the ply covers, m^2.
+    #[serde(default)]
+    pub covered_area_m2: Option<f64>,
     /// Complete cells.
     #[serde(default)]
     pub cells: Option<usize>,
@@ -86,6 +94,35 @@ pub struct LayupRow {
     /// Offset vertices moved off their normals to bridge tight concave corners.
     #[serde(default)]
     pub offset_bridged_vertices: Option<usize>,
+}
+
+/// What a ply's coverage is a share of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CoverageOf {
+    /// The surface the ply lies on (the tool offset by the plies below).
+    Tool,
+    /// The part of that surface inside the ply's outline.
+    Outline,
+}
+
+impl CoverageOf {
+    /// What `coverage` measures.
+    pub fn of(c: &SurfaceCoverage) -> CoverageOf {
+        if c.of_outline {
+            CoverageOf::Outline
+        } else {
+            CoverageOf::Tool
+        }
+    }
+
+    /// The word in tables: `tool` or `outline`.
+    pub fn name(self) -> &'static str {
+        match self {
+            CoverageOf::Tool => "tool",
+            CoverageOf::Outline => "outline",
+        }
+    }
 }
 
 /// The nesting of the flat patterns in the layup table.
@@ -131,7 +168,9 @@ impl LayupRow {
             max_abs_shear_deg: Some(s.max_abs_shear.to_degrees()),
             mean_abs_shear_deg: Some(s.mean_abs_shear.to_degrees()),
             area_over_locking_m2: Some(s.area_over_locking),
-            coverage: Some(s.coverage),
+            coverage: Some(s.coverage.share()),
+            coverage_of: Some(CoverageOf::of(&s.coverage)),
+            covered_area_m2: Some(s.coverage.covered_area),
             cells: Some(s.cells),
             draped_area_m2: Some(s.draped_area),
             fabric_area_m2: Some(s.fabric_area),

@@ -134,7 +134,7 @@ pub(crate) fn page(p: &Page) -> String {
 fn layup_table(h: &mut String, rows: &[LayupRow]) {
     let _ = writeln!(
         h,
-        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
+        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage (share of the tool or outline covered)</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
     );
     for r in rows {
         let material = r
@@ -156,7 +156,10 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             num(r.max_abs_shear_deg, 1),
             num(r.mean_abs_shear_deg, 1),
             num(r.area_over_locking_m2, 4),
-            r.coverage.filter(|c| c.is_finite()).map_or("—".into(), |c| format!("{:.1}%", 100.0 * c)),
+            match (r.coverage.filter(|c| c.is_finite()), r.coverage_of) {
+                (Some(c), Some(of)) => format!("{:.1}% of {}", 100.0 * c, of.name()),
+                _ => "—".into(),
+            },
             num(r.draped_area_m2, 4),
             num(r.offset_m.map(|o| o * 1e3), 2),
         );

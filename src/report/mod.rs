@@ -24,8 +24,9 @@ use crate::geometry::Point;
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::read_tool_mesh;
 use crate::io::{read_net, write_atomic, ExportError};
+use crate::kinematic::coverage::surface_coverage;
 use crate::kinematic::{DrapeNet, Method};
-use crate::layup::table::{LayupRow, LayupTable};
+use crate::layup::table::{CoverageOf, LayupRow, LayupTable};
 use crate::layup::{locking_angle_deg, LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
 use crate::material::MaterialCard;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -208,7 +209,8 @@ struct PlyInput {
     stem: String,
     net: DrapeNet,
     locking_deg: f64,
-    row: LayupRow,
+    locking_source: LockingSource,
+    given: Option<LayupRow>,
     tool: Option<PathBuf>,
     tool_note: Option<String>,
 }
@@ -298,22 +300,6 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                 "ply '{stem}': neither {LAYUP_FILE} nor a material card gives a locking angle: judged against the default {DEFAULT_LOCKING_ANGLE_DEG}°"
             ));
         }
-        let st = net.shear_stats(locking_deg.to_radians());
-        let row = given.unwrap_or_else(|| LayupRow {
-            name: stem.clone(),
-            material: net.meta.material.clone(),
-            angle_deg: net.meta.angle_deg,
-            method: Some(method_name(net.method).into()),
-            locking_angle_deg: Some(locking_deg),
-            locking_angle_source: Some(locking_source),
-            max_abs_shear_deg: Some(st.max_abs.to_degrees()),
-            mean_abs_shear_deg: Some(st.mean_abs.to_degrees()),
-            area_over_locking_m2: Some(st.area_over_locking),
-            coverage: (net.num_cells() > 0).then(|| st.coverage()),
-            draped_area_m2: Some(st.area),
-            offset_m: net.meta.stack_offset_max_m,
-            ..LayupRow::default()
-        });
         let recorded = net.meta.tool.clone().or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
         let (tool, tool_note) = match recorded {
             None => (None, Some("the net records no tool file: drawn without the tool".to_string())),
@@ -328,7 +314,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                 ),
             },
         };
-        inputs.push(PlyInput { stem, net, locking_deg, row, tool, tool_note });
+        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note });
     }
 
     std::fs::create_dir_all(out).map_err(|source| ReportError::CreateDir { path: out.to_path_buf(), source })?;
@@ -338,6 +324,17 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for p in inputs.iter().filter_map(|i| i.tool.clone()) {
         tools.entry(p.clone()).or_insert_with(|| load_tool(&p));
     }
+    // The table rows: layup.json's, else computed from the net (its coverage of the tool).
+    let rows: Vec<LayupRow> = inputs
+        .iter()
+        .map(|i| match &i.given {
+            Some(row) => row.clone(),
+            None => {
+                let tool = i.tool.as_ref().and_then(|p| tools.get(p)).and_then(|t| t.as_ref().ok());
+                row_of_net(i, tool)
+            }
+        })
+        .collect();
 
     let pictures: u64 = inputs.iter().map(|i| if i.net.method == Method::Mechanical { 3 } else { 2 }).sum();
     let bar = if progress {
@@ -392,7 +389,6 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for i in &inputs {
         extra.insert(i.stem.clone(), html::net_facts(&i.net));
     }
-    let rows: Vec<LayupRow> = inputs.iter().map(|i| i.row.clone()).collect();
     let title = layup
         .as_ref()
         .and_then(|l| l.scene.clone())
@@ -408,6 +404,36 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     files.push(index);
     let Page { plies, notes, .. } = page;
     Ok(ReportSummary { out: out.to_path_buf(), files, plies, notes })
+}
+
+/// The table row of a net that `layup.json` does not list: its shear statistics and, when its
+/// tool could be read, its coverage of the tool.
+fn row_of_net(input: &PlyInput, tool: Option<&RawTool>) -> LayupRow {
+    let (net, locking_deg) = (&input.net, input.locking_deg);
+    let st = net.shear_stats(locking_deg.to_radians());
+    let coverage = tool.map(|t| {
+        let s = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or_else(|| guess_scale(t, net));
+        let triangles: Vec<[Point; 3]> =
+            t.triangles.iter().map(|tri| tri.map(|v| Point::from(t.vertices[v as usize].coords * s))).collect();
+        surface_coverage(net, &triangles, None)
+    });
+    LayupRow {
+        name: input.stem.clone(),
+        material: net.meta.material.clone(),
+        angle_deg: net.meta.angle_deg,
+        method: Some(method_name(net.method).into()),
+        locking_angle_deg: Some(locking_deg),
+        locking_angle_source: Some(input.locking_source),
+        max_abs_shear_deg: Some(st.max_abs.to_degrees()),
+        mean_abs_shear_deg: Some(st.mean_abs.to_degrees()),
+        area_over_locking_m2: Some(st.area_over_locking),
+        coverage: coverage.map(|c| c.share()),
+        coverage_of: coverage.as_ref().map(CoverageOf::of),
+        covered_area_m2: coverage.map(|c| c.covered_area),
+        draped_area_m2: Some(st.area),
+        offset_m: net.meta.stack_offset_max_m,
+        ..LayupRow::default()
+    }
 }
 
 /// A link from the page in `out` to `file` in `dir`: relative when `out` is inside `dir`.
