@@ -350,3 +350,27 @@ fn a_mechanical_ply_in_a_scene_is_refined_and_bad_mechanical_fields_are_named() 
         assert!(err.contains(needle) && err.contains("line 3"), "expected '{needle}' in: {err}");
     }
 }
+
+/// `drape bench` reports cells placed per second: a net larger than the hemisphere leaves grid
+/// cells off the tool, and those do not count.
+#[test]
+fn bench_headline_counts_placed_cells() {
+    let a = drape().args(["bench", "--triangles", "2000", "--nodes", "61", "--repeat", "2"]).assert().success();
+    let out = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    let placed: f64 = out
+        .lines()
+        .find(|l| l.starts_with("net "))
+        .unwrap_or_else(|| panic!("{out}"))
+        .split(": ")
+        .nth(1)
+        .and_then(|s| s.split(" of the grid").next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(placed < 60.0 * 60.0, "{out}");
+    let line = out.lines().find(|l| l.starts_with("throughput:")).unwrap_or_else(|| panic!("{out}"));
+    let rate: f64 = line["throughput:".len()..].split_whitespace().next().unwrap().parse().unwrap();
+    let best_ms: f64 = line.split("best ").nth(1).unwrap().split(" ms").next().unwrap().parse().unwrap();
+    // Rates are printed to 0.01 M cells/s and the time to 0.1 ms.
+    let expected = placed / (best_ms * 1e-3) / 1e6;
+    assert!((rate - expected).abs() <= 0.01 + expected * 0.1 / best_ms, "{line}: expected {expected:.3}");
+}

@@ -109,6 +109,23 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
     for f in ["patterns.dxf", "patterns.svg", "ply-p0.svg", "ply-m45.svg", "flow.csv"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+    // One set of cell statistics: the report's pictures (drawn from the nets) and the run's
+    // table agree to the last digit, on the refined ply too; so do the run's printed summaries.
+    let report = drape::report::write_report(&out, &dir.path().join("report"), false).unwrap();
+    for (k, r) in report.plies.iter().enumerate() {
+        let row = &plies[k];
+        assert_eq!(r.name, names[k]);
+        assert_eq!(r.locking_angle_deg, row["locking_angle_deg"].as_f64().unwrap());
+        assert_eq!(r.cells as u64, row["cells"].as_u64().unwrap());
+        assert_eq!(r.max_abs_shear_deg, row["max_abs_shear_deg"].as_f64().unwrap(), "ply {}", r.name);
+        assert_eq!(r.mean_abs_shear_deg, row["mean_abs_shear_deg"].as_f64().unwrap(), "ply {}", r.name);
+        let printed = format!(
+            "|shear| max {:.2} deg, mean {:.2} deg",
+            row["max_abs_shear_deg"].as_f64().unwrap(),
+            row["mean_abs_shear_deg"].as_f64().unwrap()
+        );
+        assert!(stdout.contains(&printed), "{printed} not in {stdout}");
+    }
     // The scene's [export]: every ply on the flow mesh, fields prefixed by the ply, laminate
     // fields summed over the plies covering each element (read back with meshio).
     if std::env::var("DRAPE_SKIP_PYTHON").is_ok_and(|v| v == "1") {

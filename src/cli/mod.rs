@@ -74,7 +74,7 @@ pub enum Command {
     Calibrate(calibrate::CalibrateArgs),
     /// Virtual material tests on the mechanical model.
     Test(virtual_test::TestArgs),
-    /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
+    /// Measure the kinematic engine's throughput (placed cells per second) on a generated hemisphere.
     Bench(bench::BenchArgs),
     /// Draw every ply of a run folder (shear maps, histograms, changes) and write an HTML page.
     Report(report::ReportArgs),
