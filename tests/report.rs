@@ -19,12 +19,14 @@ const D: f64 = 0.007;
 /// Share of the distinct expected colours that must appear in a picture.
 const MIN_COLOURS_FOUND: f64 = 0.85;
 const WHITE: [u8; 3] = [255, 255, 255];
+/// The known change of p0mech per cell across the diagonal, degrees.
+const CHANGE_STEP: f64 = 0.2;
 /// Pixels in the tool's greys when the tool is drawn (the visible rim of the hemisphere).
 const MIN_TOOL_PIXELS: usize = 5000;
 
 /// Write a hemisphere tool with `subdivisions` and drape ply `p0` on it; plus `p0mech`, a
-/// mechanical copy with change_from_kinematic = 0.02 deg * (i - j) per cell (null where the
-/// cell is incomplete).
+/// mechanical copy with change_from_kinematic = CHANGE_STEP deg * (i - j) per cell (null where
+/// the cell is incomplete): a smooth change, well above the tool's facet noise.
 fn make_run(dir: &Path, subdivisions: usize) -> (DrapeNet, DrapeNet) {
     let mesh = shapes::hemisphere(R, subdivisions);
     let obj = dir.join("tool.obj");
@@ -38,7 +40,7 @@ fn make_run(dir: &Path, subdivisions: usize) -> (DrapeNet, DrapeNet) {
     let change: Vec<Option<f64>> = (0..net.num_cells())
         .map(|k| {
             let (i, j) = (k / (N - 1), k % (N - 1));
-            net.cell_shear(i, j).map(|_| 0.02 * (i as f64 - j as f64))
+            net.cell_shear(i, j).map(|_| CHANGE_STEP * (i as f64 - j as f64))
         })
         .collect();
     mech.meta
@@ -194,14 +196,22 @@ fn report_draws_every_ply_and_the_page_shows_them() {
         .collect();
     assert_colours(&hist, &expected, "p0-histogram.png bars");
 
-    // Change map of the mechanical ply: the known change pattern's colours.
+    // Change map of the mechanical ply: the known change pattern's colours, changes within the
+    // noise floor (the facets of this 2304-triangle hemisphere against 7 mm cells; a smooth
+    // change has no scatter) drawn as none.
     let hist = check_picture(&out.join("p0mech-change.png"));
+    let noise = summary.plies[1].change_noise.unwrap();
+    let facets = noise.facets_deg.unwrap();
+    assert!(noise.scatter_deg < 1e-9 && noise.floor_deg == facets, "{noise:?}");
+    // Facets about 8 mm across on R = 0.1 m: a sagitta of about 1e-4 m, 0.9 deg over 7 mm cells.
+    assert!(facets > 0.6 && facets < 1.2, "{noise:?}");
     let changes: Vec<f64> = (0..net.num_cells())
         .filter(|k| net.cell_shear(k / (N - 1), k % (N - 1)).is_some())
-        .map(|k| 0.02 * ((k / (N - 1)) as f64 - (k % (N - 1)) as f64))
+        .map(|k| CHANGE_STEP * ((k / (N - 1)) as f64 - (k % (N - 1)) as f64))
         .collect();
     let climit = change_limit(changes.iter().fold(0.0f64, |m, g| m.max(g.abs())));
-    let expected: HashSet<[u8; 3]> = changes.iter().map(|g| shear_colour(*g, climit)).collect();
+    let shown = |g: f64| if g.abs() <= noise.floor_deg { 0.0 } else { g };
+    let expected: HashSet<[u8; 3]> = changes.iter().map(|g| shear_colour(shown(*g), climit)).collect();
     assert_colours(&hist, &expected, "p0mech-change.png cells");
 
     for f in ["p0-shear.svg", "p0mech-shear.svg", "p0mech-change.svg"] {

@@ -13,6 +13,7 @@
 //!
 //! Text is rendered with the DejaVu Sans font compiled into the program (crate `dejavu`,
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
+pub mod change;
 mod html;
 mod render;
 mod view;
@@ -114,6 +115,9 @@ pub struct PlyReport {
     pub colour_limit_deg: f64,
     /// Whether the tool was drawn underneath.
     pub tool_drawn: bool,
+    /// For a mechanical ply: the noise floor of its change from the kinematic net (no change
+    /// map is drawn when every change lies within it).
+    pub change_noise: Option<change::ChangeNoise>,
     /// Pictures written for this ply.
     pub files: Vec<PathBuf>,
     /// What could not be drawn for this ply.
@@ -151,6 +155,15 @@ struct RawTool {
     triangles: Vec<[u32; 3]>,
     lo: Point,
     hi: Point,
+    /// Its facets' sagitta (file units), computed when a change map first needs it.
+    sagitta: std::sync::OnceLock<Option<f64>>,
+}
+
+impl RawTool {
+    /// The median sagitta of its curved facets, file units ([`change::facet_sagitta`]).
+    fn sagitta(&self) -> Option<f64> {
+        *self.sagitta.get_or_init(|| change::facet_sagitta(&self.vertices, &self.triangles))
+    }
 }
 
 /// Where a net's tool (or material card) file is: as recorded (relative to the run's working folder), else
@@ -172,7 +185,7 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
         lo = lo.inf(v);
         hi = hi.sup(v);
     }
-    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi })
+    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi, sagitta: Default::default() })
 }
 
 /// The scale (metres per file unit) the run read the tool with, for a net that does not record
@@ -465,11 +478,15 @@ fn draw_ply(
     let st = net.shear_stats(input.locking_deg.to_radians());
     let (max_abs_deg, mean_abs_deg) = (st.max_abs.to_degrees(), st.mean_abs.to_degrees());
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
+    let mut sagitta = None;
     let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
         Some(Ok(t)) => {
             // The scale the run read the tool with, when the net records it.
             let recorded = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0);
             let s = recorded.unwrap_or_else(|| guess_scale(t, net));
+            if net.method == Method::Mechanical {
+                sagitta = t.sagitta().map(|v| v * s);
+            }
             Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
         }
         Some(Err(e)) => {
@@ -526,16 +543,41 @@ fn draw_ply(
     )?;
     bar.inc(1);
 
+    let mut change_noise = None;
     if net.method == Method::Mechanical {
         match change_values(net) {
             Ok(change) => {
                 let max = change.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-                let limit = change_limit(max);
-                let mut map = render::layout_map(net, &change, layer.as_ref(), limit);
-                map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
-                map.subtitle = format!("largest change {max:.2}°, drawn on the mechanical net; {tool_text}");
-                map.bar_label = "shear change (deg)".into();
-                write_pair(&name("change"), |r| render::draw_map(r, &map), |r| render::draw_map(r, &map), &mut files)?;
+                let noise = change::change_noise(&change, net.nu, net.nv, net.spacing, sagitta);
+                let floor = noise.floor_deg;
+                if max <= floor {
+                    notes.push(format!(
+                        "the change from the kinematic net is within the solver's noise (largest |change| {max:.3}° against a noise floor of {floor:.3}°: {}): no change map drawn",
+                        noise_parts(&noise)
+                    ));
+                } else {
+                    // Changes within the noise are drawn as no change; the scale starts above it.
+                    let shown: Vec<Option<f64>> =
+                        change.iter().map(|v| v.map(|x| if x.abs() <= floor { 0.0 } else { x })).collect();
+                    let limit = change_limit(max);
+                    let mut map = render::layout_map(net, &shown, layer.as_ref(), limit);
+                    map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
+                    map.subtitle = format!(
+                        "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
+                    );
+                    map.bar_label = "shear change (deg)".into();
+                    map.marks = vec![
+                        Mark { value: floor, label: format!("+{floor:.2}° noise") },
+                        Mark { value: -floor, label: format!("−{floor:.2}° noise") },
+                    ];
+                    write_pair(
+                        &name("change"),
+                        |r| render::draw_map(r, &map),
+                        |r| render::draw_map(r, &map),
+                        &mut files,
+                    )?;
+                }
+                change_noise = Some(noise);
             }
             Err(why) => notes.push(format!("no change picture: {why}")),
         }
@@ -550,9 +592,16 @@ fn draw_ply(
         mean_abs_shear_deg: mean_abs_deg,
         colour_limit_deg: limit,
         tool_drawn: layer.is_some(),
+        change_noise,
         files,
         notes,
     })
+}
+
+/// What a noise floor is made of, in words.
+fn noise_parts(n: &change::ChangeNoise) -> String {
+    let facets = n.facets_deg.map_or("tool not read".to_string(), |f| format!("{f:.3}°"));
+    format!("the tool's facet sagitta over the spacing {facets}, the cell-to-cell scatter {:.3}°", n.scatter_deg)
 }
 
 /// The per-cell shear change (degrees) a mechanical net records in meta
@@ -610,6 +659,7 @@ mod tests {
             triangles: vec![],
             lo: Point::new(-k, -k, 0.0),
             hi: Point::new(k, k, k),
+            sagitta: Default::default(),
         };
         let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
         for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
