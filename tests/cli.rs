@@ -374,3 +374,59 @@ fn bench_headline_counts_placed_cells() {
     let expected = placed / (best_ms * 1e-3) / 1e6;
     assert!((rate - expected).abs() <= 0.01 + expected * 0.1 / best_ms, "{line}: expected {expected:.3}");
 }
+
+#[test]
+fn a_run_owns_its_folder_and_the_report_shows_its_plies() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let ply = |name: &str| {
+        format!("[[ply]]\nname = \"{name}\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.05\ngrid = [9, 9]\nthickness = 0.0005\n\n")
+    };
+    let head = "tool = \"plate.obj\"\n\n";
+    std::fs::write(&scene, format!("{head}{}{}", ply("a"), ply("b"))).unwrap();
+    let out = dir.path().join("out");
+    let run = |replace: bool| {
+        let mut c = drape();
+        c.args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        if replace {
+            c.arg("--replace");
+        }
+        c.assert()
+    };
+    run(false).success();
+    for f in ["a.drape.json", "b.drape.json", "b.vtu", "b.cells.csv", "layup.json"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let layup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("layup.json")).unwrap()).unwrap();
+    let files: Vec<&str> = layup["files"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+    assert!(files.contains(&"b.vtu") && files.contains(&"layup.json") && files.contains(&"patterns.dxf"), "{files:?}");
+
+    // The same folder, a scene without ply b: b's files go, a file the user put there stays.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    std::fs::write(&scene, format!("{head}{}", ply("a"))).unwrap();
+    let second = run(false).success();
+    let stdout = String::from_utf8_lossy(&second.get_output().stdout).to_string();
+    assert!(stdout.contains("removed") && stdout.contains("b.drape.json"), "{stdout}");
+    for f in ["b.drape.json", "b.vtu", "b.cells.csv"] {
+        assert!(!out.join(f).exists(), "{f} left behind");
+    }
+    assert!(out.join("a.drape.json").is_file() && out.join("notes.txt").is_file());
+
+    // A net no run into the folder wrote: refused (exit 2) unless --replace, and the report
+    // leaves it out.
+    std::fs::copy(out.join("a.drape.json"), out.join("other.drape.json")).unwrap();
+    let report = dir.path().join("report");
+    let r = drape().args(["report", out.to_str().unwrap(), "--out", report.to_str().unwrap()]).assert().success();
+    let stdout = String::from_utf8_lossy(&r.get_output().stdout).to_string();
+    assert!(report.join("a-shear.png").is_file() && !report.join("other-shear.png").exists(), "{stdout}");
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(page.contains("other.drape.json") && page.contains("not drawn"));
+    let refused = run(false).code(2);
+    let err = String::from_utf8_lossy(&refused.get_output().stderr).to_string();
+    assert!(err.contains("other.drape.json") && err.contains("--replace"), "{err}");
+    assert!(out.join("other.drape.json").is_file());
+    run(true).success();
+    assert!(!out.join("other.drape.json").exists() && out.join("a.drape.json").is_file());
+}

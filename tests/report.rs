@@ -257,6 +257,10 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
     lost.name = "lost".into();
     lost.meta.insert("tool".into(), serde_json::json!("nowhere/missing.obj"));
     write_net(&lost, dir, &[Format::Json]).unwrap();
+    // A net of another run or command that layup.json does not list: left out.
+    let mut stray = net.clone();
+    stray.name = "stray".into();
+    write_net(&stray, dir, &[Format::Json]).unwrap();
     let layup = serde_json::json!({
         "scene": "hemi.toml", "tool": "tool.obj",
         "plies": [
@@ -268,7 +272,8 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
              "draped_area_m2": 0.04, "offset_m": 0.0},
             {"name": "ghost", "material": null, "angle_deg": 90.0, "method": "kinematic", "locking_angle_deg": 45.0,
              "max_abs_shear_deg": null, "mean_abs_shear_deg": null, "area_over_locking_m2": null, "coverage": null,
-             "draped_area_m2": null, "offset_m": null}
+             "draped_area_m2": null, "offset_m": null},
+            {"name": "lost", "method": "kinematic"}
         ],
         "nesting": {"roll_width_m": 1.2, "length_m": 0.5, "used_area_m2": 0.6, "pattern_area_m2": 0.45, "waste_fraction": 0.25}
     });
@@ -278,10 +283,12 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
     let out = dir.join("pictures");
     let s = write_report(dir, &out, false).unwrap();
     let order: Vec<&str> = s.plies.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(order, ["p0mech", "p0", "lost"], "layup order first, then the unlisted net");
+    assert_eq!(order, ["p0mech", "p0", "lost"], "the layup's plies in its order, the unlisted net left out");
+    assert!(s.notes.iter().any(|n| n.contains("stray.drape.json") && n.contains("not drawn")), "{:?}", s.notes);
+    assert!(!out.join("stray-shear.png").exists());
     assert_eq!(s.plies[0].locking_angle_deg, 40.0);
     assert_eq!(s.plies[1].locking_angle_deg, 50.0);
-    assert_eq!(s.plies[2].locking_angle_deg, 45.0, "default for a ply the layup does not list");
+    assert_eq!(s.plies[2].locking_angle_deg, 45.0, "default for a ply the layup gives no locking angle");
     assert!(s.plies[0].tool_drawn && s.plies[1].tool_drawn && !s.plies[2].tool_drawn);
     assert!(s.notes.iter().any(|n| n.contains("ghost")), "{:?}", s.notes);
     assert!(s.notes.iter().any(|n| n.contains("lost") && n.contains("missing.obj")), "{:?}", s.notes);

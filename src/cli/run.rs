@@ -27,6 +27,10 @@ pub struct RunArgs {
     /// Output formats: comma-separated json,vtu,csv, or none.
     #[arg(long, default_value = "json,vtu,csv")]
     pub format: String,
+    /// Remove nets (and their .vtu, .cells.csv, .svg) in the output folder that no earlier
+    /// `drape run` into it wrote; without it the run refuses such a folder.
+    #[arg(long)]
+    pub replace: bool,
 }
 
 /// Run `drape run`.
@@ -34,7 +38,7 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
     let scene = Scene::load(&a.scene).map_err(input)?;
     let mut bar: Option<ProgressBar> = None;
-    run_scene(&scene, &a.out, &formats, &mut |event| print(event, &mut bar)).map_err(|e: RunError| {
+    run_scene(&scene, &a.out, &formats, a.replace, &mut |event| print(event, &mut bar)).map_err(|e: RunError| {
         if e.is_bad_input() {
             input(e)
         } else {
@@ -116,6 +120,11 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
         Event::FlowWritten { files } => {
             for p in files {
                 println!("  wrote {}", p.display());
+            }
+        }
+        Event::Removed { files } => {
+            for p in files {
+                println!("removed {} (an earlier run's, not written by this one)", p.display());
             }
         }
     }

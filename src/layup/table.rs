@@ -23,6 +23,10 @@ pub struct LayupTable {
     /// Where the flat patterns lie on the roll, when there is a pattern.
     #[serde(default)]
     pub nesting: Option<NestingRow>,
+    /// Every file the run wrote into its folder (names in the folder, sorted, `layup.json`
+    /// included): the next run into the folder removes those it does not write again.
+    #[serde(default)]
+    pub files: Vec<String>,
 }
 
 /// One ply of the layup table.

@@ -262,9 +262,19 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     let layup = read_layup(dir)?;
     let mut notes = Vec::new();
 
-    // Order: the layup's ply order, then nets it does not list, by name.
+    // With a layup.json, its plies in its order (nets it does not list belong to another run or
+    // command and are left out, with a note); without one, every net by name.
+    let listed = |stem: &str| layup.as_ref().is_none_or(|l| l.plies.iter().any(|r| r.name == stem));
+    let unlisted: Vec<&str> = net_files.iter().map(|(s, _)| s.as_str()).filter(|s| !listed(s)).collect();
+    if !unlisted.is_empty() {
+        notes.push(format!(
+            "{} also holds {} that {LAYUP_FILE} does not list (another run's or command's): not drawn.",
+            dir.display(),
+            unlisted.iter().map(|s| format!("{s}{NET_SUFFIX}")).collect::<Vec<_>>().join(", ")
+        ));
+    }
     let mut nets: BTreeMap<String, DrapeNet> = BTreeMap::new();
-    for (stem, path) in &net_files {
+    for (stem, path) in net_files.iter().filter(|(s, _)| listed(s)) {
         nets.insert(stem.clone(), read_net(path)?);
     }
     let mut order: Vec<String> = Vec::new();
