@@ -430,3 +430,64 @@ fn a_run_owns_its_folder_and_the_report_shows_its_plies() {
     run(true).success();
     assert!(!out.join("other.drape.json").exists() && out.join("a.drape.json").is_file());
 }
+
+/// Everything a run can check is checked before it computes: bad input exits 2 with one message
+/// saying what to do, and writes nothing.
+#[test]
+fn bad_input_is_found_before_computing_and_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let ply = "[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.05\ngrid = [9, 9]\nthickness = 0.0005\n";
+    // Permeability asked for without a card that has a [flow] section: refused before any ply is
+    // draped (no drape progress, no output folder).
+    std::fs::write(
+        &scene,
+        format!(
+            "tool = \"plate.obj\"\n[export]\nmesh = \"plate.obj\"\nformats = [\"vtu\"]\npermeability = true\n{ply}"
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let a = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("ply 'a'") && err.contains("[flow] section"), "{err}");
+    assert!(!out.exists());
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    assert!(!stdout.contains("ply a:") && !stdout.contains("tool "), "read the tool or draped first: {stdout}");
+
+    // --out a file, or under a file: exit 2, the OS error once, what to do.
+    std::fs::write(&scene, format!("tool = \"plate.obj\"\n{ply}")).unwrap();
+    let file = dir.path().join("file");
+    std::fs::write(&file, "x").unwrap();
+    for bad in [file.clone(), file.join("sub")] {
+        let a = drape().args(["run", scene.to_str().unwrap(), "--out", bad.to_str().unwrap()]).assert().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert!(err.contains("give a folder"), "{err}");
+        assert!(err.matches("os error").count() <= 1, "{err}");
+        let a =
+            drape().args(kinematic_args("plate.obj", bad.to_str().unwrap())).current_dir(dir.path()).assert().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert_eq!(err.matches("os error").count(), 1, "{err}");
+    }
+
+    // drape export creates its --out folder as drape run does; a folder as --out is refused.
+    let run_out = dir.path().join("run");
+    drape().args(["run", scene.to_str().unwrap(), "--out", run_out.to_str().unwrap()]).assert().success();
+    let net = run_out.join("a.drape.json");
+    let mesh = dir.path().join("plate.obj");
+    let export = |out: &Path| {
+        drape()
+            .args(["export", "--net", net.to_str().unwrap(), "--mesh", mesh.to_str().unwrap(), "--format", "csv"])
+            .args(["--out", out.to_str().unwrap()])
+            .assert()
+    };
+    let deep = dir.path().join("new/deeper/flow.csv");
+    export(&deep).success();
+    assert!(deep.is_file());
+    let a = export(dir.path()).code(2);
+    assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("is a folder"));
+    let a = export(&file.join("flow.csv")).code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("cannot create its folder") && err.matches("os error").count() == 1, "{err}");
+}

@@ -1,6 +1,6 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
-use super::{compute, input, Failure};
+use super::{input, Failure};
 use crate::io::flow::{write_flow, FlowFormat};
 use crate::io::{read_flow_mesh, read_net};
 use crate::mapping::{map_plies, PlyMap, PlyToMap};
@@ -8,7 +8,7 @@ use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP};
 use crate::material::MaterialCard;
 use crate::pipeline::unit_scale;
 use clap::{Args, ValueEnum};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Cavity on the command line.
@@ -65,6 +65,7 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
             return Err(input(anyhow::anyhow!("--thickness must be a positive length in metres, got {t}")));
         }
     }
+    check_out_file(&a.out)?;
     let net = read_net(&a.net).map_err(input)?;
     let card_path = a.material.clone().or_else(|| net.meta.material.as_ref().map(PathBuf::from));
     let card = match &card_path {
@@ -108,11 +109,31 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     );
     println!("{}", coverage_line(&map.plies[0]));
     println!("  mapped in {map_ms:.1} ms");
-    let written = write_flow(&mesh, &map, format, &a.out).map_err(compute)?;
+    let written = write_flow(&mesh, &map, format, &a.out).map_err(super::write_failure)?;
     for p in written {
         println!("  wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Check `--out` before anything is read: a file name (not a folder) whose folder is created
+/// like `drape run` creates its folder, and can be written.
+fn check_out_file(out: &Path) -> Result<(), Failure> {
+    let bad = |why: String| input(anyhow::anyhow!("--out {}: {why}", out.display()));
+    if out.is_dir() {
+        return Err(bad("is a folder: give a file name, like flow.vtu".into()));
+    }
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    std::fs::create_dir_all(parent).map_err(|e| {
+        bad(format!("cannot create its folder {} ({e}): give a path you can write to", parent.display()))
+    })?;
+    let probe = parent.join(format!(".drape-probe-{}", std::process::id()));
+    let probed = std::fs::write(&probe, b"");
+    let _ = std::fs::remove_file(&probe);
+    probed.map_err(|e| bad(format!("cannot write into {} ({e}): give a folder you can write to", parent.display())))
 }
 
 /// One line on a mapped ply: elements covered and their shear.

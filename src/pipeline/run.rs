@@ -2,8 +2,9 @@
 //! the run produces into one folder, telling its caller what it did through [`Event`]s (the
 //! command line prints them).
 //!
-//! Order, so that bad input costs nothing computed: the plies' settings are checked, the tool is
-//! read, the output folder is checked ([`super::folder`]), every ply is draped (a bad ply stops
+//! Order, so that bad input costs nothing computed: the plies' settings are checked, the flow
+//! export's mesh is read and the plies' cards checked for what it asks, the tool is read, the
+//! output folder is checked ([`super::folder`]), every ply is draped (a bad ply stops
 //! the run before any file is written), then each net is written, the flat patterns are nested
 //! and drawn, the plies are mapped onto the scene's flow mesh, `layup.json` is written listing
 //! every file, and last the files of an earlier run into the folder that this one did not write
@@ -196,7 +197,7 @@ impl RunError {
                 | RunError::NoFibreRadius { .. }
                 | RunError::Map(_)
                 | RunError::Folder(_)
-        )
+        ) || matches!(self, RunError::Write(e) if e.is_bad_input())
     }
 }
 
@@ -223,6 +224,9 @@ pub fn run(
             error,
         })?;
     }
+    // Everything that can be checked before computing: the flow export's cards and mesh, the
+    // tool, the output folder.
+    let flow = scene.export.as_ref().map(|e| flow_input(scene, e)).transpose()?;
     let t_load = Instant::now();
     let tool = read_tool(&scene.tool, scene.scale).map_err(RunError::Tool)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
@@ -258,7 +262,8 @@ pub fn run(
     let nesting = cutting_plan(scene, &results, out, &mut written, on)?;
     // The flow export before the table, so that the table lists its files.
     if let Some(export) = &scene.export {
-        export_flow(scene, export, &results, out, &mut written, on)?;
+        let flow = flow.as_ref().expect("read with the export");
+        export_flow(scene, export, flow, &results, out, &mut written, on)?;
     }
     let files = folder.names(&written);
     let table = LayupTable {
@@ -323,18 +328,55 @@ fn cutting_plan(
 fn export_flow(
     scene: &Scene,
     export: &SceneExport,
+    flow: &FlowInput,
     results: &[PlyResult],
     out: &Path,
     written: &mut Vec<PathBuf>,
     on: &mut dyn FnMut(Event),
 ) -> Result<(), RunError> {
     let t = Instant::now();
-    let mesh = read_flow_mesh(&export.mesh, scene.scale)
-        .map_err(|error| RunError::FlowMesh { scene: scene.path.clone(), error })?;
-    let mut plies = Vec::with_capacity(results.len());
-    for (ply, r) in scene.layup.plies.iter().zip(results) {
-        let card = ply.material.as_ref().map(|m| &m.card);
-        let permeability = if export.permeability {
+    let mesh = &flow.mesh;
+    let plies: Vec<PlyToMap> = scene
+        .layup
+        .plies
+        .iter()
+        .zip(results)
+        .zip(&flow.permeability)
+        .map(|((ply, r), permeability)| PlyToMap {
+            net: &r.net,
+            card: ply.material.as_ref().map(|m| &m.card),
+            thickness: ply.thickness,
+            permeability: *permeability,
+        })
+        .collect();
+    let map = map_plies(mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
+    let ms = flow.read_ms + t.elapsed().as_secs_f64() * 1e3;
+    on(Event::FlowMapped { path: &export.mesh, mesh, map: &map, ms });
+    for &format in &export.formats {
+        let files = write_flow(mesh, &map, format, &out.join(format.scene_file()))?;
+        on(Event::FlowWritten { files: &files });
+        written.extend(files);
+    }
+    Ok(())
+}
+
+/// What the flow export needs that can be checked before anything is draped.
+struct FlowInput {
+    /// The flow mesh, read.
+    mesh: FlowMesh,
+    /// Time to read it, ms.
+    read_ms: f64,
+    /// Each ply's permeability model, when the export asks for permeability.
+    permeability: Vec<Option<PermeabilityModel>>,
+}
+
+/// Read the scene's flow mesh and check that every ply's card gives what the export asks for,
+/// before anything is computed.
+fn flow_input(scene: &Scene, export: &SceneExport) -> Result<FlowInput, RunError> {
+    let mut permeability = Vec::with_capacity(scene.layup.plies.len());
+    for ply in &scene.layup.plies {
+        permeability.push(if export.permeability {
+            let card = ply.material.as_ref().map(|m| &m.card);
             let radius = card.and_then(|c| c.flow).map(|f| f.fibre_radius).ok_or_else(|| RunError::NoFibreRadius {
                 scene: scene.path.clone(),
                 ply: ply.settings.name.clone(),
@@ -343,15 +385,10 @@ fn export_flow(
             Some(PermeabilityModel { fibre_radius: radius })
         } else {
             None
-        };
-        plies.push(PlyToMap { net: &r.net, card, thickness: ply.thickness, permeability });
+        });
     }
-    let map = map_plies(&mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
-    on(Event::FlowMapped { path: &export.mesh, mesh: &mesh, map: &map, ms: t.elapsed().as_secs_f64() * 1e3 });
-    for &format in &export.formats {
-        let files = write_flow(&mesh, &map, format, &out.join(format.scene_file()))?;
-        on(Event::FlowWritten { files: &files });
-        written.extend(files);
-    }
-    Ok(())
+    let t = Instant::now();
+    let mesh = read_flow_mesh(&export.mesh, scene.scale)
+        .map_err(|error| RunError::FlowMesh { scene: scene.path.clone(), error })?;
+    Ok(FlowInput { mesh, read_ms: t.elapsed().as_secs_f64() * 1e3, permeability })
 }
