@@ -491,3 +491,57 @@ fn bad_input_is_found_before_computing_and_said_once() {
     let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
     assert!(err.contains("cannot create its folder") && err.matches("os error").count() == 1, "{err}");
 }
+
+/// A flow mesh the net does not cover at all is bad input naming the likely cause and the fix;
+/// one covered in part says how much.
+#[test]
+fn a_flow_mesh_the_net_misses_is_refused_with_the_cause() {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let out = dir.path().join("net");
+    // A 0.2 m net in the middle of the 1 m plate.
+    let mut args = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap());
+    args.iter_mut().filter(|a| **a == "21,21").for_each(|a| *a = "11,11");
+    args.iter_mut().filter(|a| **a == "1,1,0").for_each(|a| *a = "1,0,0");
+    drape().args(&args).assert().success();
+    let net = out.join("ply.drape.json");
+    // The plate as a flow mesh, scaled (mm) or moved (another part).
+    let text = std::fs::read_to_string(&tool).unwrap();
+    let transformed = |f: &dyn Fn(f64, f64) -> (f64, f64), name: &str| {
+        let body: String = text
+            .lines()
+            .map(|l| match l.strip_prefix("v ") {
+                Some(v) => {
+                    let c: Vec<f64> = v.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                    let (x, y) = f(c[0], c[1]);
+                    format!("v {x} {y} {}\n", c[2])
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        let p = dir.path().join(name);
+        std::fs::write(&p, body).unwrap();
+        p
+    };
+    let mm = transformed(&|x, y| (1000.0 * x, 1000.0 * y), "mm.obj");
+    let moved = transformed(&|x, y| (x + 5.0, y), "moved.obj");
+    let export = |mesh: &Path, units: &str| {
+        drape()
+            .args(["export", "--net", net.to_str().unwrap(), "--mesh", mesh.to_str().unwrap(), "--format", "csv"])
+            .args(["--mesh-units", units, "--out", dir.path().join("flow.csv").to_str().unwrap()])
+            .assert()
+    };
+    let a = export(&mm, "m").code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("covers none of the 200 elements") && err.contains("--mesh-units mm"), "{err}");
+    assert!(!dir.path().join("flow.csv").exists());
+    let a = export(&moved, "m").code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("another part") && err.contains("4.4000 m apart"), "{err}");
+    // In millimetres it is read right; the 0.2 m net on the 1 m plate covers 4 % of it.
+    let a = export(&mm, "mm").success();
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    let line = stdout.lines().find(|l| l.contains("covers")).unwrap();
+    let covered: f64 = line.split("elements (").nth(1).unwrap().split('%').next().unwrap().parse().unwrap();
+    assert!((covered - 4.0).abs() <= 2.0 && stdout.contains("covers only part of the flow mesh"), "{stdout}");
+}

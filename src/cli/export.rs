@@ -139,10 +139,17 @@ fn check_out_file(out: &Path) -> Result<(), Failure> {
 /// One line on a mapped ply: elements covered and their shear.
 pub(crate) fn coverage_line(ply: &PlyMap) -> String {
     let c = ply.coverage();
+    let share = 100.0 * c.covered as f64 / c.elements.max(1) as f64;
     let mut line = format!(
-        "  ply {}: covers {} of {} elements; |shear| max {:.2} deg, mean {:.2} deg",
+        "  ply {}: covers {} of {} elements ({share:.1}%); |shear| max {:.2} deg, mean {:.2} deg",
         ply.ply, c.covered, c.elements, c.max_abs_shear_deg, c.mean_abs_shear_deg
     );
+    if c.covered < c.elements {
+        line += &format!(
+            "; note: the ply covers only part of the flow mesh, {} element(s) lie outside it and carry no fibre data",
+            c.elements - c.covered
+        );
+    }
     if c.capped > 0 {
         line += &format!(
             "; Vf0 / cos(shear) passes the fibre packing limit in {} elements: Vf written as {VF_CAP:.4} there (the fabric locks before that)",
