@@ -1,7 +1,7 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
 use super::{input, Failure};
-use crate::io::flow::{write_flow, FlowFormat};
+use crate::io::flow::{write_flow_with, FlowFormat, FlowOptions};
 use crate::io::{read_flow_mesh, read_net};
 use crate::mapping::{map_plies, PlyMap, PlyToMap};
 use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP};
@@ -29,7 +29,7 @@ pub struct ExportArgs {
     /// Resin-flow shell mesh: Nastran (.bdf .nas .dat .fem), Abaqus (.inp), OBJ or Gmsh 4 (.msh).
     #[arg(long)]
     pub mesh: PathBuf,
-    /// Output format: vtu, nastran, abaqus, optistruct, rtmsim or csv.
+    /// Output format: vtu, nastran, abaqus, calculix, optistruct, rtmsim or csv.
     #[arg(long)]
     pub format: String,
     /// Output file (formats that need two files put the second beside it).
@@ -55,6 +55,9 @@ pub struct ExportArgs {
     /// Fibre radius, m, for --permeability.
     #[arg(long)]
     pub fibre_radius: Option<f64>,
+    /// The material the CalculiX deck's shell sections refer to (you define it).
+    #[arg(long, default_value = crate::io::calculix::DEFAULT_MATERIAL)]
+    pub material_name: String,
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Failure> {
@@ -65,6 +68,8 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
             return Err(input(anyhow::anyhow!("--thickness must be a positive length in metres, got {t}")));
         }
     }
+    crate::io::calculix::check_material_name(&a.material_name)
+        .map_err(|m| input(anyhow::anyhow!("--material-name: {m}")))?;
     check_out_file(&a.out)?;
     let net = read_net(&a.net).map_err(input)?;
     let card_path = a.material.clone().or_else(|| net.meta.material.as_ref().map(PathBuf::from));
@@ -109,7 +114,8 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     );
     println!("{}", coverage_line(&map.plies[0]));
     println!("  mapped in {map_ms:.1} ms");
-    let written = write_flow(&mesh, &map, format, &a.out).map_err(super::write_failure)?;
+    let written = write_flow_with(&mesh, &map, format, &a.out, &FlowOptions { material_name: a.material_name.clone() })
+        .map_err(super::write_failure)?;
     for p in written {
         println!("  wrote {}", p.display());
     }

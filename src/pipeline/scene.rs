@@ -15,7 +15,7 @@
 //! glass = "../../materials/glass-plain-weave.toml"
 //! [export]                    # optional: map every ply onto a resin-flow mesh
 //! mesh = "part.bdf"           # Nastran, Abaqus .inp, OBJ or Gmsh 4 .msh, in the scene's units
-//! formats = ["vtu", "csv"]    # vtu, nastran, abaqus, optistruct, rtmsim, csv
+//! formats = ["vtu", "csv"]    # vtu, nastran, abaqus, calculix, optistruct, rtmsim, csv
 //! cavity = "fixed"            # "fixed" (Vf = Vf0 / cos g) or "free" (t = t0 / cos g)
 //! permeability = true         # permeability tensors (needs [flow] in the material cards)
 //! [[ply]]
