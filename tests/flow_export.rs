@@ -225,9 +225,10 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
             .map(|n| Point::from(v3(&grids[n.as_u64().unwrap().to_string()])))
             .collect();
         let e = element(&corners);
-        // Uncovered elements go to PID 2 with a blank THETA (which pyNastran reads as 0).
+        // Uncovered elements keep their PID with a blank THETA (which pyNastran reads as 0).
         let pid = el["pid"].as_u64().unwrap();
-        match (&elements[&id].1, el["theta"].as_f64().filter(|_| pid == 1)) {
+        let blank = el["theta_blank"].as_bool().unwrap();
+        match (&elements[&id].1, el["theta"].as_f64().filter(|_| !blank)) {
             (Some((_, warp)), Some(theta)) => {
                 let r =
                     nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(e.normal), theta.to_radians());
@@ -237,7 +238,7 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
                 );
                 thetas += 1;
             }
-            (None, None) => assert_eq!(pid, 2, "Nastran element {id}: uncovered, PID {pid}"),
+            (None, None) => assert_eq!(pid, 1, "Nastran element {id}: uncovered keeps the mesh's PID (1 for OBJ)"),
             (at, theta) => panic!("Nastran element {id}: covered {} but THETA {theta:?}", at.is_some()),
         }
     }
