@@ -4,6 +4,7 @@
 Usage: python3 tools/flow_readback.py FORMAT FILE [FILE...]
 
   vtu FILE            meshio: points, cells in file order, cell data by name
+  vtu-vtk FILE        VTK's vtkXMLUnstructuredGridReader: counts and cell data by name
   nastran FILE...     pyNastran (BDF, xref off; bulk data only, as drape writes it) per deck:
                       grids, elements with PID and THETA;
                       meshio on the same deck: its GRID points (meshio skips elements that carry
@@ -77,6 +78,24 @@ def large_entries(path):
 
 
 # ---------------------------------------------------------------- formats
+
+
+def read_vtu_vtk(path):
+    """VTK's own XML reader (the one ParaView is built on): cell data by name, per cell."""
+    import vtk
+
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    if r.GetErrorCode() != 0:
+        raise SystemExit("vtk could not read %s (error code %d)" % (path, r.GetErrorCode()))
+    g = r.GetOutput()
+    cd = g.GetCellData()
+    data = {}
+    for k in range(cd.GetNumberOfArrays()):
+        a = cd.GetArray(k)
+        data[a.GetName()] = [list(a.GetTuple(i)) for i in range(a.GetNumberOfTuples())]
+    return {"points": g.GetNumberOfPoints(), "cells": g.GetNumberOfCells(), "cell_data": data}
 
 
 def read_vtu(path):
@@ -365,6 +384,8 @@ def main(argv):
     fmt, files = argv[0], argv[1:]
     if fmt == "vtu" and len(files) == 1:
         out = read_vtu(files[0])
+    elif fmt == "vtu-vtk" and len(files) == 1:
+        out = read_vtu_vtk(files[0])
     elif fmt == "nastran":
         out = read_nastran(files)
     elif fmt == "nastran-xref" and len(files) == 1:
