@@ -46,7 +46,7 @@ fn sheared_net() -> DrapeNet {
         let k = net.index(i, j);
         net.status[k] = s;
     }
-    net.meta.insert("test".into(), Value::from("export_readback"));
+    net.meta.other.insert("test".into(), Value::from("export_readback"));
     net
 }
 

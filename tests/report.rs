@@ -33,7 +33,7 @@ fn make_run(dir: &Path, subdivisions: usize) -> (DrapeNet, DrapeNet) {
     std::fs::write(&obj, mesh.to_obj_string()).unwrap();
     let tool = mesh.into_surface().unwrap();
     let mut net = drape(&tool, &KinematicSettings::grid("p0", Point::new(0.0, 0.0, R), Vector::x(), D, N, N)).unwrap();
-    net.meta.insert("tool".into(), serde_json::json!(obj.display().to_string()));
+    net.meta.tool = Some(obj.display().to_string());
     let mut mech = net.clone();
     mech.name = "p0mech".into();
     mech.method = Method::Mechanical;
@@ -43,9 +43,9 @@ fn make_run(dir: &Path, subdivisions: usize) -> (DrapeNet, DrapeNet) {
             net.cell_shear(i, j).map(|_| CHANGE_STEP * (i as f64 - j as f64))
         })
         .collect();
-    mech.meta
-        .insert("change_from_kinematic".into(), serde_json::json!({"shear_deg": change, "warp_angle_deg": change}));
-    mech.meta.insert("material".into(), serde_json::json!("materials/glass-plain-weave.toml"));
+    mech.meta.change_from_kinematic =
+        Some(drape::kinematic::CellChanges { shear_deg: change.clone(), warp_angle_deg: change });
+    mech.meta.material = Some("materials/glass-plain-weave.toml".into());
     write_net(&net, dir, &[Format::Json]).unwrap();
     write_net(&mech, dir, &[Format::Json]).unwrap();
     (net, mech)
@@ -255,7 +255,7 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
     // A third ply whose tool cannot be found.
     let mut lost = net.clone();
     lost.name = "lost".into();
-    lost.meta.insert("tool".into(), serde_json::json!("nowhere/missing.obj"));
+    lost.meta.tool = Some("nowhere/missing.obj".into());
     write_net(&lost, dir, &[Format::Json]).unwrap();
     // A net of another run or command that layup.json does not list: left out.
     let mut stray = net.clone();

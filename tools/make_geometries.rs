@@ -17,6 +17,9 @@
 //! | `saddle/saddle.obj`                   | z = (x^2 - y^2) / (2 * 0.3 m) over 0.3 x 0.3 m          |
 //! | `double-dome/double-dome.obj`         | double-dome benchmark-style part on a 0.47 x 0.37 m flange |
 //! | `hat-box/hat-box.obj`                 | 0.2 x 0.15 x 0.08 m box, vertical walls, 0.07 m flange  |
+//! | `square-table/square-table.obj`       | closed 0.1 x 0.1 x 0.1 m box, top at z = 0 (seed 000)    |
+//! | `round-table/round-table.obj`         | closed drum R = 0.8 m, 0.75 m high, top at z = 0 (seed 000) |
+//! | `sphere/sphere.obj`                   | sphere R = 0.4 m at the origin, 20 480 triangles (seed 000) |
 //!
 //! With `--large` it also writes `generated/hemisphere-200k.obj` (224 subdivisions, 200 704
 //! triangles) and `generated/hemisphere-800k.obj` (448 subdivisions, 802 816 triangles) for
@@ -55,7 +58,7 @@ fn main() -> anyhow::Result<()> {
         }
     }
 
-    let small: [Committed; 8] = [
+    let small: [Committed; 11] = [
         ("hemisphere/hemisphere-2k.obj", || hemisphere(HEMISPHERE_RADIUS, 23)),
         ("hemisphere/hemisphere-20k.obj", || hemisphere(HEMISPHERE_RADIUS, 71)),
         ("plate/plate.obj", || plate(0.4, 0.3, 80, 60)),
@@ -64,6 +67,9 @@ fn main() -> anyhow::Result<()> {
         ("saddle/saddle.obj", || saddle(0.3, 0.3, 100)),
         ("double-dome/double-dome.obj", || double_dome(&DoubleDome::benchmark(), 60)),
         ("hat-box/hat-box.obj", || hat_box(&HatBox::standard(), 0.004, 8)),
+        ("square-table/square-table.obj", || table_box(0.1, 0.1, 0.1, 10)),
+        ("round-table/round-table.obj", || round_table(0.8, 0.75, 256, 8, 6)),
+        ("sphere/sphere.obj", || icosphere(0.4, drape::geometry::Point::origin(), 5)),
     ];
     for (name, make) in &small {
         write(&out, name, &make())?;

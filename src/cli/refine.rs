@@ -77,6 +77,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         gravity: Vector::from(a.gravity),
         load_steps: a.load_steps,
         solver: SolverSettings::default().max_iterations(a.max_iterations),
+        sheet: Default::default(),
     };
     let t = Instant::now();
     let refined = refine(&net, &tool, &material, &settings).map_err(input)?;

@@ -17,7 +17,7 @@
 //! part of the library's API. [`TriangleMesh::to_obj_string`] writes a mesh as Wavefront OBJ at
 //! full `f64` precision and [`TriangleMesh::into_surface`] turns it into a checked tool surface.
 pub use super::hemisphere::{hemisphere, hemisphere_subdivisions_for, hemisphere_with_triangles};
-use super::{Point, TriangleMesh};
+use super::{Point, TriangleMesh, Vector};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
 
 // ---------------------------------------------------------------------------------------------
@@ -575,6 +575,171 @@ pub fn hat_box(p: &HatBox, cell: f64, n_fillet: usize) -> TriangleMesh {
     TriangleMesh { vertices, triangles }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Closed bodies: the tables and the sphere of seed 000's drapes
+// ---------------------------------------------------------------------------------------------
+
+/// Builds a mesh from triangles given by corner positions, sharing vertices at equal positions
+/// (exact equality: callers compute shared points by the same arithmetic).
+fn welded(triangles: impl IntoIterator<Item = [Point; 3]>) -> TriangleMesh {
+    let mut index: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
+    let mut mesh = TriangleMesh::default();
+    for tri in triangles {
+        let ids = tri.map(|p| {
+            *index.entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]).or_insert_with(|| {
+                mesh.vertices.push(p);
+                (mesh.vertices.len() - 1) as u32
+            })
+        });
+        mesh.triangles.push(ids);
+    }
+    mesh
+}
+
+/// A closed box: `length` (x) by `width` (y) by `height`, its top face at z = 0 and centred on
+/// the z axis, every face split into `n x n` quads. Its twelve edges are sharp (90 degrees), like
+/// the rim of seed 000's square table.
+///
+/// # Panics
+/// If a size is not positive or `n == 0`.
+pub fn table_box(length: f64, width: f64, height: f64, n: usize) -> TriangleMesh {
+    assert!(length > 0.0 && width > 0.0 && height > 0.0 && n > 0, "box sizes must be positive and n > 0");
+    let xs = linspace(-0.5 * length, 0.5 * length, n);
+    let ys = linspace(-0.5 * width, 0.5 * width, n);
+    let zs = linspace(-height, 0.0, n);
+    // Each face as a map of its two grid parameters, wound outwards.
+    type Face<'a> = Box<dyn Fn(usize, usize) -> Point + 'a>;
+    let faces: [Face; 6] = [
+        Box::new(|a, b| Point::new(xs[a], ys[b], 0.0)),           // top, +z
+        Box::new(|a, b| Point::new(xs[b], ys[a], -height)),       // bottom, -z
+        Box::new(|a, b| Point::new(0.5 * length, ys[a], zs[b])),  // +x
+        Box::new(|a, b| Point::new(-0.5 * length, ys[b], zs[a])), // -x
+        Box::new(|a, b| Point::new(xs[b], 0.5 * width, zs[a])),   // +y
+        Box::new(|a, b| Point::new(xs[a], -0.5 * width, zs[b])),  // -y
+    ];
+    let mut tris = Vec::with_capacity(12 * n * n);
+    for face in &faces {
+        let mut quads = Vec::new();
+        push_quads(&mut quads, n, n, |i, j| (i * (n + 1) + j) as u32);
+        for q in quads {
+            tris.push(q.map(|k| face(k as usize / (n + 1), k as usize % (n + 1))));
+        }
+    }
+    welded(tris)
+}
+
+/// A closed round table (a drum): radius `radius`, its top face at z = 0 and its bottom at
+/// z = -`height`, centred on the z axis; `n_around` segments around, the top and bottom disks in
+/// `n_rings` rings, the side in `n_side` bands. The rim is a sharp 90 degree edge, like seed 000's
+/// round table.
+///
+/// # Panics
+/// If a size is not positive or a count is too small.
+pub fn round_table(radius: f64, height: f64, n_around: usize, n_rings: usize, n_side: usize) -> TriangleMesh {
+    assert!(radius > 0.0 && height > 0.0, "table sizes must be positive");
+    assert!(n_around >= 3 && n_rings >= 1 && n_side >= 1, "table needs 3 segments, a ring and a band");
+    let angle = |k: usize| TAU * (k % n_around) as f64 / n_around as f64;
+    let ring = |r: f64, k: usize, z: f64| {
+        if r == 0.0 {
+            Point::new(0.0, 0.0, z)
+        } else {
+            Point::new(r * angle(k).cos(), r * angle(k).sin(), z)
+        }
+    };
+    let radii = linspace(0.0, radius, n_rings);
+    let zs = linspace(-height, 0.0, n_side);
+    let mut tris = Vec::new();
+    for (z, up) in [(0.0, true), (-height, false)] {
+        for m in 0..n_rings {
+            for k in 0..n_around {
+                let (r0, r1) = (radii[m], radii[m + 1]);
+                let (a, b, c, d) = (ring(r0, k, z), ring(r1, k, z), ring(r1, k + 1, z), ring(r0, k + 1, z));
+                let mut pieces = vec![[a, b, c]];
+                if m > 0 {
+                    pieces.push([a, c, d]);
+                }
+                for t in pieces {
+                    tris.push(if up { t } else { [t[0], t[2], t[1]] });
+                }
+            }
+        }
+    }
+    for s in 0..n_side {
+        for k in 0..n_around {
+            let (a, b) = (ring(radius, k, zs[s]), ring(radius, k + 1, zs[s]));
+            let (c, d) = (ring(radius, k + 1, zs[s + 1]), ring(radius, k, zs[s + 1]));
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    welded(tris)
+}
+
+/// A sphere of `radius` centred at `centre`: an icosahedron subdivided `levels` times (20 x 4^levels
+/// triangles), its vertices pushed onto the sphere, wound outwards.
+///
+/// # Panics
+/// If the radius is not positive.
+pub fn icosphere(radius: f64, centre: Point, levels: usize) -> TriangleMesh {
+    assert!(radius > 0.0, "sphere radius must be positive");
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut vertices: Vec<Vector> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| Vector::new(x, y, z).normalize())
+    .collect();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut midpoint: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        let mut split = |a: u32, b: u32, vertices: &mut Vec<Vector>| -> u32 {
+            *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                vertices.push((vertices[a as usize] + vertices[b as usize]).normalize());
+                (vertices.len() - 1) as u32
+            })
+        };
+        let mut next = Vec::with_capacity(4 * faces.len());
+        for [a, b, c] in faces {
+            let (ab, bc, ca) = (split(a, b, &mut vertices), split(b, c, &mut vertices), split(c, a, &mut vertices));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    TriangleMesh { vertices: vertices.iter().map(|v| centre + v * radius).collect(), triangles: faces }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -961,5 +1126,32 @@ mod tests {
         assert_clean_surface(saddle(0.3, 0.3, 10));
         assert_clean_surface(double_dome(&DoubleDome::benchmark(), 10));
         assert_clean_surface(hat_box(&HatBox::standard(), 0.01, 3));
+        assert_clean_surface(table_box(0.1, 0.1, 0.1, 3));
+        assert_clean_surface(round_table(0.8, 0.75, 24, 3, 2));
+        assert_clean_surface(icosphere(0.4, Point::origin(), 2));
+    }
+
+    #[test]
+    fn closed_bodies_are_watertight_and_wound_outwards() {
+        for mesh in [
+            table_box(0.1, 0.2, 0.05, 4),
+            round_table(0.8, 0.75, 32, 4, 3),
+            icosphere(0.4, Point::new(0.0, 0.0, 1.0), 3),
+        ] {
+            let t = topology(&mesh);
+            assert_eq!(t.boundary_edges, 0, "closed");
+            assert_eq!(t.components, 1);
+            // Outward winding: the enclosed volume (divergence theorem) is positive.
+            let volume: f64 = (0..mesh.triangles.len())
+                .map(|k| {
+                    let [a, b, c] = mesh.corners(k);
+                    a.coords.dot(&b.coords.cross(&c.coords)) / 6.0
+                })
+                .sum();
+            assert!(volume > 0.0, "{volume}");
+        }
+        let sphere = icosphere(0.4, Point::origin(), 3);
+        assert_eq!(sphere.triangles.len(), 20 * 64);
+        assert!(sphere.vertices.iter().all(|v| (v.coords.norm() - 0.4).abs() < 1e-15));
     }
 }

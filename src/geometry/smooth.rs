@@ -22,7 +22,7 @@
 //! facets joined by smooth edges. Flat regions are reproduced exactly (all quadrics are the same
 //! plane), a sphere to third order in h; a sharp edge is where two regions meet, each point
 //! taking the region of its closest facet.
-use super::surface::ToolSurface;
+use super::surface::{SurfacePoint, ToolSurface};
 use super::{Point, Vector, NO_NEIGHBOUR};
 use nalgebra::{Matrix2, Matrix3, Vector2};
 use parry3d_f64::bounding_volume::Aabb;
@@ -51,9 +51,10 @@ const CURVATURE_FIT_RIDGE: f64 = 1e-6;
 pub struct SmoothPoint {
     /// The point on the smooth surface.
     pub point: Point,
-    /// The facet closest to the point.
+    /// The facet closest to the query (a retraction moves a point by a second-order amount, so
+    /// for a query on or next to the surface this is the facet under the point).
     pub triangle: u32,
-    /// Barycentric coordinates of the point's foot on that facet.
+    /// Barycentric coordinates of the query's foot on that facet.
     pub barycentric: [f64; 3],
     /// Unit normal of the surface there.
     pub normal: Vector,
@@ -301,7 +302,11 @@ impl<'a> SmoothSurface<'a> {
     /// `q` on the surface, `q` itself. A retraction onto the surface, exact to first order, which
     /// is what sliding contact needs.
     pub fn project(&self, q: &Point) -> SmoothPoint {
-        let foot = self.tool.closest_point(q);
+        self.project_from(q, &self.tool.closest_point(q))
+    }
+
+    /// As [`SmoothSurface::project`], given the closest facet point `foot` of `q`.
+    pub fn project_from(&self, q: &Point, foot: &SurfacePoint) -> SmoothPoint {
         let region = self.regions[foot.triangle as usize];
         let l = self.tool.barycentric(foot.triangle, &foot.point);
         let off = q - foot.point;
@@ -309,12 +314,20 @@ impl<'a> SmoothSurface<'a> {
             let tangential = off - foot.normal * foot.normal.dot(&off);
             tangential.dot(m) > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
         });
-        let start = if self.value_and_gradient(region, q).is_some() { *q } else { foot.point };
         let tol = PROJECTION_TOLERANCE_REL * self.tool.diagonal();
-        let mut p = start;
+        // Newton steps along the gradient from q; from the facet point where no sector reaches q.
+        let mut p = *q;
         let mut normal = foot.normal;
+        let mut restarted = false;
         for _ in 0..PROJECTION_MAX_ITERATIONS {
-            let Some((f, g)) = self.value_and_gradient(region, &p) else { break };
+            let Some((f, g)) = self.value_and_gradient(region, &p) else {
+                if restarted {
+                    break;
+                }
+                restarted = true;
+                p = foot.point;
+                continue;
+            };
             let g2 = g.norm_squared();
             if g2 <= 0.0 {
                 break;
@@ -325,11 +338,9 @@ impl<'a> SmoothSurface<'a> {
             }
             p -= g * (f / g2);
         }
-        let at = self.tool.closest_point(&p);
-        let l = self.tool.barycentric(at.triangle, &at.point);
         SmoothPoint {
             point: p,
-            triangle: at.triangle,
+            triangle: foot.triangle,
             barycentric: clamp_barycentric(l),
             normal,
             region,

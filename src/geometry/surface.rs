@@ -208,6 +208,13 @@ impl ToolSurface {
         SurfacePoint { point, triangle, normal: self.normal(triangle), distance: (point - p).norm() }
     }
 
+    /// Distance along the unit direction `dir` from `origin` to the first facet it meets, if
+    /// any (parry's ray cast on the mesh).
+    pub fn cast_ray(&self, origin: &Point, dir: &Vector) -> Option<f64> {
+        use parry3d_f64::query::{Ray, RayCast};
+        self.mesh.cast_local_ray(&Ray::new(*origin, *dir), f64::MAX, false)
+    }
+
     /// Closest point of triangle `t` to `p`.
     pub fn project_to_triangle(&self, t: u32, p: &Point) -> Point {
         let c = self.corners(t);
@@ -283,6 +290,15 @@ impl ToolSurface {
         let r = Vector::repeat(radius);
         let aabb = Aabb::new(center - r, center + r);
         self.mesh.bvh().intersect_aabb(&aabb).collect()
+    }
+
+    /// Whether any facet's bounding box comes within `radius` of `center` (a cheap test before a
+    /// closest-point search).
+    pub fn any_triangle_near(&self, center: &Point, radius: f64) -> bool {
+        let r = Vector::repeat(radius);
+        let aabb = Aabb::new(center - r, center + r);
+        let hit = self.mesh.bvh().intersect_aabb(&aabb).next().is_some();
+        hit
     }
 
     /// Whether triangle `t` may come within `radius` of `center` (bounding-sphere test).

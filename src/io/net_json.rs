@@ -304,8 +304,8 @@ mod tests {
         let k = net.index(6, 4);
         net.status[k] = NodeStatus::NoRoot;
         net.timing = Timing { load_ms: 1.5, generators_ms: 0.1 + 0.2, fill_ms: 1e-9, total_ms: 123456.789 };
-        net.meta.insert("tool".into(), serde_json::json!("geometries/dome.obj"));
-        net.meta.insert("warp".into(), serde_json::json!([1.0, 0.0, 0.0]));
+        net.meta.tool = Some("geometries/dome.obj".into());
+        net.meta.other.insert("warp".into(), serde_json::json!([1.0, 0.0, 0.0]));
         net
     }
 

@@ -11,7 +11,7 @@ pub mod sampler;
 
 pub use fishnet::{drape, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};
-pub use provenance::Provenance;
+pub use provenance::{CellChanges, Provenance, SolverRecord, UnbalancedRecord};
 
 use crate::geometry::{Point, Vector};
 

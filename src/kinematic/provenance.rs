@@ -1,6 +1,6 @@
 //! [`Provenance`]: where a net came from and what later stages need to know about it (`"meta"`
-//! in `<ply>.drape.json`). Each stage sets the fields it knows; the mapping, the report and the
-//! commands read them by name, so a key one stage writes is the key the next one reads.
+//! in `<ply>.drape.json`). Each stage sets the typed fields it knows and the later stages read
+//! them, so a key one stage writes is the key the next one reads.
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
@@ -68,8 +68,24 @@ pub struct CellChanges {
 /// What the mechanical solver did to a net.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SolverRecord {
-    /// How the last load step ended (`converged`, ...).
+    /// How the last load step ended (`converged`, `stalled`, `iteration_limit`, ...).
     pub outcome: String,
+    /// Whether every load step ended in equilibrium: |F - P| <= tolerance |P| over the free
+    /// directions. A net that did not converge is the last accepted state, not an equilibrium.
+    #[serde(default)]
+    pub converged: bool,
+    /// Why it did not converge, in words (absent when it did).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// |F - P| / |P| at the end of the last load step.
+    #[serde(default)]
+    pub residual: f64,
+    /// Solver iterations over all load steps.
+    #[serde(default)]
+    pub iterations: usize,
+    /// Where the forces are furthest from balance when it did not converge, largest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unbalanced: Vec<UnbalancedRecord>,
     /// Energy of the kinematic net under the full load, J.
     pub energy_kinematic: f64,
     /// Energy of the state the solver started from, J.
@@ -81,49 +97,26 @@ pub struct SolverRecord {
     pub load_steps: Value,
 }
 
-impl Provenance {
-    /// Set the entry `key` as if the file held `value` there: the field of that name when
-    /// `value` has its type, else an entry of [`Provenance::other`]. For writers that build the
-    /// JSON themselves (`mechanics::refine::annotate`); elsewhere set the fields.
-    pub fn insert(&mut self, key: String, value: Value) {
-        let mut map = match serde_json::to_value(&*self) {
-            Ok(Value::Object(map)) => map,
-            _ => unreachable!("provenance serialises to a JSON object"),
-        };
-        map.insert(key.clone(), value.clone());
-        match serde_json::from_value(Value::Object(map)) {
-            Ok(updated) => *self = updated,
-            Err(_) => {
-                self.other.insert(key, value);
-            }
-        }
-    }
+/// A node whose forces do not balance, in a [`SolverRecord`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UnbalancedRecord {
+    /// Grid indices (i, j).
+    pub node: [usize; 2],
+    /// Its position, m.
+    pub position: [f64; 3],
+    /// |F - P| over its free directions, N.
+    pub force_n: f64,
+    /// The energy term with the largest force there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub term: Option<String>,
+}
 
+impl Provenance {
     /// The provenance as the JSON object written to a file: keys in sorted order.
     pub fn to_json(&self) -> Map<String, Value> {
         match serde_json::to_value(self) {
             Ok(Value::Object(map)) => map,
             _ => unreachable!("provenance serialises to a JSON object"),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn keys_set_by_name_land_in_their_fields() {
-        let mut p = Provenance::default();
-        p.insert("tool_scale".into(), 0.001.into());
-        p.insert("material".into(), "card.toml".into());
-        p.insert("warp".into(), serde_json::json!([1.0, 0.0, 0.0]));
-        p.insert("tool".into(), 7.into()); // not a path: kept as given
-        assert_eq!(p.tool_scale, Some(0.001));
-        assert_eq!(p.material.as_deref(), Some("card.toml"));
-        assert_eq!(p.other["warp"], serde_json::json!([1.0, 0.0, 0.0]));
-        assert_eq!((p.tool.as_ref(), &p.other["tool"]), (None, &Value::from(7)));
-        let json = p.to_json();
-        assert_eq!(json.keys().collect::<Vec<_>>(), ["material", "tool", "tool_scale", "warp"]);
     }
 }

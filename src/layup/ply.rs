@@ -4,6 +4,7 @@
 use crate::geometry::Vector;
 use crate::kinematic::KinematicSettings;
 use crate::material::MaterialCard;
+use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::ContactMode;
 use std::path::PathBuf;
 
@@ -97,7 +98,15 @@ impl Ply {
     }
 }
 
-/// A ply's mechanical refinement: the material card and the contact mode.
+/// Solver iterations per load step of a mechanical ply when the scene gives none.
+pub const DEFAULT_SOLVER_ITERATIONS: usize = 500;
+/// Most solver iterations per load step a scene may ask for (every run ends in bounded time).
+pub const MAX_SOLVER_ITERATIONS: usize = 100_000;
+/// Most load steps a scene may ask for.
+pub const MAX_LOAD_STEPS: usize = 1000;
+
+/// A ply's mechanical refinement: the material card, the contact mode, where it starts, and the
+/// sheet's features.
 #[derive(Debug, Clone)]
 pub struct Refinement {
     /// The card.
@@ -106,6 +115,27 @@ pub struct Refinement {
     pub material_path: PathBuf,
     /// Pressed onto the tool or hanging free.
     pub mode: ContactMode,
+    /// The state the solver starts from.
+    pub start: Start,
+    /// Gravity is applied in this many steps.
+    pub load_steps: usize,
+    /// Solver iterations per load step, at most.
+    pub max_iterations: usize,
+    /// Reinforcements, seam, fold, cuts.
+    pub sheet: SheetFeatures,
+}
+
+/// Where a mechanical ply starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Start {
+    /// From its kinematic drape.
+    Kinematic,
+    /// From a flat sheet with this unit normal laid over the tool, just touching it (seed
+    /// 000's drapes).
+    Flat {
+        /// The sheet plane's normal.
+        normal: Vector,
+    },
 }
 
 /// Which side of the tool the plies stack on.

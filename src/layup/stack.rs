@@ -1,16 +1,18 @@
 //! Draping a layup: each ply in stacking order on the tool offset by the plies below it, its warp
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
-use super::{Layup, Orientation, Ply, StackSide};
+use super::{Layup, Orientation, Ply, StackSide, Start};
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
 use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
-use crate::kinematic::{drape, DrapeNet, Extent};
+use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings};
 use crate::material::flow::sheared_thickness;
 use crate::mechanics::refine::{annotate, refine, RefineError, RefineSettings, Refined};
+use crate::mechanics::sheet::{default_origin_node, flat_sheet, SheetError};
+use crate::mechanics::SolverSettings;
 use std::time::Instant;
 
 /// A reference direction closer than this (sine of the angle) to the tool normal at a seed has
@@ -178,6 +180,36 @@ fn seed_normal(surface: &ToolSurface, p: &Point) -> Vector {
     }
 }
 
+/// The warp of a ply laid as a flat sheet with unit normal `normal`: its warp or the scene's
+/// reference, projected into the sheet's plane and turned by the ply angle about the normal.
+fn sheet_warp(ply: &Ply, reference: &Vector, normal: &Vector) -> Result<Vector, String> {
+    let (direction, angle) = match ply.orientation {
+        Orientation::Warp(w) => (w, 0.0),
+        Orientation::Angle(a) => (*reference, a),
+    };
+    let projected = direction - normal * normal.dot(&direction);
+    if projected.norm() < MIN_REFERENCE_SINE * direction.norm() {
+        return Err("the warp direction is normal to the sheet: give a direction in the sheet's plane".into());
+    }
+    let rotation = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(*normal), angle);
+    Ok((rotation * projected).normalize())
+}
+
+/// The flat sheet a ply with `start = "flat"` starts from (see [`flat_sheet`]).
+fn flat_start(
+    ply: &Ply,
+    settings: &KinematicSettings,
+    normal: &Vector,
+    tool: &ToolSurface,
+) -> Result<DrapeNet, SheetError> {
+    let Extent::Grid { nu, nv, origin_node } = settings.extent else {
+        return Err(SheetError("a flat sheet needs a grid".into()));
+    };
+    let seam = ply.refinement.as_ref().and_then(|r| r.sheet.seam);
+    let origin = origin_node.unwrap_or_else(|| default_origin_node(nu, nv, seam));
+    flat_sheet(&settings.name, nu, nv, settings.spacing, origin, &settings.origin, &settings.warp, normal, seam, tool)
+}
+
 /// Facets within this distance (times the tool's diagonal) of a seed touch it.
 const SEED_CONTACT_REL: f64 = 1e-9;
 
@@ -228,15 +260,30 @@ pub fn drape_layup(
                 settings.origin = riding;
             }
         }
-        let warp = resolve_warp(ply, &settings.origin, &layup.reference, surface, layup.stack_side)
-            .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
+        let start = ply.refinement.as_ref().map_or(Start::Kinematic, |r| r.start);
+        let warp = match start {
+            Start::Kinematic => resolve_warp(ply, &settings.origin, &layup.reference, surface, layup.stack_side),
+            Start::Flat { normal } => sheet_warp(ply, &layup.reference, &normal),
+        }
+        .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
-        let mut net =
-            drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?;
+        let mut net = match start {
+            Start::Kinematic => {
+                drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?
+            }
+            Start::Flat { normal } => flat_start(ply, &settings, &normal, surface)
+                .map_err(|source| LayupError::Refine { ply: name.clone(), line, source: source.into() })?,
+        };
         let mut refined = None;
         if let Some(r) = &ply.refinement {
             let t = Instant::now();
-            let settings = RefineSettings { mode: r.mode, ..RefineSettings::default() };
+            let settings = RefineSettings {
+                mode: r.mode,
+                load_steps: r.load_steps,
+                solver: SolverSettings::default().max_iterations(r.max_iterations),
+                sheet: r.sheet.clone(),
+                ..RefineSettings::default()
+            };
             let result = refine(&net, surface, &r.material, &settings).map_err(|source| LayupError::Refine {
                 ply: name.clone(),
                 line,

@@ -59,21 +59,25 @@ impl ContactSurface for SmoothSurface<'_> {
         }
     }
     fn locate_near(&self, p: &Point, range: f64) -> Option<Foot> {
-        // The surface stays within a sagitta of the facets: test against the facets first.
+        // The surface stays within a sagitta of the facets: test against the facets first, by
+        // bounding boxes, then by distance.
+        if !self.tool().any_triangle_near(p, 2.0 * range) {
+            return None;
+        }
         let facet = self.tool().closest_point(p);
         if facet.distance > 2.0 * range {
             return None;
         }
-        let s = self.project(p);
+        let s = self.project_from(p, &facet);
+        let open_edges = self.tool().open_edges_at(s.triangle, &s.barycentric);
         if s.beyond_boundary {
             // Past the tool's open edge the nearest tool is the edge itself: the point is
             // outside, at its distance from the edge.
             let normal = (p - facet.point).try_normalize(0.0).unwrap_or(facet.normal);
-            let l = self.tool().barycentric(facet.triangle, &facet.point);
             return Some(Foot {
                 point: facet.point,
                 normal,
-                open_edges: self.tool().open_edges_at(facet.triangle, &l),
+                open_edges,
                 gap: facet.distance,
                 curvature: Matrix3::zeros(),
             });
@@ -81,7 +85,7 @@ impl ContactSurface for SmoothSurface<'_> {
         Some(Foot {
             point: s.point,
             normal: s.normal,
-            open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric),
+            open_edges,
             gap: s.normal.dot(&(p - s.point)),
             curvature: self.curvature(s.region, &s.point),
         })

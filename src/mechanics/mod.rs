@@ -5,6 +5,7 @@ pub mod contact;
 pub mod energy;
 pub mod qp;
 pub mod refine;
+pub mod sheet;
 pub mod solver;
 pub mod sparse;
 pub mod virtual_tests;

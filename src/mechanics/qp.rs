@@ -289,6 +289,8 @@ pub struct QpEngine {
     pub builds: usize,
     /// Subproblems solved.
     pub solves: usize,
+    /// Time spent in Clarabel (set-up, updates and solves), ms.
+    pub time_ms: f64,
 }
 
 impl QpEngine {
@@ -321,6 +323,13 @@ impl QpEngine {
         if n == 0 {
             return Ok(Vec::new());
         }
+        let start = std::time::Instant::now();
+        let result = self.solve_timed(red, values, q, n);
+        self.time_ms += start.elapsed().as_secs_f64() * 1e3;
+        result
+    }
+
+    fn solve_timed(&mut self, red: &Reduction, values: &[f64], q: &[f64], n: usize) -> Result<Vec<f64>, QpFailure> {
         let reuse = matches!(&self.cached, Some((key, _)) if key.as_slice() == red.key());
         if reuse {
             let (_, solver) = self.cached.as_mut().expect("checked");

@@ -1,10 +1,12 @@
 //! Mechanical refinement of a draped net: the energy model on its grid, minimised from the
 //! kinematic state with the tool as contact, under load steps of gravity.
 use super::contact::{ContactMode, ContactSurface, Freedom};
-use super::energy::{Grid, HessianKind, Laws, Model};
+use super::energy::{Gravity, Grid, HessianKind, Laws, Model};
 use super::qp::HessianBlocks;
+use super::sheet::{SheetError, SheetFeatures, SheetLayout};
 use super::solver::{solve, Constraints, Evaluation, Objective, Outcome, SolveReport, SolverSettings};
 use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
+use crate::kinematic::provenance::{CellChanges, SolverRecord, UnbalancedRecord};
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
 /// Which Hessian the quadratic models use: the exact one (the solver's shift handles its
@@ -15,7 +17,7 @@ const HESSIAN: HessianKind = HessianKind::Exact;
 pub const STANDARD_GRAVITY: f64 = 9.80665;
 
 /// The energy of a net's grid as the solver sees it: internal energy from the model, and
-/// gravity as constant nodal loads P = m g.
+/// gravity as constant nodal loads P = m g (the masses of [`Gravity`]).
 pub struct NetObjective<'a> {
     model: Model<'a>,
     loads: Vec<Vector>,
@@ -27,11 +29,11 @@ impl<'a> NetObjective<'a> {
     /// Stretch, shear and bending of `laws` on `grid`, loaded by `gravity` (m/s^2) times
     /// `load_factor`.
     pub fn new<L: Laws + ?Sized>(grid: Grid, laws: &'a L, gravity: Vector) -> Self {
-        let masses: Vec<f64> = grid.nodal_areas().iter().map(|a| a * laws.areal_mass()).collect();
-        let loads = masses.iter().map(|m| gravity * *m).collect();
-        let model = Model::new(grid, laws, Vector::zeros());
+        let weight = Gravity::new(&grid, laws.areal_mass(), gravity);
+        let loads = weight.loads();
+        let model = Model::internal(grid, laws);
         let pairs = model.pattern().coupled_pairs();
-        NetObjective { model, loads, masses, pairs }
+        NetObjective { model, loads, masses: weight.mass, pairs }
     }
 
     /// Scale the loads (load stepping).
@@ -89,7 +91,6 @@ impl Objective for NetObjective<'_> {
     }
     fn term_forces(&self, x: &[Point]) -> Vec<(&'static str, Vec<Vector>)> {
         let mut terms = self.model.term_gradients(x);
-        terms.retain(|(name, _)| *name != "gravity");
         terms.push(("gravity", self.loads.iter().map(|l| -l).collect()));
         terms
     }
@@ -119,6 +120,8 @@ pub struct RefineSettings {
     pub load_steps: usize,
     /// The solver's settings (per load step).
     pub solver: SolverSettings,
+    /// The sheet's features (reinforcements, seam, fold, cuts), laid out on the net's grid.
+    pub sheet: SheetFeatures,
 }
 
 impl Default for RefineSettings {
@@ -129,6 +132,7 @@ impl Default for RefineSettings {
             gravity: Vector::new(0.0, 0.0, -STANDARD_GRAVITY),
             load_steps: 1,
             solver: SolverSettings::default(),
+            sheet: SheetFeatures::default(),
         }
     }
 }
@@ -161,17 +165,46 @@ impl Refined {
     pub fn outcome(&self) -> Outcome {
         self.steps.last().map_or(Outcome::Converged, |s| s.outcome)
     }
+
+    /// Why the refinement did not reach equilibrium, in words: the outcome, the load step, and
+    /// where the forces are furthest from balance and which energy term dominates there.
+    pub fn describe_failure(&self) -> String {
+        let Some((k, step)) = self.steps.iter().enumerate().find(|(_, s)| !s.ok()) else {
+            return "converged".into();
+        };
+        let mut s = format!(
+            "{} in load step {} after {} iterations, |F-P|/|P| = {:.2e}",
+            step.outcome.describe(),
+            k + 1,
+            step.iterations.len(),
+            step.residual
+        );
+        if let Some(status) = &step.subproblem_status {
+            s.push_str(&format!(" (Clarabel: {status})"));
+        }
+        if let Some(u) = step.unbalanced.first() {
+            let (i, j) = (u.node / self.net.nv, u.node % self.net.nv);
+            s.push_str(&format!("; largest unbalanced force {:.2e} N at node ({i}, {j})", u.force));
+            if let Some(t) = u.dominant_term {
+                s.push_str(&format!(", mostly {t}"));
+            }
+        }
+        s
+    }
 }
 
 /// Why a refinement could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum RefineError {
-    #[error("the net has no placed nodes to refine")]
     /// The net has no placed node.
+    #[error("the net has no placed nodes to refine")]
     Empty,
-    #[error("load steps must be at least 1")]
     /// No load step was asked for.
+    #[error("load steps must be at least 1")]
     LoadSteps,
+    /// The sheet's features do not fit the net.
+    #[error("{0}")]
+    Sheet(#[from] SheetError),
 }
 
 /// Refine a kinematic net on its tool. Pressed: every node slides on the tool (by default on its
@@ -188,11 +221,18 @@ pub fn refine<L: Laws + ?Sized>(
     if settings.load_steps == 0 {
         return Err(RefineError::LoadSteps);
     }
-    let active = connected_body(kinematic);
+    let layout = (!settings.sheet.is_empty())
+        .then(|| settings.sheet.layout(kinematic.nu, kinematic.nv, kinematic.spacing, kinematic.origin_node))
+        .transpose()?;
+    let active = connected_body(kinematic, layout.as_ref());
     if !active.iter().any(|a| *a) {
         return Err(RefineError::Empty);
     }
-    let grid = Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone());
+    let stitched = layout.as_ref().map(|l| l.stitched.clone());
+    let mut grid = Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone());
+    if let Some(layout) = layout {
+        grid = grid.with_sheet(layout);
+    }
     // Nodes meet the smooth patches: on the facets themselves a net finer than them crawls from
     // edge to edge (see the module doc of `geometry::smooth`).
     let on_patches = settings.pressed_surface == PressedSurface::Smooth;
@@ -223,8 +263,7 @@ pub fn refine<L: Laws + ?Sized>(
             (true, _, None) => Freedom::Free,
         })
         .collect();
-    let cons =
-        Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing, stitched: None };
+    let cons = Constraints { freedom, mode: settings.mode, tool: Some(surface), spacing: kinematic.spacing, stitched };
     let mut steps = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
     let solver_settings = settings.solver.clone();
@@ -260,11 +299,12 @@ pub fn refine<L: Laws + ?Sized>(
     Ok(Refined { net, steps, energy_kinematic, energy_start, energy_final })
 }
 
-/// The nodes of the net's body: the corners of the complete cells joined by shared edges to the
-/// cell at the origin node (or, without one, to the largest such group). Cells that hang on the
-/// rest by a single corner, and placed nodes in no complete cell, are mechanisms the energy does
-/// not hold (they would swing about their corner): the mechanical model leaves them out.
-pub fn connected_body(net: &DrapeNet) -> Vec<bool> {
+/// The nodes of the net's body: the corners of the complete cells joined by shared fibre links
+/// (not cut) or by stitched nodes to the cell at the origin node (or, without one, to the
+/// largest such group). Cells that hang on the rest by a single corner, and placed nodes in no
+/// complete cell, are mechanisms the energy does not hold (they would swing about their
+/// corner): the mechanical model leaves them out.
+pub fn connected_body(net: &DrapeNet, layout: Option<&SheetLayout>) -> Vec<bool> {
     let (nu, nv) = (net.nu, net.nv);
     let mut body = vec![false; nu * nv];
     if nu < 2 || nv < 2 {
@@ -272,7 +312,13 @@ pub fn connected_body(net: &DrapeNet) -> Vec<bool> {
     }
     let (cu, cv) = (nu - 1, nv - 1);
     let placed = |i: usize, j: usize| net.status[net.index(i, j)] == NodeStatus::Placed;
-    let complete = |i: usize, j: usize| placed(i, j) && placed(i + 1, j) && placed(i, j + 1) && placed(i + 1, j + 1);
+    let complete = |i: usize, j: usize| {
+        placed(i, j)
+            && placed(i + 1, j)
+            && placed(i, j + 1)
+            && placed(i + 1, j + 1)
+            && !layout.is_some_and(|l| l.cell_cut(i, j))
+    };
     let cells: Vec<bool> = (0..cu * cv).map(|c| complete(c / cv, c % cv)).collect();
     let mut parent: Vec<usize> = (0..cells.len()).collect();
     fn root(parent: &mut [usize], mut a: usize) -> usize {
@@ -282,16 +328,40 @@ pub fn connected_body(net: &DrapeNet) -> Vec<bool> {
         }
         a
     }
+    fn join(parent: &mut [usize], a: usize, b: usize) {
+        let (ra, rb) = (root(parent, a), root(parent, b));
+        parent[ra] = rb;
+    }
     for i in 0..cu {
         for j in 0..cv {
             let c = i * cv + j;
             if !cells[c] {
                 continue;
             }
-            for other in [(i + 1 < cu).then(|| c + cv), (j + 1 < cv).then(|| c + 1)].into_iter().flatten() {
-                if cells[other] {
-                    let (a, b) = (root(&mut parent, c), root(&mut parent, other));
-                    parent[a] = b;
+            // Across the weft link (i+1, j)-(i+1, j+1) to the next cell along the warp, across the
+            // warp link (i, j+1)-(i+1, j+1) to the next along the weft.
+            if i + 1 < cu && cells[c + cv] && !layout.is_some_and(|l| l.weft_cut(i + 1, j)) {
+                join(&mut parent, c, c + cv);
+            }
+            if j + 1 < cv && cells[c + 1] && !layout.is_some_and(|l| l.warp_cut(i, j + 1)) {
+                join(&mut parent, c, c + 1);
+            }
+        }
+    }
+    // Stitched nodes join the cells around them.
+    if let Some(layout) = layout {
+        let cell_at = |k: usize| -> Option<usize> {
+            let (i, j) = (k / nv, k % nv);
+            [(i, j), (i.wrapping_sub(1), j), (i, j.wrapping_sub(1)), (i.wrapping_sub(1), j.wrapping_sub(1))]
+                .into_iter()
+                .filter(|&(a, b)| a < cu && b < cv)
+                .map(|(a, b)| a * cv + b)
+                .find(|&c| cells[c])
+        };
+        for (k, &r) in layout.stitched.iter().enumerate() {
+            if r != k {
+                if let (Some(a), Some(b)) = (cell_at(k), cell_at(r)) {
+                    join(&mut parent, a, b);
                 }
             }
         }
@@ -348,18 +418,38 @@ pub fn cell_changes(before: &DrapeNet, after: &DrapeNet) -> Vec<Option<(f64, f64
 /// Record the solver's work and the per-cell change from the kinematic net in the net's meta.
 pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, material: &std::path::Path) {
     let changes = cell_changes(kinematic, &refined.net);
-    let shear: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(g, _)| g.to_degrees())).collect();
-    let angle: Vec<Option<f64>> = changes.iter().map(|c| c.map(|(_, a)| a.to_degrees())).collect();
-    out.meta.insert("change_from_kinematic".into(), serde_json::json!({"shear_deg": shear, "warp_angle_deg": angle}));
-    out.meta.insert("material".into(), serde_json::json!(material.display().to_string()));
-    out.meta.insert(
-        "solver".into(),
-        serde_json::json!({
-            "outcome": refined.outcome(),
-            "energy_kinematic": refined.energy_kinematic,
-            "energy_start": refined.energy_start,
-            "energy_final": refined.energy_final,
-            "load_steps": refined.steps,
-        }),
-    );
+    out.meta.change_from_kinematic = Some(CellChanges {
+        shear_deg: changes.iter().map(|c| c.map(|(g, _)| g.to_degrees())).collect(),
+        warp_angle_deg: changes.iter().map(|c| c.map(|(_, a)| a.to_degrees())).collect(),
+    });
+    out.meta.material = Some(material.display().to_string());
+    let last = refined.steps.last();
+    let unbalanced = last
+        .map(|s| {
+            s.unbalanced
+                .iter()
+                .map(|u| UnbalancedRecord {
+                    node: [u.node / out.nv, u.node % out.nv],
+                    position: out.positions[u.node].coords.into(),
+                    force_n: u.force,
+                    term: u.dominant_term.map(str::to_string),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    out.meta.solver = Some(SolverRecord {
+        outcome: serde_json::to_value(refined.outcome())
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default(),
+        converged: refined.ok(),
+        reason: (!refined.ok()).then(|| refined.describe_failure()),
+        residual: last.map_or(0.0, |s| s.residual),
+        iterations: refined.steps.iter().map(|s| s.iterations.len()).sum(),
+        unbalanced,
+        energy_kinematic: refined.energy_kinematic,
+        energy_start: refined.energy_start,
+        energy_final: refined.energy_final,
+        load_steps: serde_json::to_value(&refined.steps).unwrap_or_default(),
+    });
 }

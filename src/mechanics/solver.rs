@@ -133,6 +133,13 @@ pub struct IterationLog {
     pub corrected: bool,
     /// Clarabel subproblems solved in the iteration.
     pub subproblems: u32,
+    /// Of the iteration's time: assembling the quadratic models (energy, gradient and Hessian
+    /// at the new state, reduced onto the free directions), ms.
+    pub model_ms: f64,
+    /// ... solving them (Clarabel), ms.
+    pub solve_ms: f64,
+    /// ... trying steps (moving nodes onto the tool, energies), ms.
+    pub trial_ms: f64,
     /// Wall-clock time of the iteration.
     pub time_ms: f64,
 }
@@ -222,6 +229,9 @@ pub struct Constraints<'a> {
     pub stitched: Option<Vec<usize>>,
 }
 
+/// Below this residual the exact model is tried first even if the last step needed the convex
+/// one: near equilibrium Newton's step converges quadratically.
+const EXACT_FIRST_RESIDUAL: f64 = 1e-2;
 /// A step is accepted when the energy falls by at least this fraction of the predicted fall.
 const ACCEPT_RATIO: f64 = 1e-4;
 /// Steps whose energy change agrees with the model this well let the shift fall.
@@ -242,8 +252,13 @@ const ROUNDING_RETRIES: usize = 4;
 const CURVATURE_ROUNDING: f64 = 1e-9;
 /// Free nodes within this many spacings of the tool are checked for contact.
 pub const CONTACT_RANGE: f64 = 2.0;
-/// No node moves further than this many spacings in one step (a cap, not a line search).
+/// No node moves further than this many spacings in a step at first: the reach of a step (a cap,
+/// not a line search). It doubles after every step it capped that went as the model said, up to
+/// [`MAX_REACH_SPACINGS`] (a falling sheet moves many spacings at a time), and starts again from
+/// this after a step is refused.
 pub const MAX_STEP_SPACINGS: f64 = 1.0;
+/// The largest reach of a step, spacings.
+pub const MAX_REACH_SPACINGS: f64 = 32.0;
 /// The shift never falls below this (relative): Newton's step to rounding.
 const MIN_SHIFT: f64 = 1e-14;
 /// A shift above this (relative) makes steps too short to matter: give up.
@@ -310,12 +325,17 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let mut outcome = Outcome::IterationLimit;
     let mut residual = residual_of(&red, &state, force_scale);
     let mut last_failure: Option<QpFailure> = None;
+    // The reach of a step (spacings) and whether the last step needed the convex model.
+    let mut reach = MAX_STEP_SPACINGS;
+    let mut prefer_convex = false;
     for it in 0..settings.max_iterations {
         if residual <= settings.tolerance || red.is_empty() {
             outcome = Outcome::Converged;
             break;
         }
         let t_it = std::time::Instant::now();
+        let solve_ms_before = engine.time_ms;
+        let mut trial_ms = 0.0;
         let g = red.reduce(&unbalanced(&state.eval), &state.bases);
         let hess = state.eval.hessian.as_deref().expect("the Hessian is evaluated with every accepted state");
         let mut base_values = red.values(hess, &state.bases);
@@ -338,12 +358,19 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             }
             *shift = (*shift * 10.0).max(1e-8);
         };
+        if prefer_convex && residual > EXACT_FIRST_RESIDUAL {
+            // The exact model was indefinite last time: start where that ended.
+            fallback(&mut shift, &mut base_values, &mut convex);
+        }
+        let mut values = vec![0.0; base_values.len()];
+        let mut step_capped = false;
+        let mut refused = false;
         let mut subproblems = 0;
         let mut rounding_tries = 0;
         let mut accepted = None;
         let mut failure = None;
         while shift <= MAX_SHIFT {
-            let mut values = base_values.clone();
+            values.copy_from_slice(&base_values);
             red.add_diagonal(&mut values, &masses, shift * unit_shift);
             subproblems += 1;
             let y = match engine.solve(&red, &values, &g) {
@@ -365,7 +392,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 fallback(&mut shift, &mut base_values, &mut convex);
                 continue;
             }
-            let y = cap_step(&red, y, &state.bases, cons.spacing);
+            let (y, capped) = cap_step(&red, y, &state.bases, reach * cons.spacing);
             let gy = dot(&g, &y);
             // The decrease the unshifted model predicts (the shifted one's if that is not
             // positive: the Hessian alone is indefinite along y).
@@ -379,8 +406,10 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 }
             };
             let delta = red.expand(&y, &state.bases);
+            let t_trial = std::time::Instant::now();
             let (trial, trial_feet) = moved(cons, x, &delta, &state.sliding);
             let e1 = objective.energy(&trial);
+            trial_ms += t_trial.elapsed().as_secs_f64() * 1e3;
             let fall = state.eval.energy - e1;
             if acceptable(fall, predicted, noise) {
                 // Where the model is stiffer along the step than the energy (the shift, or the
@@ -390,11 +419,12 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 let y_exact = if convex { red.quad(&exact_values, &y) } else { y_hess };
                 let (trial, trial_feet, fall) = if y_exact < EXTEND_CURVATURE * y_model && fall > ROUNDING_BAND * noise
                 {
-                    extend_step(objective, cons, x, &state, &red, &y, (trial, trial_feet, fall))
+                    extend_step(objective, cons, x, &state, &red, &y, reach * cons.spacing, (trial, trial_feet, fall))
                 } else {
                     (trial, trial_feet, fall)
                 };
                 accepted = Some((trial, trial_feet, fall / predicted, false));
+                step_capped = capped;
                 break;
             }
             if predicted <= ROUNDING_BAND * noise {
@@ -421,7 +451,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     let g2 = red.reduce(&f2, &state.bases);
                     subproblems += 1;
                     if let Ok(z) = engine.solve(&red, &values, &g2) {
-                        let z = cap_step(&red, z, &state.bases, cons.spacing);
+                        let (z, _) = cap_step(&red, z, &state.bases, reach * cons.spacing);
                         let dz = red.expand(&z, &state.bases);
                         let (trial2, feet2) = moved(cons, &trial, &dz, &state.sliding);
                         let e2 = objective.energy(&trial2);
@@ -433,6 +463,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     }
                 }
             }
+            refused = true;
             shift = (shift * 4.0).max(1e-8);
         }
         let (accepted_flag, corrected, step) = match accepted {
@@ -452,10 +483,16 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 } else if ratio < 0.1 {
                     shift *= 2.0;
                 }
+                reach = if step_capped && ratio >= GOOD_RATIO { (2.0 * reach).min(MAX_REACH_SPACINGS) } else { reach };
+                prefer_convex = convex;
                 (true, corrected, step)
             }
             None => (false, false, 0.0),
         };
+        if refused {
+            // A step was refused on the way: start small again.
+            reach = MAX_STEP_SPACINGS;
+        }
         residual = residual_of(&red, &state, force_scale);
         iterations.push(IterationLog {
             iteration: it + 1,
@@ -468,6 +505,9 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             corrected,
             subproblems,
             time_ms: t_it.elapsed().as_secs_f64() * 1e3,
+            model_ms: t_it.elapsed().as_secs_f64() * 1e3 - (engine.time_ms - solve_ms_before) - trial_ms,
+            solve_ms: engine.time_ms - solve_ms_before,
+            trial_ms,
         });
         if residual <= settings.tolerance {
             outcome = Outcome::Converged;
@@ -504,7 +544,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
 }
 
 /// The accepted step `y` doubled while the energy keeps falling and no node moves further than
-/// [`MAX_STEP_SPACINGS`]; returns the best trial (state, feet, fall).
+/// `cap` (m); returns the best trial (state, feet, fall).
+#[allow(clippy::too_many_arguments)] // the solve's own locals, passed as they are
 fn extend_step(
     objective: &dyn Objective,
     cons: &Constraints,
@@ -512,11 +553,12 @@ fn extend_step(
     s: &State,
     red: &Reduction,
     y: &[f64],
+    cap: f64,
     mut best: (Vec<Point>, Feet, f64),
 ) -> (Vec<Point>, Feet, f64) {
-    let reach = red.expand(y, &s.bases).iter().map(|d| d.norm()).fold(0.0, f64::max);
+    let largest = red.expand(y, &s.bases).iter().map(|d| d.norm()).fold(0.0, f64::max);
     let mut factor = 1.0;
-    while reach * factor * 2.0 <= MAX_STEP_SPACINGS * cons.spacing {
+    while largest * factor * 2.0 <= cap {
         factor *= 2.0;
         let step: Vec<f64> = y.iter().map(|v| v * factor).collect();
         let (trial, feet) = moved(cons, x, &red.expand(&step, &s.bases), &s.sliding);
@@ -545,16 +587,15 @@ fn acceptable(fall: f64, predicted: f64, noise: f64) -> bool {
     }
 }
 
-/// Scales `y` so that no node moves further than [`MAX_STEP_SPACINGS`] spacings.
-fn cap_step(red: &Reduction, y: Vec<f64>, bases: &[NodeBasis], spacing: f64) -> Vec<f64> {
+/// Scales `y` so that no node moves further than `cap` (m); whether it had to.
+fn cap_step(red: &Reduction, y: Vec<f64>, bases: &[NodeBasis], cap: f64) -> (Vec<f64>, bool) {
     let delta = red.expand(&y, bases);
     let largest = delta.iter().map(|d| d.norm()).fold(0.0, f64::max);
-    let cap = MAX_STEP_SPACINGS * spacing;
     if largest > cap {
         let s = cap / largest;
-        y.into_iter().map(|v| v * s).collect()
+        (y.into_iter().map(|v| v * s).collect(), true)
     } else {
-        y
+        (y, false)
     }
 }
 

@@ -37,15 +37,41 @@
 //! method = "kinematic"       # or "mechanical": kinematic, then refinement with the
 //!                             # ply's material card
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
+//! # start = "kinematic"       # mechanical plies: start from the kinematic drape (default) or
+//!                             # "flat": a flat sheet laid over the tool, its origin node over
+//!                             # `origin`, just touching the tool (free drape; grid only)
+//! # sheet_normal = [0, 0, 1]  # with start = "flat": the sheet plane's normal (default +z)
+//! # load_steps = 1            # gravity applied in this many steps (default 1)
+//! # max_iterations = 500      # solver iterations per load step (default 500)
+//! # [[ply.reinforcement]]     # regions with multiplied properties (seed 000's bands):
+//! # edges = 0.03              #   a band this wide along the edges; or axes = W (bands along
+//! #                           #   the fibres through the origin node); or u = [u0, u1],
+//! #                           #   v = [v0, v1] (fabric coordinates from the origin node)
+//! # tension = 5.0             #   factors (default 1): tension, shear, bending, weight
+//! # shear = 5.0
+//! # bending = 20.0
+//! # weight = 2.0
+//! # [ply.seam]                # two sheets side by side, stitched along a weft line
+//! # rows = [47, 47]           #   node rows of each (adding up to grid[0])
+//! # allowance = 1             #   seam allowance in cells; the allowances hang as flaps
+//! # [ply.fold]                # a fold along a weft line, the sheet starting unfolded
+//! # row = 45                  #   its node row (default: the middle)
+//! # stiffness = 98.0          #   restoring stiffness, N/m per metre of fold (SI)
+//! # [[ply.cut]]               # fibre links removed along a polyline
+//! # points = [[-0.45, 0.82], [0.45, 0.82]]   # fabric coordinates (u, v) from the origin node
 //! ```
 use super::{parse_generators, unit_scale};
 use crate::geometry::{Point, Vector};
 use crate::io::flow::FlowFormat;
 use crate::io::points::read_points;
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
-use crate::layup::{locking_angle_deg, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide};
+use crate::layup::{
+    locking_angle_deg, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_SOLVER_ITERATIONS,
+    MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
+};
 use crate::material::flow::Cavity;
 use crate::material::MaterialCard;
+use crate::mechanics::sheet::{default_origin_node, Cut, Factors, Fold, Region, Reinforcement, Seam, SheetFeatures};
 use crate::mechanics::ContactMode;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -137,6 +163,62 @@ struct PlyFile {
     material: Option<String>,
     thickness: Option<f64>,
     mode: Option<String>,
+    start: Option<String>,
+    sheet_normal: Option<[f64; 3]>,
+    load_steps: Option<usize>,
+    max_iterations: Option<usize>,
+    #[serde(default)]
+    reinforcement: Vec<ReinforcementFile>,
+    seam: Option<SeamFile>,
+    fold: Option<FoldFile>,
+    #[serde(default)]
+    cut: Vec<CutFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReinforcementFile {
+    edges: Option<f64>,
+    axes: Option<f64>,
+    u: Option<[f64; 2]>,
+    v: Option<[f64; 2]>,
+    #[serde(default = "one")]
+    tension: f64,
+    #[serde(default = "one")]
+    shear: f64,
+    #[serde(default = "one")]
+    bending: f64,
+    #[serde(default = "one")]
+    weight: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SeamFile {
+    rows: [usize; 2],
+    #[serde(default = "default_allowance")]
+    allowance: usize,
+}
+
+fn default_allowance() -> usize {
+    1
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FoldFile {
+    row: Option<usize>,
+    stiffness: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CutFile {
+    points: Vec<[f64; 2]>,
 }
 
 fn default_generators() -> String {
@@ -157,6 +239,128 @@ pub struct SceneExport {
     pub cavity: Cavity,
     /// Whether to write permeability tensors.
     pub permeability: bool,
+}
+
+/// The mechanical refinement a ply asks for; errors name the field.
+fn refinement(
+    p: &PlyFile,
+    material: Option<&PlyMaterial>,
+    extent: &Extent,
+    scale: f64,
+) -> Result<Refinement, (&'static str, String)> {
+    let m = material.ok_or((
+        "material",
+        "a mechanical ply needs a material card: material = \"card.toml\" or a name from [materials]".to_string(),
+    ))?;
+    let mode = match p.mode.as_deref().unwrap_or("pressed") {
+        "pressed" => ContactMode::Pressed,
+        "free" => ContactMode::Free,
+        other => return Err(("mode", format!("unknown mode '{other}': use \"pressed\" or \"free\""))),
+    };
+    let start = match (p.start.as_deref().unwrap_or("kinematic"), p.sheet_normal) {
+        ("kinematic", None) => Start::Kinematic,
+        ("kinematic", Some(_)) => return Err(("sheet_normal", "only a ply with start = \"flat\" uses it".into())),
+        ("flat", normal) => {
+            let n = normal.unwrap_or([0.0, 0.0, 1.0]);
+            let n = Vector::new(n[0], n[1], n[2]);
+            if !(n.iter().all(|x| x.is_finite()) && n.norm() > 0.0) {
+                return Err((
+                    "sheet_normal",
+                    format!("must be a non-zero vector of three finite numbers, got {:?}", p.sheet_normal),
+                ));
+            }
+            if !matches!(extent, Extent::Grid { .. }) {
+                return Err(("start", "a flat sheet needs a grid (not an outline)".into()));
+            }
+            if mode != ContactMode::Free {
+                return Err(("start", "a flat sheet hangs under gravity: give mode = \"free\"".into()));
+            }
+            Start::Flat { normal: n.normalize() }
+        }
+        (other, _) => return Err(("start", format!("unknown start '{other}': use \"kinematic\" or \"flat\""))),
+    };
+    let load_steps = match p.load_steps {
+        Some(0) => return Err(("load_steps", "must be at least 1".into())),
+        Some(n) if n > MAX_LOAD_STEPS => return Err(("load_steps", format!("at most {MAX_LOAD_STEPS}, got {n}"))),
+        Some(n) => n,
+        None => 1,
+    };
+    let max_iterations = match p.max_iterations {
+        Some(0) => return Err(("max_iterations", "must be at least 1".into())),
+        Some(n) if n > MAX_SOLVER_ITERATIONS => {
+            return Err(("max_iterations", format!("at most {MAX_SOLVER_ITERATIONS}, got {n}")))
+        }
+        Some(n) => n,
+        None => DEFAULT_SOLVER_ITERATIONS,
+    };
+    let mut sheet = SheetFeatures::default();
+    let length = |field: &'static str, x: f64| -> Result<f64, (&'static str, String)> {
+        if x.is_finite() {
+            Ok(x * scale)
+        } else {
+            Err((field, format!("must be a finite length, got {x}")))
+        }
+    };
+    for r in &p.reinforcement {
+        let region = match (r.edges, r.axes, r.u, r.v) {
+            (Some(w), None, None, None) if w > 0.0 => Region::Edges(length("reinforcement", w)?),
+            (None, Some(w), None, None) if w > 0.0 => Region::Axes(length("reinforcement", w)?),
+            (None, None, Some(u), Some(v)) if u[0] <= u[1] && v[0] <= v[1] => Region::Rectangle {
+                u: [length("reinforcement", u[0])?, length("reinforcement", u[1])?],
+                v: [length("reinforcement", v[0])?, length("reinforcement", v[1])?],
+            },
+            _ => {
+                return Err((
+                    "reinforcement",
+                    "give one region: edges = W (a band W wide along the sheet's edges), axes = W (bands along the fibres through the origin node) or u = [u0, u1] and v = [v0, v1] (from the origin node, u0 <= u1, v0 <= v1); widths positive".into(),
+                ))
+            }
+        };
+        let factors = Factors { tension: r.tension, shear: r.shear, bending: r.bending, weight: r.weight };
+        if [factors.tension, factors.shear, factors.bending, factors.weight]
+            .iter()
+            .any(|f| !(f.is_finite() && *f > 0.0))
+        {
+            return Err((
+                "reinforcement",
+                "the factors tension, shear, bending and weight must be positive numbers".into(),
+            ));
+        }
+        sheet.reinforcements.push(Reinforcement { region, factors });
+    }
+    let nu = match extent {
+        Extent::Grid { nu, .. } => Some(*nu),
+        Extent::Outline(_) => None,
+    };
+    if let Some(seam) = &p.seam {
+        if nu.is_none() {
+            return Err(("seam", "a seam needs a grid (not an outline)".into()));
+        }
+        sheet.seam = Some(Seam { rows: seam.rows, allowance: seam.allowance });
+    }
+    if let Some(fold) = &p.fold {
+        let Some(nu) = nu else { return Err(("fold", "a fold needs a grid (not an outline)".into())) };
+        sheet.fold = Some(Fold { row: fold.row.unwrap_or(nu / 2), stiffness: fold.stiffness });
+    }
+    for c in &p.cut {
+        let points =
+            c.points.iter().map(|q| Ok([length("cut", q[0])?, length("cut", q[1])?])).collect::<Result<Vec<_>, _>>()?;
+        sheet.cuts.push(Cut { points });
+    }
+    if let (Extent::Grid { nu, nv, origin_node }, false) = (extent, sheet.is_empty()) {
+        // The features must fit the grid now, not after the drape.
+        let origin = origin_node.unwrap_or_else(|| default_origin_node(*nu, *nv, sheet.seam));
+        sheet.layout(*nu, *nv, p.spacing * scale, origin).map_err(|e| ("seam", e.0))?;
+    }
+    Ok(Refinement {
+        material: m.card.clone(),
+        material_path: m.path.clone(),
+        mode,
+        start,
+        load_steps,
+        max_iterations,
+        sheet,
+    })
 }
 
 /// Gap between nested flat patterns when the scene gives none, metres.
@@ -344,27 +548,33 @@ impl Scene {
             };
             let refinement = match p.method.as_str() {
                 "kinematic" => {
-                    if p.mode.is_some() {
-                        return Err(at("mode", "only a ply with method = \"mechanical\" uses it".into()));
+                    let mechanical_only = [
+                        ("mode", p.mode.is_some()),
+                        ("start", p.start.is_some()),
+                        ("sheet_normal", p.sheet_normal.is_some()),
+                        ("load_steps", p.load_steps.is_some()),
+                        ("max_iterations", p.max_iterations.is_some()),
+                        ("reinforcement", !p.reinforcement.is_empty()),
+                        ("seam", p.seam.is_some()),
+                        ("fold", p.fold.is_some()),
+                        ("cut", !p.cut.is_empty()),
+                    ];
+                    if let Some((field, _)) = mechanical_only.iter().find(|(_, given)| *given) {
+                        return Err(at(field, "only a ply with method = \"mechanical\" uses it".into()));
                     }
                     None
                 }
-                "mechanical" => {
-                    let m = material.as_ref().ok_or_else(|| {
-                        at("material", "a mechanical ply needs a material card: material = \"card.toml\" or a name from [materials]".into())
-                    })?;
-                    let mode = match p.mode.as_deref().unwrap_or("pressed") {
-                        "pressed" => ContactMode::Pressed,
-                        "free" => ContactMode::Free,
-                        other => {
-                            return Err(at("mode", format!("unknown mode '{other}': use \"pressed\" or \"free\"")))
-                        }
-                    };
-                    Some(Refinement { material: m.card.clone(), material_path: m.path.clone(), mode })
-                }
+                "mechanical" => Some(refinement(p, material.as_ref(), &extent, scale).map_err(|(f, m)| at(f, m))?),
                 other => {
                     return Err(at("method", format!("unknown method '{other}': use \"kinematic\" or \"mechanical\"")))
                 }
+            };
+            // A seamed sheet is held on its stitch line unless told otherwise.
+            let extent = match (extent, refinement.as_ref().and_then(|r| r.sheet.seam)) {
+                (Extent::Grid { nu, nv, origin_node: None }, Some(seam)) => {
+                    Extent::Grid { nu, nv, origin_node: Some(default_origin_node(nu, nv, Some(seam))) }
+                }
+                (extent, _) => extent,
             };
             let max_shear = p.max_shear_deg.unwrap_or(DEFAULT_MAX_SHEAR_DEG);
             if !(max_shear > 0.0 && max_shear < 90.0) {

@@ -55,7 +55,6 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Bending<'a, L> {
     fn add(&self, grid: &Grid, x: &[Point], base: Range<usize>, sink: &mut Sink<'_>) {
         let (nu, nv) = (grid.nu, grid.nv);
         let d2 = grid.spacing * grid.spacing;
-        let act = &grid.active;
         // Warp lines: A = (i, j), O = (i + 1, j), B = (i + 2, j).
         let cw = 2.0 * self.material.bending(Fibre::Warp) / d2;
         if cw != 0.0 {
@@ -64,8 +63,8 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Bending<'a, L> {
                     let a = i * nv + j;
                     let (o, b) = (a + nv, a + 2 * nv);
                     let width = grid.warp_triple_width(i, j);
-                    if act[a] && act[o] && act[b] && width > 0.0 {
-                        triple(cw * width, a, o, b, x, sink);
+                    if width > 0.0 && grid.warp_triple(i, j) {
+                        triple(cw * width * grid.node_factors(i + 1, j).bending, a, o, b, x, sink);
                     }
                 }
             }
@@ -77,8 +76,8 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Bending<'a, L> {
                 for j in 0..nv.saturating_sub(2) {
                     let a = i * nv + j;
                     let width = grid.weft_triple_width(i, j);
-                    if act[a] && act[a + 1] && act[a + 2] && width > 0.0 {
-                        triple(cf * width, a, a + 1, a + 2, x, sink);
+                    if width > 0.0 && grid.weft_triple(i, j) {
+                        triple(cf * width * grid.node_factors(i, j + 1).bending, a, a + 1, a + 2, x, sink);
                     }
                 }
             }

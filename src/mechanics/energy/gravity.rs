@@ -1,7 +1,8 @@
-//! Gravity: `E = -sum_i m_i g . x_i`, with `m_i` the areal mass times the node's area, a quarter
-//! of each complete (all four corners active) cell it is a corner of — d^2 inside a full grid,
-//! d^2/2 on its edges, d^2/4 at its corners; nodes without a complete cell carry no mass. Linear:
-//! gradient `-m_i g`, zero Hessian.
+//! Gravity: `E = -sum_i m_i g . x_i`, with `m_i` the node's mass ([`Grid::nodal_masses`]: a
+//! quarter of each complete cell it is a corner of, times the areal mass and the cell's weight
+//! factor — d^2 inside a full grid, d^2/2 on its edges, d^2/4 at its corners; nodes without a
+//! complete cell carry no mass). Linear: gradient `-m_i g`, zero Hessian. The same masses are
+//! the solver's loads `P = m g` ([`Gravity::loads`]).
 use super::{EnergyTerm, Grid, Sink};
 use crate::geometry::{Point, Vector};
 use std::ops::Range;
@@ -17,8 +18,12 @@ pub struct Gravity {
 impl Gravity {
     /// Nodal masses from `grid` (see the module docs) and the areal mass (kg/m^2).
     pub fn new(grid: &Grid, areal_mass: f64, g: Vector) -> Self {
-        let mass = grid.nodal_areas().into_iter().map(|a| a * areal_mass).collect();
-        Gravity { g, mass }
+        Gravity { g, mass: grid.nodal_masses(areal_mass) }
+    }
+
+    /// The weight of every node as a load, `m_i g` (N).
+    pub fn loads(&self) -> Vec<Vector> {
+        self.mass.iter().map(|m| self.g * *m).collect()
     }
 }
 

@@ -27,6 +27,7 @@
 use crate::geometry::{Point, Vector};
 use crate::kinematic::net::{DrapeNet, NodeStatus};
 use crate::material::{Fibre, MaterialCard};
+use crate::mechanics::sheet::{Factors, SheetLayout};
 use crate::mechanics::sparse::{SymmetricMatrix, SymmetricPattern};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -36,11 +37,13 @@ use std::sync::Arc;
 mod bending;
 mod gravity;
 mod shear;
+mod springs;
 mod stretch;
 
 pub use bending::Bending;
 pub use gravity::Gravity;
 pub use shear::{atan2_right, Shear};
+pub use springs::Springs;
 pub use stretch::Stretch;
 
 /// The constitutive laws the energy needs (implemented by [`MaterialCard`]; tests use their
@@ -92,6 +95,8 @@ pub struct Grid {
     pub spacing: f64,
     /// Per node (`i * nv + j`): does it take part (placed)?
     pub active: Vec<bool>,
+    /// The sheet's features (cuts, seams, folds, reinforcements), if any.
+    pub sheet: Option<Arc<SheetLayout>>,
 }
 
 impl Grid {
@@ -104,7 +109,13 @@ impl Grid {
         assert!(nu >= 1 && nv >= 1, "empty grid");
         assert_eq!(active.len(), nu * nv, "one active flag per node");
         assert!(spacing > 0.0 && spacing.is_finite(), "spacing must be positive");
-        Grid { nu, nv, spacing, active }
+        Grid { nu, nv, spacing, active, sheet: None }
+    }
+    /// This grid with the sheet's features laid out on it.
+    pub fn with_sheet(mut self, sheet: SheetLayout) -> Self {
+        assert_eq!(sheet.size(), (self.nu, self.nv), "the sheet layout is for another grid");
+        self.sheet = Some(Arc::new(sheet));
+        self
     }
     /// The grid of a drape net: the placed nodes are active.
     pub fn from_net(net: &DrapeNet) -> Self {
@@ -121,12 +132,58 @@ impl Grid {
     pub fn index(&self, i: usize, j: usize) -> usize {
         i * self.nv + j
     }
-    /// Is cell (i, j) complete (all four corners active)?
+    /// Is cell (i, j) complete (all four corners active, not cut open)?
     #[inline]
     pub fn cell_active(&self, i: usize, j: usize) -> bool {
         let k = self.index(i, j);
         let nv = self.nv;
-        self.active[k] && self.active[k + 1] && self.active[k + nv] && self.active[k + nv + 1]
+        self.active[k]
+            && self.active[k + 1]
+            && self.active[k + nv]
+            && self.active[k + nv + 1]
+            && !self.sheet.as_ref().is_some_and(|s| s.cell_cut(i, j))
+    }
+    /// Is the warp link (i, j)-(i+1, j) there (both nodes active, not cut)?
+    #[inline]
+    pub fn warp_link(&self, i: usize, j: usize) -> bool {
+        let k = self.index(i, j);
+        self.active[k] && self.active[k + self.nv] && !self.sheet.as_ref().is_some_and(|s| s.warp_cut(i, j))
+    }
+    /// Is the weft link (i, j)-(i, j+1) there?
+    #[inline]
+    pub fn weft_link(&self, i: usize, j: usize) -> bool {
+        let k = self.index(i, j);
+        self.active[k] && self.active[k + 1] && !self.sheet.as_ref().is_some_and(|s| s.weft_cut(i, j))
+    }
+    /// Is the warp bending triple (i, j), (i+1, j), (i+2, j) there (both links, no hinge)?
+    #[inline]
+    pub fn warp_triple(&self, i: usize, j: usize) -> bool {
+        self.warp_link(i, j) && self.warp_link(i + 1, j) && !self.sheet.as_ref().is_some_and(|s| s.warp_hinge(i + 1, j))
+    }
+    /// Is the weft bending triple (i, j), (i, j+1), (i, j+2) there?
+    #[inline]
+    pub fn weft_triple(&self, i: usize, j: usize) -> bool {
+        self.weft_link(i, j) && self.weft_link(i, j + 1)
+    }
+    /// Reinforcement factors of the warp link (i, j)-(i+1, j).
+    #[inline]
+    pub fn warp_link_factors(&self, i: usize, j: usize) -> Factors {
+        self.sheet.as_ref().map_or(Factors::ONE, |s| *s.warp_link(i, j))
+    }
+    /// Reinforcement factors of the weft link (i, j)-(i, j+1).
+    #[inline]
+    pub fn weft_link_factors(&self, i: usize, j: usize) -> Factors {
+        self.sheet.as_ref().map_or(Factors::ONE, |s| *s.weft_link(i, j))
+    }
+    /// Reinforcement factors of cell (i, j).
+    #[inline]
+    pub fn cell_factors(&self, i: usize, j: usize) -> Factors {
+        self.sheet.as_ref().map_or(Factors::ONE, |s| *s.cell(i, j))
+    }
+    /// Reinforcement factors of node (i, j).
+    #[inline]
+    pub fn node_factors(&self, i: usize, j: usize) -> Factors {
+        self.sheet.as_ref().map_or(Factors::ONE, |s| *s.node(i, j))
     }
     /// Whether cell (i, j) exists and is complete (out-of-range indices: false).
     fn cell_on(&self, i: isize, j: isize) -> f64 {
@@ -164,19 +221,29 @@ impl Grid {
     /// interior nodes of a full grid, d^2/2 on edges, d^2/4 at corners, 0 for nodes without a
     /// complete cell). Sums to the area of the complete cells.
     pub fn nodal_areas(&self) -> Vec<f64> {
-        let mut area = vec![0.0; self.num_nodes()];
+        self.quarter_cells(|_, _| 1.0)
+    }
+    /// Mass of each node (kg) for the fabric's `areal_mass` (kg/m^2): a quarter of each complete
+    /// cell it is a corner of, times the cell's weight factor.
+    pub fn nodal_masses(&self, areal_mass: f64) -> Vec<f64> {
+        self.quarter_cells(|i, j| areal_mass * self.cell_factors(i, j).weight)
+    }
+    /// Per node, the sum over the complete cells it is a corner of of `weight(cell) d^2 / 4`.
+    fn quarter_cells(&self, weight: impl Fn(usize, usize) -> f64) -> Vec<f64> {
+        let mut out = vec![0.0; self.num_nodes()];
         let q = 0.25 * self.spacing * self.spacing;
         for i in 0..self.nu.saturating_sub(1) {
             for j in 0..self.nv.saturating_sub(1) {
                 if self.cell_active(i, j) {
                     let k = self.index(i, j);
+                    let w = q * weight(i, j);
                     for n in [k, k + 1, k + self.nv, k + self.nv + 1] {
-                        area[n] += q;
+                        out[n] += w;
                     }
                 }
             }
         }
-        area
+        out
     }
     /// The reference state laid flat: node (i, j) at (i d, j d, 0).
     pub fn flat_positions(&self) -> Vec<Point> {
@@ -324,12 +391,18 @@ impl<'a> Model<'a> {
     /// Stretch, shear, bending and gravity (`gravity` in m/s^2, e.g. (0, 0, -9.81)).
     pub fn new<L: Laws + ?Sized>(grid: Grid, material: &'a L, gravity: Vector) -> Self {
         let g = Gravity::new(&grid, material.areal_mass(), gravity);
-        let terms: Vec<Box<dyn EnergyTerm + 'a>> = vec![
-            Box::new(Stretch::new(material)),
-            Box::new(Shear::new(material)),
-            Box::new(Bending::new(material)),
-            Box::new(g),
-        ];
+        let mut model = Self::internal(grid, material);
+        model.push_term(Box::new(g));
+        model
+    }
+    /// The fabric's internal energy only: stretch, shear and bending, and the springs of the
+    /// grid's sheet features (a fold) if it has any; loads are added by the caller.
+    pub fn internal<L: Laws + ?Sized>(grid: Grid, material: &'a L) -> Self {
+        let mut terms: Vec<Box<dyn EnergyTerm + 'a>> =
+            vec![Box::new(Stretch::new(material)), Box::new(Shear::new(material)), Box::new(Bending::new(material))];
+        if let Some(sheet) = grid.sheet.as_ref().filter(|s| !s.springs.is_empty()) {
+            terms.push(Box::new(Springs::new(&grid, &sheet.springs)));
+        }
         Self::with_terms(grid, terms)
     }
     /// A model with the given terms (e.g. a subset, or extra penalty terms).

@@ -212,17 +212,17 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Shear<'a, L> {
 
     fn add(&self, grid: &Grid, x: &[Point], base: Range<usize>, sink: &mut Sink<'_>) {
         let (nu, nv) = (grid.nu, grid.nv);
-        let w = 0.25 * grid.spacing * grid.spacing;
-        let act = &grid.active;
+        let quarter = 0.25 * grid.spacing * grid.spacing;
         let want_grad = sink.wants_gradient();
         let kind = sink.hessian_kind();
         for i in sink.element_rows(&base, 1, nu) {
             for j in 0..nv.saturating_sub(1) {
                 let k = i * nv + j;
                 let nodes = [k, k + nv, k + 1, k + nv + 1];
-                if !(act[nodes[0]] && act[nodes[1]] && act[nodes[2]] && act[nodes[3]]) {
+                if !grid.cell_active(i, j) {
                     continue;
                 }
+                let w = quarter * grid.cell_factors(i, j).shear;
                 let p = [x[nodes[0]], x[nodes[1]], x[nodes[2]], x[nodes[3]]];
                 let mut energy = 0.0;
                 let mut g = [Vector::zeros(); 4];

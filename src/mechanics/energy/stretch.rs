@@ -78,28 +78,42 @@ impl<'a, L: Laws + ?Sized> Stretch<'a, L> {
     }
 }
 
-impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
-    fn add_second_order(&self, grid: &Grid, x: &[Point], trial: &[Point], out: &mut [Vector]) {
-        let (nu, nv) = (grid.nu, grid.nv);
-        let d2 = grid.spacing * grid.spacing;
-        let act = &grid.active;
-        for i in 0..nu {
-            for j in 0..nv {
+/// Calls `f(fibre, weight, a, b)` for every fibre link of the grid: warp links (i, j)-(i+1, j)
+/// with i in `warp_rows`, weft links (i, j)-(i, j+1) with i in `weft_rows`, whose `weight` is
+/// the link's tributary width times its tension factor (links with no width are skipped).
+fn for_each_link(
+    grid: &Grid,
+    warp_rows: Range<usize>,
+    weft_rows: Range<usize>,
+    mut f: impl FnMut(Fibre, f64, usize, usize),
+) {
+    let nv = grid.nv;
+    for i in warp_rows {
+        for j in 0..nv {
+            let width = grid.warp_segment_width(i, j);
+            if width > 0.0 && grid.warp_link(i, j) {
                 let a = i * nv + j;
-                if i + 1 < nu {
-                    let width = grid.warp_segment_width(i, j);
-                    if act[a] && act[a + nv] && width > 0.0 {
-                        self.segment_second_order(Fibre::Warp, d2, width, a, a + nv, x, trial, out);
-                    }
-                }
-                if j + 1 < nv {
-                    let width = grid.weft_segment_width(i, j);
-                    if act[a] && act[a + 1] && width > 0.0 {
-                        self.segment_second_order(Fibre::Weft, d2, width, a, a + 1, x, trial, out);
-                    }
-                }
+                f(Fibre::Warp, width * grid.warp_link_factors(i, j).tension, a, a + nv);
             }
         }
+    }
+    for i in weft_rows {
+        for j in 0..nv.saturating_sub(1) {
+            let width = grid.weft_segment_width(i, j);
+            if width > 0.0 && grid.weft_link(i, j) {
+                let a = i * nv + j;
+                f(Fibre::Weft, width * grid.weft_link_factors(i, j).tension, a, a + 1);
+            }
+        }
+    }
+}
+
+impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
+    fn add_second_order(&self, grid: &Grid, x: &[Point], trial: &[Point], out: &mut [Vector]) {
+        let d2 = grid.spacing * grid.spacing;
+        for_each_link(grid, 0..grid.nu.saturating_sub(1), 0..grid.nu, |fibre, weight, a, b| {
+            self.segment_second_order(fibre, d2, weight, a, b, x, trial, out)
+        });
     }
 
     fn name(&self) -> &'static str {
@@ -111,29 +125,9 @@ impl<'a, L: Laws + ?Sized> EnergyTerm for Stretch<'a, L> {
     }
 
     fn add(&self, grid: &Grid, x: &[Point], base: Range<usize>, sink: &mut Sink<'_>) {
-        let (nu, nv) = (grid.nu, grid.nv);
         let d2 = grid.spacing * grid.spacing;
-        let act = &grid.active;
-        // Warp segments (i, j)-(i + 1, j).
-        for i in sink.element_rows(&base, 1, nu) {
-            for j in 0..nv {
-                let a = i * nv + j;
-                let b = a + nv;
-                let width = grid.warp_segment_width(i, j);
-                if act[a] && act[b] && width > 0.0 {
-                    self.segment(Fibre::Warp, d2, width, a, b, x, sink);
-                }
-            }
-        }
-        // Weft segments (i, j)-(i, j + 1).
-        for i in sink.element_rows(&base, 0, nu) {
-            for j in 0..nv.saturating_sub(1) {
-                let a = i * nv + j;
-                let width = grid.weft_segment_width(i, j);
-                if act[a] && act[a + 1] && width > 0.0 {
-                    self.segment(Fibre::Weft, d2, width, a, a + 1, x, sink);
-                }
-            }
-        }
+        let warp_rows = sink.element_rows(&base, 1, grid.nu);
+        let weft_rows = sink.element_rows(&base, 0, grid.nu);
+        for_each_link(grid, warp_rows, weft_rows, |fibre, weight, a, b| self.segment(fibre, d2, weight, a, b, x, sink));
     }
 }
