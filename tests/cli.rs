@@ -151,7 +151,14 @@ fn scenes_run_and_bad_scenes_name_the_field_and_line() {
     let good = "units = \"mm\"\ntool = \"plate.obj\"\n\n[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.02\ngrid = [11, 11]\nthickness = 0.5\n\n[[ply]]\nname = \"b\"\norigin = [0, 0, 0]\nwarp = [1, 1, 0]\nspacing = 0.02\ngrid = [11, 11]\n";
     std::fs::write(&scene, good).unwrap();
     let out = dir.path().join("out");
-    drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
+    let ran = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().success();
+    // No locking angle in the plies and no card: the table says which default judged them.
+    let stdout = String::from_utf8_lossy(&ran.get_output().stdout).to_string();
+    assert!(stdout.contains("a, b give(s) no locking_angle_deg") && stdout.contains("default 45 deg"), "{stdout}");
+    let layup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("layup.json")).unwrap()).unwrap();
+    assert_eq!(layup["plies"][0]["locking_angle_source"], "default");
+    assert_eq!(layup["plies"][0]["locking_angle_deg"], 45.0);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("b.drape.json")).unwrap()).unwrap();
     // Millimetres in, metres out.
@@ -342,4 +349,199 @@ fn a_mechanical_ply_in_a_scene_is_refined_and_bad_mechanical_fields_are_named() 
         let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
         assert!(err.contains(needle) && err.contains("line 3"), "expected '{needle}' in: {err}");
     }
+}
+
+/// `drape bench` reports cells placed per second: a net larger than the hemisphere leaves grid
+/// cells off the tool, and those do not count.
+#[test]
+fn bench_headline_counts_placed_cells() {
+    let a = drape().args(["bench", "--triangles", "2000", "--nodes", "61", "--repeat", "2"]).assert().success();
+    let out = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    let placed: f64 = out
+        .lines()
+        .find(|l| l.starts_with("net "))
+        .unwrap_or_else(|| panic!("{out}"))
+        .split(": ")
+        .nth(1)
+        .and_then(|s| s.split(" of the grid").next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(placed < 60.0 * 60.0, "{out}");
+    let line = out.lines().find(|l| l.starts_with("throughput:")).unwrap_or_else(|| panic!("{out}"));
+    let rate: f64 = line["throughput:".len()..].split_whitespace().next().unwrap().parse().unwrap();
+    let best_ms: f64 = line.split("best ").nth(1).unwrap().split(" ms").next().unwrap().parse().unwrap();
+    // Rates are printed to 0.01 M cells/s and the time to 0.1 ms.
+    let expected = placed / (best_ms * 1e-3) / 1e6;
+    assert!((rate - expected).abs() <= 0.01 + expected * 0.1 / best_ms, "{line}: expected {expected:.3}");
+}
+
+#[test]
+fn a_run_owns_its_folder_and_the_report_shows_its_plies() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let ply = |name: &str| {
+        format!("[[ply]]\nname = \"{name}\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.05\ngrid = [9, 9]\nthickness = 0.0005\n\n")
+    };
+    let head = "tool = \"plate.obj\"\n\n";
+    std::fs::write(&scene, format!("{head}{}{}", ply("a"), ply("b"))).unwrap();
+    let out = dir.path().join("out");
+    let run = |replace: bool| {
+        let mut c = drape();
+        c.args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        if replace {
+            c.arg("--replace");
+        }
+        c.assert()
+    };
+    run(false).success();
+    for f in ["a.drape.json", "b.drape.json", "b.vtu", "b.cells.csv", "layup.json"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let layup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("layup.json")).unwrap()).unwrap();
+    let files: Vec<&str> = layup["files"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+    assert!(files.contains(&"b.vtu") && files.contains(&"layup.json") && files.contains(&"patterns.dxf"), "{files:?}");
+
+    // The same folder, a scene without ply b: b's files go, a file the user put there stays.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    std::fs::write(&scene, format!("{head}{}", ply("a"))).unwrap();
+    let second = run(false).success();
+    let stdout = String::from_utf8_lossy(&second.get_output().stdout).to_string();
+    assert!(stdout.contains("removed") && stdout.contains("b.drape.json"), "{stdout}");
+    for f in ["b.drape.json", "b.vtu", "b.cells.csv"] {
+        assert!(!out.join(f).exists(), "{f} left behind");
+    }
+    assert!(out.join("a.drape.json").is_file() && out.join("notes.txt").is_file());
+
+    // A net no run into the folder wrote: refused (exit 2) unless --replace, and the report
+    // leaves it out.
+    std::fs::copy(out.join("a.drape.json"), out.join("other.drape.json")).unwrap();
+    let report = dir.path().join("report");
+    let r = drape().args(["report", out.to_str().unwrap(), "--out", report.to_str().unwrap()]).assert().success();
+    let stdout = String::from_utf8_lossy(&r.get_output().stdout).to_string();
+    assert!(report.join("a-shear.png").is_file() && !report.join("other-shear.png").exists(), "{stdout}");
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(page.contains("other.drape.json") && page.contains("not drawn"));
+    let refused = run(false).code(2);
+    let err = String::from_utf8_lossy(&refused.get_output().stderr).to_string();
+    assert!(err.contains("other.drape.json") && err.contains("--replace"), "{err}");
+    assert!(out.join("other.drape.json").is_file());
+    run(true).success();
+    assert!(!out.join("other.drape.json").exists() && out.join("a.drape.json").is_file());
+}
+
+/// Everything a run can check is checked before it computes: bad input exits 2 with one message
+/// saying what to do, and writes nothing.
+#[test]
+fn bad_input_is_found_before_computing_and_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let ply = "[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.05\ngrid = [9, 9]\nthickness = 0.0005\n";
+    // Permeability asked for without a card that has a [flow] section: refused before any ply is
+    // draped (no drape progress, no output folder).
+    std::fs::write(
+        &scene,
+        format!(
+            "tool = \"plate.obj\"\n[export]\nmesh = \"plate.obj\"\nformats = [\"vtu\"]\npermeability = true\n{ply}"
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let a = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("ply 'a'") && err.contains("[flow] section"), "{err}");
+    assert!(!out.exists());
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    assert!(!stdout.contains("ply a:") && !stdout.contains("tool "), "read the tool or draped first: {stdout}");
+
+    // --out a file, or under a file: exit 2, the OS error once, what to do.
+    std::fs::write(&scene, format!("tool = \"plate.obj\"\n{ply}")).unwrap();
+    let file = dir.path().join("file");
+    std::fs::write(&file, "x").unwrap();
+    for bad in [file.clone(), file.join("sub")] {
+        let a = drape().args(["run", scene.to_str().unwrap(), "--out", bad.to_str().unwrap()]).assert().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert!(err.contains("give a folder"), "{err}");
+        assert!(err.matches("os error").count() <= 1, "{err}");
+        let a =
+            drape().args(kinematic_args("plate.obj", bad.to_str().unwrap())).current_dir(dir.path()).assert().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert_eq!(err.matches("os error").count(), 1, "{err}");
+    }
+
+    // drape export creates its --out folder as drape run does; a folder as --out is refused.
+    let run_out = dir.path().join("run");
+    drape().args(["run", scene.to_str().unwrap(), "--out", run_out.to_str().unwrap()]).assert().success();
+    let net = run_out.join("a.drape.json");
+    let mesh = dir.path().join("plate.obj");
+    let export = |out: &Path| {
+        drape()
+            .args(["export", "--net", net.to_str().unwrap(), "--mesh", mesh.to_str().unwrap(), "--format", "csv"])
+            .args(["--out", out.to_str().unwrap()])
+            .assert()
+    };
+    let deep = dir.path().join("new/deeper/flow.csv");
+    export(&deep).success();
+    assert!(deep.is_file());
+    let a = export(dir.path()).code(2);
+    assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("is a folder"));
+    let a = export(&file.join("flow.csv")).code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("cannot create its folder") && err.matches("os error").count() == 1, "{err}");
+}
+
+/// A flow mesh the net does not cover at all is bad input naming the likely cause and the fix;
+/// one covered in part says how much.
+#[test]
+fn a_flow_mesh_the_net_misses_is_refused_with_the_cause() {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let out = dir.path().join("net");
+    // A 0.2 m net in the middle of the 1 m plate.
+    let mut args = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap());
+    args.iter_mut().filter(|a| **a == "21,21").for_each(|a| *a = "11,11");
+    args.iter_mut().filter(|a| **a == "1,1,0").for_each(|a| *a = "1,0,0");
+    drape().args(&args).assert().success();
+    let net = out.join("ply.drape.json");
+    // The plate as a flow mesh, scaled (mm) or moved (another part).
+    let text = std::fs::read_to_string(&tool).unwrap();
+    let transformed = |f: &dyn Fn(f64, f64) -> (f64, f64), name: &str| {
+        let body: String = text
+            .lines()
+            .map(|l| match l.strip_prefix("v ") {
+                Some(v) => {
+                    let c: Vec<f64> = v.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                    let (x, y) = f(c[0], c[1]);
+                    format!("v {x} {y} {}\n", c[2])
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        let p = dir.path().join(name);
+        std::fs::write(&p, body).unwrap();
+        p
+    };
+    let mm = transformed(&|x, y| (1000.0 * x, 1000.0 * y), "mm.obj");
+    let moved = transformed(&|x, y| (x + 5.0, y), "moved.obj");
+    let export = |mesh: &Path, units: &str| {
+        drape()
+            .args(["export", "--net", net.to_str().unwrap(), "--mesh", mesh.to_str().unwrap(), "--format", "csv"])
+            .args(["--mesh-units", units, "--out", dir.path().join("flow.csv").to_str().unwrap()])
+            .assert()
+    };
+    let a = export(&mm, "m").code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("covers none of the 200 elements") && err.contains("--mesh-units mm"), "{err}");
+    assert!(!dir.path().join("flow.csv").exists());
+    let a = export(&moved, "m").code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("another part") && err.contains("4.4000 m apart"), "{err}");
+    // In millimetres it is read right; the 0.2 m net on the 1 m plate covers 4 % of it.
+    let a = export(&mm, "mm").success();
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    let line = stdout.lines().find(|l| l.contains("covers")).unwrap();
+    let covered: f64 = line.split("elements (").nth(1).unwrap().split('%').next().unwrap().parse().unwrap();
+    assert!((covered - 4.0).abs() <= 2.0 && stdout.contains("covers only part of the flow mesh"), "{stdout}");
 }

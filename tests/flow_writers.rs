@@ -69,7 +69,7 @@ fn mesh() -> FlowMesh {
         id,
         shape: if ns.len() == 3 { ElementShape::Tria3 } else { ElementShape::Quad4 },
         nodes: ns.iter().map(|&n| idx(n)).collect(),
-        property: 1,
+        property: user_pid(id),
     };
     let elements = vec![
         el(7, &[11, 21, 22, 12]),
@@ -80,6 +80,23 @@ fn mesh() -> FlowMesh {
         el(16, &[31, 40, 32]),
     ];
     FlowMesh { path: PathBuf::from("test-mesh.bdf"), nodes, node_ids, elements }
+}
+
+/// The user's property of each element of [`mesh`]: 0 (none) for elements 15 and 16.
+fn user_pid(id: u64) -> u64 {
+    match id {
+        7 | 3 => 5,
+        42 | 1000 => 6,
+        _ => 0,
+    }
+}
+
+/// The PID an element keeps in a Nastran deck: the user's, else 1.
+fn kept_pid(id: u64) -> u64 {
+    match user_pid(id) {
+        0 => 1,
+        p => p,
+    }
 }
 
 /// Ply angles (rad) and which elements (by index) each ply misses.
@@ -154,11 +171,11 @@ fn python_ready() -> bool {
         eprintln!("flow_writers: DRAPE_SKIP_PYTHON=1: skipped the independent Python read-back");
         return false;
     }
-    let probe = Command::new("python3").args(["-c", "import meshio, numpy, pyNastran"]).output();
+    let probe = Command::new("python3").args(["-c", "import meshio, numpy, pyNastran, vtk"]).output();
     match probe {
         Ok(o) if o.status.success() => true,
         Ok(o) => panic!(
-            "python3 cannot import meshio/numpy/pyNastran ({}). Run `python3 -m pip install -r tools/requirements.txt`, \
+            "python3 cannot import meshio/numpy/pyNastran/vtk ({}). Run `python3 -m pip install -r tools/requirements.txt`, \
              or set DRAPE_SKIP_PYTHON=1 to skip this check.",
             String::from_utf8_lossy(&o.stderr).trim()
         ),
@@ -174,7 +191,9 @@ fn readback(format: &str, files: &[PathBuf]) -> Value {
 }
 
 fn f64s(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap_or_else(|| panic!("not an array: {v}")).iter().map(|x| x.as_f64().unwrap()).collect()
+    // Non-finite numbers come as text ("nan") from the read-back.
+    let number = |x: &Value| x.as_f64().or_else(|| x.as_str().and_then(|s| s.parse().ok())).unwrap();
+    v.as_array().unwrap_or_else(|| panic!("not an array: {v}")).iter().map(number).collect()
 }
 
 fn vec3(v: &[f64]) -> Vector {
@@ -206,12 +225,17 @@ fn vtu_fields_and_frames() {
         let dir = tempfile::tempdir().unwrap();
         let files = write(&mesh, &map, FlowFormat::Vtu, &dir.path().join("flow.vtu"));
         let text = std::fs::read_to_string(&files[0]).unwrap();
-        assert!(!text.contains("NaN") && !text.contains("inf"));
+        // Uncovered elements carry NaN (every map here leaves some element uncovered), never inf.
+        assert!(text.contains("NaN") && !text.contains("inf"));
         if !python_ready() {
             continue;
         }
+        // Cells through meshio, the fields through VTK's own reader.
         let s = readback("vtu", &files);
-        let data = s["cell_data"].as_object().unwrap();
+        let vtk = readback("vtu-vtk", &files);
+        assert_eq!(vtk["cells"], mesh.elements.len());
+        assert_eq!(vtk["points"], mesh.nodes.len());
+        let data = vtk["cell_data"].as_object().unwrap();
         let mut names: Vec<&str> = data.keys().map(String::as_str).collect();
         names.sort();
         let per_ply = ["covered", "warp", "weft", "shear_deg", "thickness", "vf", "permeability"];
@@ -242,7 +266,7 @@ fn vtu_fields_and_frames() {
                     None => {
                         assert_eq!(covered, 0.0);
                         for f in ["warp", "weft", "shear_deg", "thickness", "vf", "permeability"] {
-                            assert!(get(f).iter().all(|&v| v == 0.0), "{f} of uncovered element {}", el.id);
+                            assert!(get(f).iter().all(|v| v.is_nan()), "{f} of uncovered element {}", el.id);
                         }
                     }
                     Some(fib) => {
@@ -263,8 +287,11 @@ fn vtu_fields_and_frames() {
                 }
             }
             if layup {
-                assert_eq!(data["laminate_thickness"][e][0].as_f64().unwrap(), map.thickness[e]);
-                assert_eq!(data["mean_vf"][e][0].as_f64().unwrap(), map.mean_vf[e].unwrap_or(0.0));
+                let (t, vf) = (f64s(&data["laminate_thickness"][e])[0], f64s(&data["mean_vf"][e])[0]);
+                match map.mean_vf[e] {
+                    Some(want) => assert!(t == map.thickness[e] && vf == want),
+                    None => assert!(t.is_nan() && vf.is_nan(), "element {} no ply covers", el.id),
+                }
             }
         }
     }
@@ -310,9 +337,13 @@ fn nastran_theta_reproduces_warp() {
                 assert_eq!(nodes, el.nodes.iter().map(|&k| mesh.node_ids[k]).collect::<Vec<_>>());
                 assert!(r["mcid"].is_null(), "THETA must be read as a real angle, not a coordinate system");
                 match &ply.elements[e] {
-                    None => assert_eq!(r["pid"], 2, "uncovered element {} must have its own PID", el.id),
+                    None => {
+                        assert_eq!(r["pid"], kept_pid(el.id), "uncovered element {} keeps the user's PID", el.id);
+                        assert_eq!(r["theta_blank"], true, "uncovered element {}: no THETA", el.id);
+                    }
                     Some(fib) => {
-                        assert_eq!(r["pid"], 1);
+                        assert_eq!(r["pid"], kept_pid(el.id), "element {} keeps the user's PID", el.id);
+                        assert_eq!(r["theta_blank"], false);
                         let theta = r["theta"].as_f64().unwrap();
                         assert!((theta - fib.theta.to_degrees()).abs() < LARGE_FIELD_DEG_TOL, "{theta}");
                         let n = back.normal(e).unwrap();
@@ -385,6 +416,11 @@ fn optistruct_ply_drape() {
     let map = layup_map(&mesh, true);
     let dir = tempfile::tempdir().unwrap();
     let files = write(&mesh, &map, FlowFormat::OptiStruct, &dir.path().join("flow.fem"));
+    // The deck structure OptiStruct reads: control section, CEND, BEGIN BULK, bulk, ENDDATA.
+    let text = std::fs::read_to_string(&files[0]).unwrap();
+    let keys: Vec<&str> =
+        text.lines().filter(|l| !l.starts_with('$') && !l.starts_with(' ') && !l.contains('*')).collect();
+    assert_eq!(keys, ["CEND", "BEGIN BULK", "ENDDATA"], "{text}");
     if !python_ready() {
         return;
     }
@@ -417,8 +453,10 @@ fn optistruct_ply_drape() {
             (wrap_deg(p["theta"].as_f64().unwrap()) - wrap_deg((PLIES[k].1 - PLIES[0].1).to_degrees())).abs() < 1e-8
         );
     }
-    // Element 16 is covered by the base ply only in the single-net map; here p45 covers it.
-    assert_eq!(els["16"]["pid"], 1);
+    // Every element keeps the user's PID (1 where the mesh has none).
+    for el in &mesh.elements {
+        assert_eq!(els[&el.id.to_string()]["pid"], kept_pid(el.id));
+    }
 }
 
 #[test]
@@ -640,4 +678,39 @@ fn rtmsim_merges_excess_groups() {
     let sets = s["sets"].as_array().unwrap();
     assert!(sets.iter().all(|v| !v.as_array().unwrap().is_empty()), "all four sets used");
     assert_eq!(s["patchtypes"], serde_json::json!([2, 2, 2, 2]));
+}
+
+/// pyNastran reads a solver's deck that INCLUDEs drape's bulk data with cross-referencing on:
+/// every element finds the user's property and material, and keeps its THETA.
+#[test]
+fn nastran_deck_cross_references_the_users_properties() {
+    if !python_ready() {
+        return;
+    }
+    let mesh = mesh();
+    let map = layup_map(&mesh, false);
+    let dir = tempfile::tempdir().unwrap();
+    write(&mesh, &map, FlowFormat::Nastran, &dir.path().join("flow.bdf"));
+    let master = dir.path().join("job.bdf");
+    let mut text = String::from("SOL 101\nCEND\nSUBCASE 1\n  DISP = ALL\nBEGIN BULK\n");
+    for pid in [1, 5, 6] {
+        text += &format!("PSHELL,{pid},100,0.001\n");
+    }
+    text += "MAT8,100,140.+9,10.+9,0.3,5.+9,5.+9,5.+9,1600.\nINCLUDE 'flow.bdf'\nENDDATA\n";
+    std::fs::write(&master, text).unwrap();
+    let s = readback("nastran-xref", &[master]);
+    let els = s["elements"].as_object().unwrap();
+    assert_eq!(els.len(), mesh.elements.len());
+    for (e, el) in mesh.elements.iter().enumerate() {
+        let r = &els[&el.id.to_string()];
+        assert_eq!(r["pid"], kept_pid(el.id));
+        assert_eq!(r["property"], "PSHELL");
+        assert_eq!(r["material"], "MAT8");
+        match &map.plies[0].elements[e] {
+            Some(fib) => {
+                assert!((r["theta"].as_f64().unwrap() - fib.theta.to_degrees()).abs() < LARGE_FIELD_DEG_TOL)
+            }
+            None => assert!(r["theta"].is_null() || r["theta"].as_f64() == Some(0.0), "{r}"),
+        }
+    }
 }

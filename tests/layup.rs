@@ -57,6 +57,9 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
         assert_eq!(p["material"], "glass");
         assert_eq!(p["method"], if k == 0 { "mechanical" } else { "kinematic" });
         assert!((p["thickness_m"].as_f64().unwrap() - GLASS_T).abs() < 1e-15);
+        // The scene gives no locking angle: the glass card's two-slope law does (30 deg).
+        assert!((p["locking_angle_deg"].as_f64().unwrap() - 30.0).abs() < 1e-12, "{}", p["locking_angle_deg"]);
+        assert_eq!(p["locking_angle_source"], "card");
         // Each ply sits on the ones below: at the pole (no shear) k plies of t0.
         let net = read_json(&out.join(format!("{}.drape.json", names[k])));
         let o = origin_node(&net);
@@ -71,8 +74,18 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
         let max = p["max_abs_shear_deg"].as_f64().unwrap();
         assert!(max > 40.0 && max < 60.0, "ply {k}: max |shear| {max}");
         assert!(p["area_over_locking_m2"].as_f64().unwrap() > 0.0);
+        // Coverage is the share of the tool (R = 0.1 m hemisphere, 2 pi R^2 of surface, the
+        // plies above on the offset tool) that the ply covers: nearly all of it (97 %), not the
+        // share of grid cells placed (67 %). The covered area is the draped area to within the
+        // facets' sagitta and the sampling along the ply's edge.
         let cov = p["coverage"].as_f64().unwrap();
-        assert!(cov > 0.5 && cov <= 1.0, "coverage {cov}");
+        assert_eq!(p["coverage_of"], "tool");
+        assert!(cov > 0.93 && cov <= 1.0, "ply {k}: coverage {cov}");
+        let covered = p["covered_area_m2"].as_f64().unwrap();
+        let draped = p["draped_area_m2"].as_f64().unwrap();
+        assert!((covered / draped - 1.0).abs() < 0.02, "ply {k}: covered {covered} m^2, draped {draped} m^2");
+        let tool_area = 2.0 * std::f64::consts::PI * (0.1 + k as f64 * GLASS_T).powi(2);
+        assert!((cov - covered / tool_area).abs() < 0.02, "ply {k}: coverage {cov} of {tool_area} m^2");
         let cells = p["cells"].as_f64().unwrap();
         assert!((p["fabric_area_m2"].as_f64().unwrap() - cells * 0.004 * 0.004).abs() < 1e-12);
         let mass = p["fabric_mass_kg"].as_f64().unwrap();
@@ -96,6 +109,33 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
     for f in ["patterns.dxf", "patterns.svg", "ply-p0.svg", "ply-m45.svg", "flow.csv"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+    // One set of cell statistics: the report's pictures (drawn from the nets) and the run's
+    // table agree to the last digit, on the refined ply too; so do the run's printed summaries.
+    let report = drape::report::write_report(&out, &dir.path().join("report"), false).unwrap();
+    // p0's refinement changes no cell by more than the tool's facets can explain (0.07 deg
+    // against 4 mm cells on 3 mm facets): no change map, and the report says why.
+    let noise = report.plies[0].change_noise.expect("p0 is mechanical");
+    assert!(noise.facets_deg.is_some_and(|f| f > 0.07), "{noise:?}");
+    assert!(!dir.path().join("report/p0-change.png").exists());
+    assert!(
+        report.notes.iter().any(|n| n.starts_with("ply 'p0'") && n.contains("within the solver's noise")),
+        "{:?}",
+        report.notes
+    );
+    for (k, r) in report.plies.iter().enumerate() {
+        let row = &plies[k];
+        assert_eq!(r.name, names[k]);
+        assert_eq!(r.locking_angle_deg, row["locking_angle_deg"].as_f64().unwrap());
+        assert_eq!(r.cells as u64, row["cells"].as_u64().unwrap());
+        assert_eq!(r.max_abs_shear_deg, row["max_abs_shear_deg"].as_f64().unwrap(), "ply {}", r.name);
+        assert_eq!(r.mean_abs_shear_deg, row["mean_abs_shear_deg"].as_f64().unwrap(), "ply {}", r.name);
+        let printed = format!(
+            "|shear| max {:.2} deg, mean {:.2} deg",
+            row["max_abs_shear_deg"].as_f64().unwrap(),
+            row["mean_abs_shear_deg"].as_f64().unwrap()
+        );
+        assert!(stdout.contains(&printed), "{printed} not in {stdout}");
+    }
     // The scene's [export]: every ply on the flow mesh, fields prefixed by the ply, laminate
     // fields summed over the plies covering each element (read back with meshio).
     if std::env::var("DRAPE_SKIP_PYTHON").is_ok_and(|v| v == "1") {
@@ -117,17 +157,24 @@ fn a_four_ply_layup_on_the_hemisphere_stacks_and_turns_each_ply() {
         }
     }
     assert!(data.get("warp").is_none(), "a layup prefixes every ply field");
-    let scalar = |f: String, k: usize| data[&f][k][0].as_f64().unwrap();
+    // Non-finite numbers come as text ("nan": elements no ply covers).
+    let scalar = |f: String, k: usize| {
+        let v = &data[&f][k][0];
+        v.as_f64().or_else(|| v.as_str().and_then(|s| s.parse().ok())).unwrap()
+    };
     let mut full = 0;
     for k in 0..n {
         let covering: Vec<&str> = names.iter().copied().filter(|p| scalar(format!("{p}_covered"), k) == 1.0).collect();
         let t: f64 = covering.iter().map(|p| scalar(format!("{p}_thickness"), k)).sum();
-        assert!((scalar("laminate_thickness".into(), k) - t).abs() < 1e-15, "element {k}");
-        assert!((t - covering.len() as f64 * GLASS_T).abs() < 1e-15, "fixed cavity keeps each ply at t0");
-        if !covering.is_empty() {
-            let vf: f64 = covering.iter().map(|p| scalar(format!("{p}_vf"), k)).sum::<f64>() / covering.len() as f64;
-            assert!((scalar("mean_vf".into(), k) - vf).abs() < 1e-12, "element {k}: mean Vf");
+        let laminate = scalar("laminate_thickness".into(), k);
+        if covering.is_empty() {
+            assert!(laminate.is_nan() && scalar("mean_vf".into(), k).is_nan(), "element {k}: no ply, NaN");
+            continue;
         }
+        assert!((laminate - t).abs() < 1e-15, "element {k}");
+        assert!((t - covering.len() as f64 * GLASS_T).abs() < 1e-15, "fixed cavity keeps each ply at t0");
+        let vf: f64 = covering.iter().map(|p| scalar(format!("{p}_vf"), k)).sum::<f64>() / covering.len() as f64;
+        assert!((scalar("mean_vf".into(), k) - vf).abs() < 1e-12, "element {k}: mean Vf");
         full += (covering.len() == 4) as usize;
     }
     assert!(full > 1900, "{full} elements under all four plies");
@@ -208,4 +255,46 @@ fn scene_errors_name_the_field_and_the_line() {
     );
     // A reference along the normal at the seed (the pole) has no direction on the tool there.
     scene_refused(&format!("{head}reference = [0.0, 0.0, 1.0]\n{PLY}"), "normal to the tool at the seed");
+}
+
+/// Coverage is the share of the tool, or of the ply's outline, that the ply covers: a ply larger
+/// than a plate covers the whole plate but for the staircase of cells along its edges; a ply
+/// trimmed to a disc covers the disc but for the cells its edge cuts.
+#[test]
+fn coverage_is_the_share_of_the_tool_or_the_outline_covered() {
+    use drape::geometry::{shapes, Point, Vector};
+    use drape::kinematic::outline::Outline;
+    use drape::kinematic::{drape as drape_net, Extent, KinematicSettings};
+    use drape::layup::stack::ply_stats;
+    let (w, l, d) = (0.5, 0.3, 0.02);
+    let plate = shapes::plate(w, l, 10, 6).into_surface().unwrap();
+    let net =
+        drape_net(&plate, &KinematicSettings::grid("big", Point::new(0.013, -0.007, 0.0), Vector::x(), d, 41, 31))
+            .unwrap();
+    let s = ply_stats(&net, &plate, None, 0.5, None);
+    let least = (w - 2.0 * d) * (l - 2.0 * d) / (w * l);
+    assert!(!s.coverage.of_outline && (s.coverage.area - w * l).abs() < 1e-12, "{:?}", s.coverage);
+    assert!(s.coverage.share() >= least && s.coverage.share() <= 1.0, "{:?}", s.coverage);
+    // The placed cells over the grid's cells, the old "coverage", is far less: the grid
+    // overhangs the plate.
+    assert!((s.cells as f64 / (40.0 * 30.0)) < 0.8 * s.coverage.share());
+
+    let (r, d) = (0.2, 0.01);
+    let tool = shapes::plate(1.0, 1.0, 20, 20).into_surface().unwrap();
+    let points: Vec<Point> = (0..180)
+        .map(|k| {
+            let t = k as f64 * std::f64::consts::TAU / 180.0;
+            Point::new(r * t.cos(), r * t.sin(), 0.0)
+        })
+        .collect();
+    let mut settings = KinematicSettings::grid("disc", Point::origin(), Vector::x(), d, 3, 3);
+    settings.extent = Extent::Outline(points.clone());
+    let net = drape_net(&tool, &settings).unwrap();
+    let outline = Outline::new(&tool, &points, d).unwrap();
+    let s = ply_stats(&net, &tool, Some(&outline), 0.5, None);
+    let pi = std::f64::consts::PI;
+    assert!(s.coverage.of_outline && (s.coverage.area / (pi * r * r) - 1.0).abs() < 0.01, "{:?}", s.coverage);
+    let inner = r - std::f64::consts::SQRT_2 * d;
+    assert!(s.coverage.share() > (inner / r).powi(2) && s.coverage.share() < 1.0, "{:?}", s.coverage);
+    assert!((s.coverage.covered_area / s.draped_area - 1.0).abs() < 0.01, "{:?} vs {}", s.coverage, s.draped_area);
 }

@@ -4,6 +4,7 @@
 mod common;
 mod energy_common;
 
+mod calculix;
 mod chebyshev_reference;
 mod cli;
 mod developable;

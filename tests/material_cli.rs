@@ -126,6 +126,14 @@ fn bad_input_exits_2_and_writes_nothing() {
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, "d,F\n0.001,1.0\n0.002,oops\n").unwrap();
     let good = write_csv(dir.path(), "good.csv", "d,F", &[(0.001, 1.0), (0.002, 2.0), (0.003, 3.5), (0.004, 6.0)]);
+    // Picture-frame data of a fabric that never locks (one straight slope up to 40 deg).
+    let linear: Vec<(f64, f64)> = (1..=100)
+        .map(|i| {
+            let d = 0.04 * i as f64 / 100.0;
+            (d, picture_frame_force(&ShearLaw::Polynomial { coefficients: vec![3.0] }, d, 0.15).unwrap())
+        })
+        .collect();
+    let linear = write_csv(dir.path(), "linear.csv", "d,F", &linear);
     let broken_card = dir.path().join("broken.toml");
     std::fs::write(&broken_card, std::fs::read_to_string(&card).unwrap().replace("g2 = 200.0", "g2 = -200.0")).unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
@@ -136,6 +144,10 @@ fn bad_input_exits_2_and_writes_nothing() {
         (vec!["bias-extension", "--data", s(&good), "--length", "0.1", "--width", "0.08"], "twice"),
         (vec!["knit", "--data", s(&bad), "--direction", "weft"], "line 3"),
         (vec!["knit", "--data", s(&good), "--direction", "bias"], "bias"),
+        (
+            vec!["picture-frame", "--data", s(&linear), "--side", "0.15", "--law", "two-slope"],
+            "do not show a locking angle",
+        ),
     ];
     for (args, needle) in cases {
         let assert = drape().arg("calibrate").args(&args).args(["--card", s(&card), "--out", s(&out)]).assert().code(2);

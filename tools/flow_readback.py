@@ -4,9 +4,14 @@
 Usage: python3 tools/flow_readback.py FORMAT FILE [FILE...]
 
   vtu FILE            meshio: points, cells in file order, cell data by name
-  nastran FILE...     pyNastran (BDF, xref off) per deck: grids, elements with PID and THETA;
+  vtu-vtk FILE        VTK's vtkXMLUnstructuredGridReader: counts and cell data by name
+  nastran FILE...     pyNastran (BDF, xref off; bulk data only, as drape writes it) per deck:
+                      grids, elements with PID and THETA;
                       meshio on the same deck: its GRID points (meshio skips elements that carry
                       a THETA field, so only the points are compared)
+  nastran-xref FILE   pyNastran read_bdf(FILE, xref=True), as a solver reads a whole deck (the
+                      user's, which INCLUDEs drape's bulk data): elements with PID, the type of
+                      the property and material they cross-reference, THETA
   abaqus FILE         meshio for nodes and elements; our parser of *ELSET, *DISTRIBUTION TABLE,
                       *DISTRIBUTION and *ORIENTATION as the Abaqus Keywords Reference lays them out
   optistruct FILE     our parser of large-field fixed format (GRID*, CTRIA3*, CQUAD4*, SET*,
@@ -20,7 +25,9 @@ Prints one JSON object to stdout. Exit status 2 on bad arguments.
 import csv
 import json
 import math
+import os
 import sys
+import tempfile
 
 # ---------------------------------------------------------------- helpers
 
@@ -41,34 +48,54 @@ def nastran_real(text):
 def large_entries(path):
     """Large-field fixed-format entries of a bulk section: [(name, [fields 2..])]."""
     entries = []
-    in_bulk = False
     with open(path) as f:
-        for raw in f:
-            line = raw.rstrip("\n")
-            if line.startswith("$") or not line.strip():
-                continue
-            if line.strip().upper() == "BEGIN BULK":
-                in_bulk = True
-                continue
-            if not in_bulk:
-                continue
-            if line.strip().upper() == "ENDDATA":
-                break
-            head = line[:8]
-            fields = [line[8 + 16 * i: 24 + 16 * i].strip() for i in range(4)]
-            if head.startswith("*"):
-                if not entries:
-                    raise SystemExit("%s: continuation before any entry" % path)
-                entries[-1][1].extend(fields)
-            else:
-                name = head.strip()
-                if not name.endswith("*"):
-                    raise SystemExit("%s: not a large-field entry: %r" % (path, line))
-                entries.append((name[:-1], fields))
+        text = f.read()
+    # Bulk data alone (a file to INCLUDE) is all bulk.
+    in_bulk = not any(l.strip().upper() == "BEGIN BULK" for l in text.splitlines())
+    for raw in text.splitlines(True):
+        line = raw.rstrip("\n")
+        if line.startswith("$") or not line.strip():
+            continue
+        if line.strip().upper() == "BEGIN BULK":
+            in_bulk = True
+            continue
+        if not in_bulk:
+            continue
+        if line.strip().upper() == "ENDDATA":
+            break
+        head = line[:8]
+        fields = [line[8 + 16 * i: 24 + 16 * i].strip() for i in range(4)]
+        if head.startswith("*"):
+            if not entries:
+                raise SystemExit("%s: continuation before any entry" % path)
+            entries[-1][1].extend(fields)
+        else:
+            name = head.strip()
+            if not name.endswith("*"):
+                raise SystemExit("%s: not a large-field entry: %r" % (path, line))
+            entries.append((name[:-1], fields))
     return entries
 
 
 # ---------------------------------------------------------------- formats
+
+
+def read_vtu_vtk(path):
+    """VTK's own XML reader (the one ParaView is built on): cell data by name, per cell."""
+    import vtk
+
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    if r.GetErrorCode() != 0:
+        raise SystemExit("vtk could not read %s (error code %d)" % (path, r.GetErrorCode()))
+    g = r.GetOutput()
+    cd = g.GetCellData()
+    data = {}
+    for k in range(cd.GetNumberOfArrays()):
+        a = cd.GetArray(k)
+        data[a.GetName()] = [list(a.GetTuple(i)) for i in range(a.GetNumberOfTuples())]
+    return {"points": g.GetNumberOfPoints(), "cells": g.GetNumberOfCells(), "cell_data": data}
 
 
 def read_vtu(path):
@@ -97,8 +124,14 @@ def read_nastran(paths):
     decks = []
     for path in paths:
         model = BDF(debug=None, log=None, mode="msc")
-        model.read_bdf(path, xref=False, punch=False)
+        model.read_bdf(path, xref=False, punch=True)
         grids = {int(nid): [float(x) for x in n.xyz] for nid, n in model.nodes.items()}
+        # pyNastran reads a blank THETA as 0.0: whether the field is blank, from the text.
+        blank = {}
+        for name, fields in large_entries(path):
+            if name in ("CTRIA3", "CQUAD4"):
+                k = 5 if name == "CTRIA3" else 6
+                blank[int(fields[0])] = len(fields) <= k or fields[k] == ""
         elements = {}
         for eid, e in model.elements.items():
             theta = e.theta_mcid
@@ -108,8 +141,17 @@ def read_nastran(paths):
                 "nodes": [int(n) for n in e.node_ids],
                 "theta": float(theta) if isinstance(theta, float) else None,
                 "mcid": int(theta) if isinstance(theta, int) else None,
+                "theta_blank": blank[int(eid)],
             }
-        m = meshio.read(path, file_format="nastran")
+        # meshio reads whole decks: the bulk data as a user's deck INCLUDEs it.
+        with open(path) as f:
+            bulk = f.read()
+        with tempfile.NamedTemporaryFile("w", suffix=".bdf", delete=False) as whole:
+            whole.write("CEND\nBEGIN BULK\n" + bulk + "ENDDATA\n")
+        try:
+            m = meshio.read(whole.name, file_format="nastran")
+        finally:
+            os.unlink(whole.name)
         decks.append(
             {
                 "path": path,
@@ -119,6 +161,25 @@ def read_nastran(paths):
             }
         )
     return {"decks": decks}
+
+
+def read_nastran_xref(path):
+    from pyNastran.bdf.bdf import BDF
+
+    model = BDF(debug=None, log=None, mode="msc")
+    model.read_bdf(path, xref=True)
+    elements = {}
+    for eid, e in model.elements.items():
+        theta = e.theta_mcid
+        prop = e.pid_ref
+        mats = prop.mid_ref if hasattr(prop, "mid_ref") else prop.mids_ref[0]
+        elements[int(eid)] = {
+            "pid": int(e.pid),
+            "property": prop.type,
+            "material": mats.type,
+            "theta": float(theta) if isinstance(theta, float) else None,
+        }
+    return {"elements": elements, "rejected": len(model.reject_cards)}
 
 
 def read_abaqus(path):
@@ -323,8 +384,12 @@ def main(argv):
     fmt, files = argv[0], argv[1:]
     if fmt == "vtu" and len(files) == 1:
         out = read_vtu(files[0])
+    elif fmt == "vtu-vtk" and len(files) == 1:
+        out = read_vtu_vtk(files[0])
     elif fmt == "nastran":
         out = read_nastran(files)
+    elif fmt == "nastran-xref" and len(files) == 1:
+        out = read_nastran_xref(files[0])
     elif fmt == "abaqus" and len(files) == 1:
         out = read_abaqus(files[0])
     elif fmt == "optistruct" and len(files) == 1:

@@ -70,20 +70,19 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         total += s;
         placed_cells = net.shear_stats(1.0).cells;
     }
-    let cells = (a.nodes - 1) * (a.nodes - 1);
+    let grid_cells = (a.nodes - 1) * (a.nodes - 1);
     println!(
-        "net {n} x {n} nodes, spacing {spacing:.6} m, {threads} thread(s): {placed_cells} of {cells} cells on the tool",
+        "net {n} x {n} nodes, spacing {spacing:.6} m, {threads} thread(s): {placed_cells} of the grid's {grid_cells} cells placed on the tool",
         n = a.nodes,
         threads = pool.current_num_threads()
     );
     println!(
-        "time per drape: best {:.1} ms, mean {:.1} ms; throughput {:.2} M cells/s (best), {:.2} M cells/s (mean)",
+        "throughput: {:.2} M placed cells/s (best), {:.2} M placed cells/s (mean); time per drape: best {:.1} ms, mean {:.1} ms",
+        placed_cells as f64 / best / 1e6,
+        placed_cells as f64 * a.repeat as f64 / total / 1e6,
         best * 1e3,
         total / a.repeat as f64 * 1e3,
-        cells as f64 / best / 1e6,
-        cells as f64 * a.repeat as f64 / total / 1e6
     );
-    println!("placed cells per second (best): {:.2} M", placed_cells as f64 / best / 1e6);
     if let Some(card) = &a.refine {
         let material = MaterialCard::load(card).map_err(input)?;
         let net = pool.install(|| drape(&tool, &settings)).map_err(input)?;

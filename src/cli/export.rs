@@ -1,14 +1,14 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
-use super::{compute, input, Failure};
-use crate::io::flow::{write_flow, FlowFormat};
+use super::{input, Failure};
+use crate::io::flow::{write_flow_with, FlowFormat, FlowOptions};
 use crate::io::{read_flow_mesh, read_net};
 use crate::mapping::{map_plies, PlyMap, PlyToMap};
 use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP};
 use crate::material::MaterialCard;
 use crate::pipeline::unit_scale;
 use clap::{Args, ValueEnum};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Cavity on the command line.
@@ -29,7 +29,7 @@ pub struct ExportArgs {
     /// Resin-flow shell mesh: Nastran (.bdf .nas .dat .fem), Abaqus (.inp), OBJ or Gmsh 4 (.msh).
     #[arg(long)]
     pub mesh: PathBuf,
-    /// Output format: vtu, nastran, abaqus, optistruct, rtmsim or csv.
+    /// Output format: vtu, nastran, abaqus, calculix, optistruct, rtmsim or csv.
     #[arg(long)]
     pub format: String,
     /// Output file (formats that need two files put the second beside it).
@@ -55,6 +55,9 @@ pub struct ExportArgs {
     /// Fibre radius, m, for --permeability.
     #[arg(long)]
     pub fibre_radius: Option<f64>,
+    /// The material the CalculiX deck's shell sections refer to (you define it).
+    #[arg(long, default_value = crate::io::calculix::DEFAULT_MATERIAL)]
+    pub material_name: String,
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Failure> {
@@ -65,6 +68,9 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
             return Err(input(anyhow::anyhow!("--thickness must be a positive length in metres, got {t}")));
         }
     }
+    crate::io::calculix::check_material_name(&a.material_name)
+        .map_err(|m| input(anyhow::anyhow!("--material-name: {m}")))?;
+    check_out_file(&a.out)?;
     let net = read_net(&a.net).map_err(input)?;
     let card_path = a.material.clone().or_else(|| net.meta.material.as_ref().map(PathBuf::from));
     let card = match &card_path {
@@ -108,20 +114,48 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     );
     println!("{}", coverage_line(&map.plies[0]));
     println!("  mapped in {map_ms:.1} ms");
-    let written = write_flow(&mesh, &map, format, &a.out).map_err(compute)?;
+    let written = write_flow_with(&mesh, &map, format, &a.out, &FlowOptions { material_name: a.material_name.clone() })
+        .map_err(super::write_failure)?;
     for p in written {
         println!("  wrote {}", p.display());
     }
     Ok(())
 }
 
+/// Check `--out` before anything is read: a file name (not a folder) whose folder is created
+/// like `drape run` creates its folder, and can be written.
+fn check_out_file(out: &Path) -> Result<(), Failure> {
+    let bad = |why: String| input(anyhow::anyhow!("--out {}: {why}", out.display()));
+    if out.is_dir() {
+        return Err(bad("is a folder: give a file name, like flow.vtu".into()));
+    }
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    std::fs::create_dir_all(parent).map_err(|e| {
+        bad(format!("cannot create its folder {} ({e}): give a path you can write to", parent.display()))
+    })?;
+    let probe = parent.join(format!(".drape-probe-{}", std::process::id()));
+    let probed = std::fs::write(&probe, b"");
+    let _ = std::fs::remove_file(&probe);
+    probed.map_err(|e| bad(format!("cannot write into {} ({e}): give a folder you can write to", parent.display())))
+}
+
 /// One line on a mapped ply: elements covered and their shear.
 pub(crate) fn coverage_line(ply: &PlyMap) -> String {
     let c = ply.coverage();
+    let share = 100.0 * c.covered as f64 / c.elements.max(1) as f64;
     let mut line = format!(
-        "  ply {}: covers {} of {} elements; |shear| max {:.2} deg, mean {:.2} deg",
+        "  ply {}: covers {} of {} elements ({share:.1}%); |shear| max {:.2} deg, mean {:.2} deg",
         ply.ply, c.covered, c.elements, c.max_abs_shear_deg, c.mean_abs_shear_deg
     );
+    if c.covered < c.elements {
+        line += &format!(
+            "; note: the ply covers only part of the flow mesh, {} element(s) lie outside it and carry no fibre data",
+            c.elements - c.covered
+        );
+    }
     if c.capped > 0 {
         line += &format!(
             "; Vf0 / cos(shear) passes the fibre packing limit in {} elements: Vf written as {VF_CAP:.4} there (the fabric locks before that)",

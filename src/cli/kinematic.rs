@@ -1,6 +1,6 @@
 //! `drape kinematic`: one ply from command-line arguments.
 use super::summary::summary;
-use super::{compute, input, parse_pair, parse_vec3, Failure};
+use super::{input, parse_pair, parse_vec3, Failure};
 use crate::geometry::{Point, ToolSurface, Vector};
 use crate::io::points::read_points;
 use crate::io::{write_net, Format};
@@ -102,7 +102,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     net.meta.tool = Some(a.tool.display().to_string());
     net.meta.tool_scale = Some(scale);
     let t_write = Instant::now();
-    let written = write_net(&net, &a.out, &formats).map_err(compute)?;
+    let written = write_net(&net, &a.out, &formats).map_err(super::write_failure)?;
     let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
     println!("{}", summary(&net, a.locking_angle.to_radians(), load_ms, write_ms));
     for p in written {

@@ -34,11 +34,20 @@ impl Failure {
             Failure::Compute(_) => EXIT_FAILED,
         }
     }
-    /// The message shown to the user.
+    /// The message shown to the user: each cause once (a message that already quotes its
+    /// cause, as `cannot write X: <os error>. Check...` does, does not repeat it).
     pub fn message(&self) -> String {
-        match self {
-            Failure::Input(e) | Failure::Compute(e) => format!("{e:#}"),
+        let (Failure::Input(e) | Failure::Compute(e)) = self;
+        let mut text = String::new();
+        for cause in e.chain() {
+            let part = cause.to_string();
+            if text.is_empty() {
+                text = part;
+            } else if !text.contains(&part) {
+                text = format!("{text}: {part}");
+            }
         }
+        text
     }
 }
 
@@ -46,6 +55,15 @@ impl Failure {
 pub(crate) fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
     Failure::Input(e.into())
 }
+/// A file that could not be written: bad input when the user's output path is at fault.
+pub(crate) fn write_failure(e: crate::io::ExportError) -> Failure {
+    if e.is_bad_input() {
+        input(e)
+    } else {
+        compute(e)
+    }
+}
+
 /// Tag an error as a failed computation.
 pub(crate) fn compute<E: Into<anyhow::Error>>(e: E) -> Failure {
     Failure::Compute(e.into())
@@ -74,7 +92,7 @@ pub enum Command {
     Calibrate(calibrate::CalibrateArgs),
     /// Virtual material tests on the mechanical model.
     Test(virtual_test::TestArgs),
-    /// Measure the kinematic engine's throughput (cells per second) on a generated hemisphere.
+    /// Measure the kinematic engine's throughput (placed cells per second) on a generated hemisphere.
     Bench(bench::BenchArgs),
     /// Draw every ply of a run folder (shear maps, histograms, changes) and write an HTML page.
     Report(report::ReportArgs),

@@ -95,7 +95,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     out.timing.total_ms = load_ms + solve_ms;
     // The last consistent state is written even when the solver did not converge.
     let t_write = Instant::now();
-    let written = write_net(&out, &a.out, &formats).map_err(compute)?;
+    let written = write_net(&out, &a.out, &formats).map_err(super::write_failure)?;
     println!(
         "{}",
         summary(&out, DEFAULT_LOCKING_ANGLE_DEG.to_radians(), load_ms, t_write.elapsed().as_secs_f64() * 1e3)

@@ -8,6 +8,8 @@ use super::summary::summary;
 use super::{compute, input, Failure};
 use crate::io::Format;
 use crate::layup::stack::PlyResult;
+use crate::layup::table::CoverageOf;
+use crate::layup::{LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
 use crate::pipeline::run::{run as run_scene, Event, RunError};
 use crate::pipeline::Scene;
 use clap::Args;
@@ -25,6 +27,10 @@ pub struct RunArgs {
     /// Output formats: comma-separated json,vtu,csv, or none.
     #[arg(long, default_value = "json,vtu,csv")]
     pub format: String,
+    /// Remove nets (and their .vtu, .cells.csv, .svg) in the output folder that no earlier
+    /// `drape run` into it wrote; without it the run refuses such a folder.
+    #[arg(long)]
+    pub replace: bool,
 }
 
 /// Run `drape run`.
@@ -32,7 +38,7 @@ pub fn run(a: RunArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
     let scene = Scene::load(&a.scene).map_err(input)?;
     let mut bar: Option<ProgressBar> = None;
-    run_scene(&scene, &a.out, &formats, &mut |event| print(event, &mut bar)).map_err(|e: RunError| {
+    run_scene(&scene, &a.out, &formats, a.replace, &mut |event| print(event, &mut bar)).map_err(|e: RunError| {
         if e.is_bad_input() {
             input(e)
         } else {
@@ -116,19 +122,25 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
                 println!("  wrote {}", p.display());
             }
         }
+        Event::Removed { files } => {
+            for p in files {
+                println!("removed {} (an earlier run's, not written by this one)", p.display());
+            }
+        }
     }
 }
 
 /// The layup table: one row per ply in stacking order.
 fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     let mut out = format!(
-        "layup: {} plies on {}\n{:<12} {:>7} {:<10} {:<20} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
+        "layup: {} plies on {}\n{:<12} {:>7} {:<10} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
         scene.layup.plies.len(),
         scene.tool.display(),
         "ply",
         "angle",
         "method",
         "material",
+        "locking",
         "max|g|",
         "mean|g|",
         "over lock",
@@ -138,13 +150,13 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         "offset"
     );
     out += &format!(
-        "{:<12} {:>7} {:<10} {:<20} {:>9} {:>9} {:>12} {:>8} {:>11} {:>9} {:>10}\n",
-        "", "deg", "", "", "deg", "deg", "m^2", "%", "m^2", "kg", "mm"
+        "{:<12} {:>7} {:<10} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm"
     );
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         let s = &r.stats;
         out += &format!(
-            "{:<12} {:>7} {:<10} {:<20} {:>9.2} {:>9.2} {:>12.3e} {:>8.1} {:>11.4} {:>9} {:>10.3}\n",
+            "{:<12} {:>7} {:<10} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
             match &r.refined {
@@ -153,10 +165,15 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 None => "kinematic",
             },
             ply.material.as_ref().map_or("-", |m| m.name.as_str()),
+            format!(
+                "{:.1}{}",
+                ply.locking_angle.to_degrees(),
+                if ply.locking_source == LockingSource::Default { "*" } else { "" }
+            ),
             s.max_abs_shear.to_degrees(),
             s.mean_abs_shear.to_degrees(),
             s.area_over_locking,
-            100.0 * s.coverage,
+            format!("{:.1} {}", 100.0 * s.coverage.share(), CoverageOf::of(&s.coverage).name()),
             s.fabric_area,
             s.fabric_mass.map_or("-".to_string(), |m| format!("{m:.4}")),
             r.offset.max_distance * 1e3,
@@ -170,6 +187,19 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 refined.describe_failure()
             );
         }
+    }
+    let defaults: Vec<&str> = scene
+        .layup
+        .plies
+        .iter()
+        .filter(|p| p.locking_source == LockingSource::Default)
+        .map(|p| p.settings.name.as_str())
+        .collect();
+    if !defaults.is_empty() {
+        out += &format!(
+            "* locking angle: {} give(s) no locking_angle_deg and no material card with a two-slope shear law: the default {DEFAULT_LOCKING_ANGLE_DEG} deg is used; give locking_angle_deg in the scene\n",
+            defaults.join(", ")
+        );
     }
     out.trim_end().to_string()
 }

@@ -43,9 +43,13 @@
 //! <TAG>_DIR
 //! 3, 0.
 //! ```
+//! Numbers have 13 significant digits in at most 20 characters, so that readers with fixed
+//! fields (CalculiX) read them whole. CalculiX does not apply distributions to shell sections:
+//! for it, write [`super::calculix`] decks.
 //! Abaqus takes local 1 = a projected onto the shell and local 2 in the plane of a and b, so
 //! local 1 is the warp; b = weft keeps the sheared weft in the file (angle a-b = 90 - shear).
 //! Reference the orientation from your *SHELL SECTION / *SHELL SECTION, COMPOSITE on ELSET `<TAG>`.
+use super::calculix::short;
 use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
 use super::{write_atomic, ExportError};
 use crate::mapping::{ElementShape, FlowMesh, LayupMap};
@@ -475,7 +479,7 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
     }
     writeln!(w, "*NODE, NSET=DRAPE_NODES")?;
     for (p, id) in mesh.nodes.iter().zip(&mesh.node_ids) {
-        writeln!(w, "{id}, {:?}, {:?}, {:?}", p.x, p.y, p.z)?;
+        writeln!(w, "{id}, {}, {}, {}", short(p.x), short(p.y), short(p.z))?;
     }
     for (shape, ty) in [(ElementShape::Tria3, "S3"), (ElementShape::Quad4, "S4")] {
         let els: Vec<_> = mesh.elements.iter().filter(|e| e.shape == shape).collect();
@@ -511,7 +515,7 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
         for (el, f) in mesh.elements.iter().zip(&ply.elements) {
             if let Some(f) = f {
                 let (a, b) = (f.warp, f.weft);
-                writeln!(w, "{}, {:?}, {:?}, {:?}, {:?}, {:?}, {:?}", el.id, a.x, a.y, a.z, b.x, b.y, b.z)?;
+                writeln!(w, "{}, {}", el.id, [a.x, a.y, a.z, b.x, b.y, b.z].map(short).join(", "))?;
             }
         }
         writeln!(w, "*ORIENTATION, NAME={tag}_ORI, SYSTEM=RECTANGULAR, DEFINITION=COORDINATES")?;

@@ -2,6 +2,21 @@
 use std::io;
 use std::path::PathBuf;
 
+impl ExportError {
+    /// Whether the user's output path is at fault (a folder that cannot be created, a file
+    /// where a folder should be, no permission to write): bad input, exit code 2.
+    pub fn is_bad_input(&self) -> bool {
+        use io::ErrorKind::*;
+        match self {
+            ExportError::CreateDir { .. } | ExportError::BadName { .. } => true,
+            ExportError::Write { source, .. } => {
+                matches!(source.kind(), PermissionDenied | NotADirectory | IsADirectory | ReadOnlyFilesystem | NotFound)
+            }
+            _ => false,
+        }
+    }
+}
+
 /// Why a file could not be written (or a written net read back). Every message names the file,
 /// node or cell at fault and what to do about it.
 #[derive(Debug, thiserror::Error)]

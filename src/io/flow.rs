@@ -5,6 +5,7 @@
 //! | [`FlowFormat::Vtu`] | `out` (VTK XML unstructured grid, cell data per ply) |
 //! | [`FlowFormat::Nastran`] | `out` for one net; for a layup one deck per ply, `STEM_<ply>.<ext>` |
 //! | [`FlowFormat::Abaqus`] | `out` (`*NODE`, `*ELEMENT`, one `*ORIENTATION` + `*DISTRIBUTION` per ply) |
+//! | [`FlowFormat::Calculix`] | `out` for one net, `STEM_<ply>.<ext>` a ply for a layup (orientation, set and shell section per orientation) |
 //! | [`FlowFormat::OptiStruct`] | `out` (GRID, elements, SET, PLY and DRAPE bulk entries) |
 //! | [`FlowFormat::Rtmsim`] | `STEM.bdf` (mesh + sets) and `STEM_input.txt` (parameter file) |
 //! | [`FlowFormat::Csv`] | `out` (one row per element and ply) |
@@ -12,7 +13,7 @@
 //! Everything is checked before the first file is opened (map sizes against the mesh, finite
 //! values), so a bad map writes nothing; each file is written with [`crate::io::write_atomic`].
 use super::rtmsim::RtmsimRegion;
-use super::{abaqus, csv, nastran, optistruct, rtmsim, vtk, ExportError};
+use super::{abaqus, calculix, csv, nastran, optistruct, rtmsim, vtk, ExportError};
 use crate::mapping::{ElementFibres, FlowMesh, LayupMap};
 use std::path::{Path, PathBuf};
 
@@ -25,6 +26,8 @@ pub enum FlowFormat {
     Nastran,
     /// Abaqus orientations and distributions (`flow.inp`).
     Abaqus,
+    /// CalculiX shell sections with an orientation each (`flow-ccx.inp`, a deck a ply).
+    Calculix,
     /// OptiStruct PLY and DRAPE entries (`flow.fem`).
     OptiStruct,
     /// RTMsim mesh and parameter file (`flow-rtmsim.bdf`).
@@ -35,10 +38,11 @@ pub enum FlowFormat {
 
 impl FlowFormat {
     /// All formats.
-    pub const ALL: [FlowFormat; 6] = [
+    pub const ALL: [FlowFormat; 7] = [
         FlowFormat::Vtu,
         FlowFormat::Nastran,
         FlowFormat::Abaqus,
+        FlowFormat::Calculix,
         FlowFormat::OptiStruct,
         FlowFormat::Rtmsim,
         FlowFormat::Csv,
@@ -50,6 +54,7 @@ impl FlowFormat {
             FlowFormat::Vtu => "vtu",
             FlowFormat::Nastran => "nastran",
             FlowFormat::Abaqus => "abaqus",
+            FlowFormat::Calculix => "calculix",
             FlowFormat::OptiStruct => "optistruct",
             FlowFormat::Rtmsim => "rtmsim",
             FlowFormat::Csv => "csv",
@@ -64,6 +69,7 @@ impl FlowFormat {
             FlowFormat::Vtu => "flow.vtu",
             FlowFormat::Nastran => "flow.bdf",
             FlowFormat::Abaqus => "flow.inp",
+            FlowFormat::Calculix => "flow-ccx.inp",
             FlowFormat::OptiStruct => "flow.fem",
             FlowFormat::Rtmsim => "flow-rtmsim.bdf",
             FlowFormat::Csv => "flow.csv",
@@ -80,6 +86,19 @@ impl std::str::FromStr for FlowFormat {
     }
 }
 
+/// Choices of the flow writers beyond the format.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FlowOptions {
+    /// The material name CalculiX sections refer to (the user defines the material).
+    pub material_name: String,
+}
+
+impl Default for FlowOptions {
+    fn default() -> Self {
+        FlowOptions { material_name: calculix::DEFAULT_MATERIAL.to_string() }
+    }
+}
+
 /// Write `map` on `mesh` in `format` to `out` (and, for formats that need more than one file,
 /// beside it, see the module table). Returns the files written, in a fixed order.
 pub fn write_flow(
@@ -88,11 +107,23 @@ pub fn write_flow(
     format: FlowFormat,
     out: &Path,
 ) -> Result<Vec<PathBuf>, ExportError> {
+    write_flow_with(mesh, map, format, out, &FlowOptions::default())
+}
+
+/// [`write_flow`] with `options`.
+pub fn write_flow_with(
+    mesh: &FlowMesh,
+    map: &LayupMap,
+    format: FlowFormat,
+    out: &Path,
+    options: &FlowOptions,
+) -> Result<Vec<PathBuf>, ExportError> {
     check(mesh, map, format.name())?;
     match format {
         FlowFormat::Vtu => vtk::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Nastran => nastran::write_flow(mesh, map, out),
         FlowFormat::Abaqus => abaqus::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::Calculix => calculix::write_flow(mesh, map, out, &options.material_name),
         FlowFormat::OptiStruct => optistruct::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Rtmsim => rtmsim::write_flow(mesh, map, out).map(|r| r.files),
         FlowFormat::Csv => csv::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),

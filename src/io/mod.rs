@@ -10,6 +10,7 @@
 //! | [`nastran`] | flow meshes and tools (bulk data) | THETA decks |
 //! | [`optistruct`], [`rtmsim`] | | ply-based decks, RTMsim mesh and parameters |
 //! | [`abaqus`] | flow meshes and tools (input decks) | orientation decks |
+//! | [`calculix`] | (as [`abaqus`]) | a shell section per orientation, for `ccx` |
 //! | [`gmsh`] | flow meshes and tools (`.msh` 4.1) | |
 //! | [`dxf`], [`svg`] | | cutting plans ([`drawing`] lays them out) |
 //!
@@ -17,6 +18,7 @@
 //! file is refused and nothing partial is left behind. A new shell-mesh format is a new module
 //! with a `FORMAT` and its name in the `mesh_formats!` list below.
 mod atomic;
+pub mod calculix;
 mod check;
 pub mod csv;
 pub mod drawing;

@@ -5,7 +5,8 @@
 //! OptiStruct puts the fibre of ply k in element e at element x-axis (edge G1 -> G2 turned by
 //! the element's THETA) + PLY THETA_k + DRAPE THETA_k,e. drape writes
 //! * element THETA_e = nominal angle of the first ply covering e (its `theta - angle_change`)
-//!   less that ply's PLY THETA; elements no ply covers get PID 2 and no THETA;
+//!   less that ply's PLY THETA; elements no ply covers get no THETA; every element keeps the
+//!   PID it has in the flow mesh ([`DEFAULT_PID`] where it has none);
 //! * PLY THETA_k = circular mean over shared elements of the ply's nominal angle relative to
 //!   the first ply (0 for the first ply): the ply angle as the part sees it;
 //! * DRAPE per covered element: `ELEM, eid, T, THETA` with the thinning factor
@@ -14,9 +15,12 @@
 //!   map's `theta`;
 //! * PLY: ID k, MID 1, T = the ply's nominal thickness, DID k, ESID k (SET k, ELEM LIST).
 //!
-//! Not written (yours to add): MAT8 1, the PCOMPP 1 property and the STACK ordering the plies.
+//! The deck is laid out as OptiStruct reads one: a control section (empty but for comments: add
+//! your I/O options and subcases), `CEND`, `BEGIN BULK`, the bulk data, `ENDDATA`.
+//! Not written (yours to add): MAT8 1, the PCOMPP properties of the flow mesh's PIDs and the
+//! STACK ordering the plies.
 use super::flow::{deg, wrap};
-use super::nastran::write::{write_element, write_grids, PID_COVERED, PID_UNCOVERED};
+use super::nastran::write::{pid, write_element, write_grids, DEFAULT_PID};
 use super::nastran::{large, real};
 use super::{write_atomic, ExportError};
 use crate::mapping::{FlowMesh, LayupMap};
@@ -96,16 +100,15 @@ fn write_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, angles: &Angles, w: &mut 
     writeln!(w, "$ fibre angle = element THETA + PLY THETA + DRAPE THETA (deg, from edge G1->G2).")?;
     writeln!(
         w,
-        "$ Add MAT8 {MID}, PCOMPP {PID_COVERED} and a STACK of the plies; PID {PID_UNCOVERED}: elements no ply covers."
+        "$ Add MAT8 {MID}, a PCOMPP for each PID of the flow mesh ({DEFAULT_PID} where it had none) and a STACK of the plies."
     )?;
+    writeln!(w, "$ Control section: add your I/O options and SUBCASEs here.")?;
+    writeln!(w, "CEND")?;
     writeln!(w, "BEGIN BULK")?;
     write_grids(mesh, w)?;
     for (e, el) in mesh.elements.iter().enumerate() {
-        let (pid, theta) = match angles.element[e] {
-            Some(a) => (PID_COVERED, Some(real(deg(a)))),
-            None => (PID_UNCOVERED, None),
-        };
-        write_element(mesh, el, pid, theta, w)?;
+        let theta = angles.element[e].map(|a| real(deg(a)));
+        write_element(mesh, el, pid(el), theta, w)?;
     }
     for (k, ply) in map.plies.iter().enumerate() {
         let id = (k + 1) as u64;

@@ -17,8 +17,9 @@
 //! `shear_deg`, `thickness`, `vf` (Float64) and `permeability` (Float64 x 9, row-major, only if
 //! some element has one). For a layup the per-ply fields get the prefix `<ply>_` (`covered`
 //! too) and the laminate fields `laminate_thickness`, `mean_vf` and `laminate_permeability`
-//! (only if present) follow. Where a ply does not cover an element: covered = 0 and zeros in
-//! its other fields (never NaN); likewise zeros where a laminate value is missing.
+//! (only if present) follow. Where a ply does not cover an element: covered = 0 and NaN in its
+//! other fields (not zeros, which a flow solver would read as an impermeable, zero-thickness
+//! wall); likewise NaN where no ply covers an element in the laminate fields. VTK reads `NaN`.
 use super::check::{cells, check_net};
 use super::xml::xml_escape;
 use super::{write_atomic, ExportError};
@@ -143,12 +144,13 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
         let els = &ply.elements;
         tuple_array(w, "Int32", &format!("{p}covered"), 1, els.iter().map(|f| i32::from(f.is_some())))?;
         let vec3 = |pick: fn(&crate::mapping::ElementFibres) -> [f64; 3]| {
-            els.iter().flat_map(move |f| f.as_ref().map_or([0.0; 3], pick))
+            els.iter().flat_map(move |f| f.as_ref().map_or([f64::NAN; 3], pick))
         };
         tuple_array(w, "Float64", &format!("{p}warp"), 3, vec3(|f| [f.warp.x, f.warp.y, f.warp.z]))?;
         tuple_array(w, "Float64", &format!("{p}weft"), 3, vec3(|f| [f.weft.x, f.weft.y, f.weft.z]))?;
-        let scalar =
-            |pick: fn(&crate::mapping::ElementFibres) -> f64| els.iter().map(move |f| f.as_ref().map_or(0.0, pick));
+        let scalar = |pick: fn(&crate::mapping::ElementFibres) -> f64| {
+            els.iter().map(move |f| f.as_ref().map_or(f64::NAN, pick))
+        };
         tuple_array(w, "Float64", &format!("{p}shear_deg"), 1, scalar(|f| f.shear.to_degrees()))?;
         tuple_array(w, "Float64", &format!("{p}thickness"), 1, scalar(|f| f.thickness))?;
         tuple_array(w, "Float64", &format!("{p}vf"), 1, scalar(|f| f.vf))?;
@@ -158,8 +160,9 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
         }
     }
     if map.layup {
-        tuple_array(w, "Float64", "laminate_thickness", 1, map.thickness.iter().copied())?;
-        tuple_array(w, "Float64", "mean_vf", 1, map.mean_vf.iter().map(|v| v.unwrap_or(0.0)))?;
+        let laminate = map.thickness.iter().zip(&map.mean_vf).map(|(t, vf)| if vf.is_some() { *t } else { f64::NAN });
+        tuple_array(w, "Float64", "laminate_thickness", 1, laminate)?;
+        tuple_array(w, "Float64", "mean_vf", 1, map.mean_vf.iter().map(|v| v.unwrap_or(f64::NAN)))?;
         if map.permeability.iter().any(Option::is_some) {
             let k = map.permeability.iter().flat_map(|k| row_major(k.as_ref()));
             tuple_array(w, "Float64", "laminate_permeability", 9, k)?;
@@ -183,8 +186,9 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
 }
 
 /// The 9 entries of `k` row by row, zeros for `None`.
+/// A tensor's nine components row by row; NaN for none (an element no ply covers).
 fn row_major(k: Option<&nalgebra::Matrix3<f64>>) -> [f64; 9] {
-    let mut out = [0.0; 9];
+    let mut out = [f64::NAN; 9];
     if let Some(k) = k {
         for r in 0..3 {
             for c in 0..3 {

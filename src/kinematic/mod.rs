@@ -1,6 +1,7 @@
 //! The kinematic (pin-jointed net, "fishnet") drape: generators through a seed point, then every
 //! other node as the intersection of the tool with a circle of points at distance d from two
 //! placed neighbours.
+pub mod coverage;
 pub mod fishnet;
 pub mod generators;
 pub mod net;

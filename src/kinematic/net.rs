@@ -205,10 +205,6 @@ impl DrapeNet {
         let mut sum = 0.0;
         for i in 0..self.nu.saturating_sub(1) {
             for j in 0..self.nv.saturating_sub(1) {
-                let corners = [self.index(i, j), self.index(i + 1, j), self.index(i + 1, j + 1), self.index(i, j + 1)];
-                if corners.iter().all(|&k| self.status[k] != NodeStatus::OutsideOutline) {
-                    s.asked += 1;
-                }
                 let (Some(g), Some(area)) = (self.cell_shear(i, j), self.cell_area(i, j)) else { continue };
                 s.cells += 1;
                 s.area += area;
@@ -246,8 +242,6 @@ pub struct CellFrame {
 pub struct ShearStats {
     /// Complete cells (all four corners placed).
     pub cells: usize,
-    /// Cells the ply asked for: those with no corner outside its outline (all of a grid).
-    pub asked: usize,
     /// Largest |shear|.
     pub max_abs: f64,
     /// Mean |shear|.
@@ -258,17 +252,6 @@ pub struct ShearStats {
     pub area: f64,
     /// Draped area of the cells sheared past the locking angle.
     pub area_over_locking: f64,
-}
-
-impl ShearStats {
-    /// Complete cells over the cells the ply asked for (0 when it asked for none).
-    pub fn coverage(&self) -> f64 {
-        if self.asked > 0 {
-            self.cells as f64 / self.asked as f64
-        } else {
-            0.0
-        }
-    }
 }
 
 /// Shear of one corner: pi/2 minus the angle between the warp and weft edges, radians.
@@ -301,16 +284,7 @@ mod tests {
         let net = one_cell([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [3.0, 3.0, 0.0]]);
         assert!((net.cell_area(0, 0).unwrap() - 3.0).abs() < 1e-15);
         let s = net.shear_stats(0.0);
-        assert_eq!((s.cells, s.asked, s.over_locking), (1, 1, 1));
-        assert_eq!((s.area, s.area_over_locking, s.coverage()), (3.0, 3.0, 1.0));
-    }
-
-    #[test]
-    fn coverage_counts_the_cells_inside_the_outline() {
-        let mut net = one_cell([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]);
-        net.status[3] = NodeStatus::NoRoot;
-        assert_eq!((net.shear_stats(1.0).asked, net.shear_stats(1.0).coverage()), (1, 0.0));
-        net.status[3] = NodeStatus::OutsideOutline;
-        assert_eq!((net.shear_stats(1.0).asked, net.shear_stats(1.0).coverage()), (0, 0.0));
+        assert_eq!((s.cells, s.over_locking), (1, 1));
+        assert_eq!((s.area, s.area_over_locking), (3.0, 3.0));
     }
 }

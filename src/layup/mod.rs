@@ -7,6 +7,6 @@ pub mod stack;
 pub mod table;
 
 pub use ply::{
-    Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_LOCKING_ANGLE_DEG,
-    DEFAULT_SOLVER_ITERATIONS, MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
+    locking_angle_deg, Layup, LockingSource, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start,
+    DEFAULT_LOCKING_ANGLE_DEG, DEFAULT_SOLVER_ITERATIONS, MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
 };

@@ -8,9 +8,42 @@ use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::ContactMode;
 use std::path::PathBuf;
 
-/// Locking angle used for reporting when a ply gives none (degrees; woven glass and carbon
-/// lock between about 40 and 60 degrees).
+/// Locking angle used for reporting when neither the ply nor its material card gives one
+/// (degrees; woven glass and carbon lock between about 40 and 60 degrees).
 pub const DEFAULT_LOCKING_ANGLE_DEG: f64 = 45.0;
+
+/// Where a ply's locking angle comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LockingSource {
+    /// The ply's own `locking_angle_deg`.
+    Ply,
+    /// Its material card's shear law (a two-slope law's locking angle).
+    Card,
+    /// Neither gives one: [`DEFAULT_LOCKING_ANGLE_DEG`].
+    Default,
+}
+
+impl LockingSource {
+    /// One word for tables: `ply`, `card` or `default`.
+    pub fn tag(self) -> &'static str {
+        match self {
+            LockingSource::Ply => "ply",
+            LockingSource::Card => "card",
+            LockingSource::Default => "default",
+        }
+    }
+}
+
+/// A ply's locking angle (degrees) and where it comes from: the ply's own value, else its card's
+/// two-slope locking angle, else [`DEFAULT_LOCKING_ANGLE_DEG`].
+pub fn locking_angle_deg(own: Option<f64>, card: Option<&MaterialCard>) -> (f64, LockingSource) {
+    match (own, card.and_then(|c| c.shear.locking_angle_deg())) {
+        (Some(a), _) => (a, LockingSource::Ply),
+        (None, Some(a)) => (a, LockingSource::Card),
+        (None, None) => (DEFAULT_LOCKING_ANGLE_DEG, LockingSource::Default),
+    }
+}
 
 /// How a ply's warp direction is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +82,8 @@ pub struct Ply {
     pub refinement: Option<Refinement>,
     /// Locking angle for reporting, radians.
     pub locking_angle: f64,
+    /// Where the locking angle comes from.
+    pub locking_source: LockingSource,
     /// Line of the scene file where the ply starts.
     pub line: usize,
 }

@@ -4,7 +4,9 @@
 use super::{Layup, Orientation, Ply, StackSide, Start};
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
+use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
+use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings};
 use crate::material::flow::sheared_thickness;
@@ -78,7 +80,7 @@ pub struct PlyResult {
 }
 
 /// A ply's row of the layup table.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlyStats {
     /// Largest and mean |shear| over the complete cells, radians.
     pub max_abs_shear: f64,
@@ -86,8 +88,9 @@ pub struct PlyStats {
     pub mean_abs_shear: f64,
     /// Draped area (3D) of the cells sheared past the locking angle, m^2.
     pub area_over_locking: f64,
-    /// Complete cells over the cells the ply asked for (its grid, or its outline).
-    pub coverage: f64,
+    /// What the ply covers of the surface it lies on (the tool offset by the plies below), or of
+    /// the part of that surface inside its outline.
+    pub coverage: SurfaceCoverage,
     /// Draped area (3D) of the complete cells, m^2.
     pub draped_area: f64,
     /// Fabric used: the complete cells unsheared (cells x d^2), m^2; the flat pattern's area.
@@ -98,15 +101,25 @@ pub struct PlyStats {
     pub cells: usize,
 }
 
-/// The layup-table numbers of a draped net ([`DrapeNet::shear_stats`]); `areal_mass` in kg/m^2.
-pub fn ply_stats(net: &DrapeNet, locking_angle: f64, areal_mass: Option<f64>) -> PlyStats {
+/// The layup-table numbers of a draped net ([`DrapeNet::shear_stats`], and
+/// [`surface_coverage`] of `surface`, the surface it was draped on, inside `outline` when it has
+/// one); `areal_mass` in kg/m^2.
+pub fn ply_stats(
+    net: &DrapeNet,
+    surface: &ToolSurface,
+    outline: Option<&Outline>,
+    locking_angle: f64,
+    areal_mass: Option<f64>,
+) -> PlyStats {
     let s = net.shear_stats(locking_angle);
+    let triangles: Vec<[Point; 3]> =
+        surface.triangles().iter().map(|t| t.map(|v| surface.vertices()[v as usize])).collect();
     let fabric_area = s.cells as f64 * net.spacing * net.spacing;
     PlyStats {
         max_abs_shear: s.max_abs,
         mean_abs_shear: s.mean_abs,
         area_over_locking: s.area_over_locking,
-        coverage: s.coverage(),
+        coverage: surface_coverage(net, &triangles, outline),
         draped_area: s.area,
         fabric_area,
         fabric_mass: areal_mass.map(|m| m * fabric_area),
@@ -298,7 +311,12 @@ pub fn drape_layup(
             }
         }
         let areal_mass = ply.material.as_ref().map(|m| m.card.areal_mass);
-        let stats = ply_stats(&net, ply.locking_angle, areal_mass);
+        // The outline as the drape checked it (it cannot fail here: the drape used it).
+        let outline = match &settings.extent {
+            Extent::Outline(points) => Outline::new(surface, points, settings.spacing).ok(),
+            Extent::Grid { .. } => None,
+        };
+        let stats = ply_stats(&net, surface, outline.as_ref(), ply.locking_angle, areal_mass);
         results.push(PlyResult { net, refined, warp, offset, stats });
     }
     Ok(results)

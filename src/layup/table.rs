@@ -3,7 +3,8 @@
 //! ([`crate::io::layup_json`]); `drape report` reads that file into the same type.
 use super::nest::Nesting;
 use super::stack::PlyResult;
-use super::Ply;
+use super::{LockingSource, Ply};
+use crate::kinematic::coverage::SurfaceCoverage;
 use serde::{Deserialize, Serialize};
 
 /// `layup.json`: the layup table of a run. Every field but a row's name may be missing in a file
@@ -22,6 +23,10 @@ pub struct LayupTable {
     /// Where the flat patterns lie on the roll, when there is a pattern.
     #[serde(default)]
     pub nesting: Option<NestingRow>,
+    /// Every file the run wrote into its folder (names in the folder, sorted, `layup.json`
+    /// included): the next run into the folder removes those it does not write again.
+    #[serde(default)]
+    pub files: Vec<String>,
 }
 
 /// One ply of the layup table.
@@ -59,6 +64,9 @@ pub struct LayupRow {
     /// Locking angle, degrees.
     #[serde(default)]
     pub locking_angle_deg: Option<f64>,
+    /// Where the locking angle comes from: `ply`, `card` or `default`.
+    #[serde(default)]
+    pub locking_angle_source: Option<LockingSource>,
     /// Largest |shear| over the complete cells, degrees.
     #[serde(default)]
     pub max_abs_shear_deg: Option<f64>,
@@ -68,9 +76,16 @@ pub struct LayupRow {
     /// Draped area of the cells sheared past the locking angle, m^2.
     #[serde(default)]
     pub area_over_locking_m2: Option<f64>,
-    /// Complete cells over the cells the ply asked for.
+    /// Share of the surface the ply covers: of the tool it lies on (offset by the plies below),
+    /// or of the part of it inside the ply's outline (see `coverage_of`).
     #[serde(default)]
     pub coverage: Option<f64>,
+    /// What `coverage` is a share of: `tool` or `outline`.
+    #[serde(default)]
+    pub coverage_of: Option<CoverageOf>,
+    /// Area of the tool (or the outline) the ply covers, m^2.
+    #[serde(default)]
+    pub covered_area_m2: Option<f64>,
     /// Complete cells.
     #[serde(default)]
     pub cells: Option<usize>,
@@ -92,6 +107,35 @@ pub struct LayupRow {
     /// Offset vertices moved off their normals to bridge tight concave corners.
     #[serde(default)]
     pub offset_bridged_vertices: Option<usize>,
+}
+
+/// What a ply's coverage is a share of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CoverageOf {
+    /// The surface the ply lies on (the tool offset by the plies below).
+    Tool,
+    /// The part of that surface inside the ply's outline.
+    Outline,
+}
+
+impl CoverageOf {
+    /// What `coverage` measures.
+    pub fn of(c: &SurfaceCoverage) -> CoverageOf {
+        if c.of_outline {
+            CoverageOf::Outline
+        } else {
+            CoverageOf::Tool
+        }
+    }
+
+    /// The word in tables: `tool` or `outline`.
+    pub fn name(self) -> &'static str {
+        match self {
+            CoverageOf::Tool => "tool",
+            CoverageOf::Outline => "outline",
+        }
+    }
 }
 
 /// The nesting of the flat patterns in the layup table.
@@ -135,10 +179,13 @@ impl LayupRow {
             solver_failure: result.refined.as_ref().filter(|r| !r.ok()).map(|r| r.describe_failure()),
             thickness_m: ply.thickness,
             locking_angle_deg: Some(ply.locking_angle.to_degrees()),
+            locking_angle_source: Some(ply.locking_source),
             max_abs_shear_deg: Some(s.max_abs_shear.to_degrees()),
             mean_abs_shear_deg: Some(s.mean_abs_shear.to_degrees()),
             area_over_locking_m2: Some(s.area_over_locking),
-            coverage: Some(s.coverage),
+            coverage: Some(s.coverage.share()),
+            coverage_of: Some(CoverageOf::of(&s.coverage)),
+            covered_area_m2: Some(s.coverage.covered_area),
             cells: Some(s.cells),
             draped_area_m2: Some(s.draped_area),
             fabric_area_m2: Some(s.fabric_area),

@@ -3,7 +3,7 @@
 //! fraction change and, on request, a permeability tensor (REFERENCES.md §5).
 pub mod mesh;
 
-use crate::geometry::Vector;
+use crate::geometry::{Point, Vector};
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
 pub use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP, VF_MAX_HEX};
@@ -153,6 +153,18 @@ pub enum MapError {
         /// The element.
         id: u64,
     },
+    /// The ply covers no element of the flow mesh.
+    #[error("ply '{ply}' covers none of the {elements} elements of flow mesh {path}: {cause}")]
+    NotCovered {
+        /// The ply.
+        ply: String,
+        /// The flow mesh.
+        path: std::path::PathBuf,
+        /// Its elements.
+        elements: usize,
+        /// The likely cause and the fix.
+        cause: String,
+    },
     /// The ply's thickness or fibre volume fraction is unusable.
     #[error("ply '{ply}': {message}")]
     Settings {
@@ -258,9 +270,66 @@ pub fn map_plies(
     for p in plies {
         let (settings, notes) = PlyMapSettings::for_net(p.net, p.card, p.thickness, cavity, p.permeability);
         notes.iter().for_each(|n| note(n));
-        maps.push(map_net(p.net, mesh, &settings)?);
+        let map = map_net(p.net, mesh, &settings)?;
+        if !mesh.elements.is_empty() && map.elements.iter().all(Option::is_none) {
+            return Err(MapError::NotCovered {
+                ply: p.net.name.clone(),
+                path: mesh.path.clone(),
+                elements: mesh.elements.len(),
+                cause: why_not_covered(p.net, mesh),
+            });
+        }
+        maps.push(map);
     }
     Ok(LayupMap::new(maps, layup, mesh.elements.len()))
+}
+
+/// A mesh this many times larger or smaller than the net (in size) is taken to be in other units.
+const UNIT_MISMATCH_RATIO: f64 = 20.0;
+
+/// The likely reason a ply covers no element of `mesh`, and the fix: the sizes of the mesh and
+/// the net's boxes (another length unit when they differ by a factor of [`UNIT_MISMATCH_RATIO`]
+/// or more), else how far apart they lie (another part, or the mesh placed elsewhere).
+fn why_not_covered(net: &DrapeNet, mesh: &FlowMesh) -> String {
+    let bounds = |points: &mut dyn Iterator<Item = Point>| {
+        points.fold(None, |b: Option<(Point, Point)>, p| match b {
+            None => Some((p, p)),
+            Some((lo, hi)) => Some((lo.inf(&p), hi.sup(&p))),
+        })
+    };
+    let net_box = bounds(
+        &mut net
+            .positions
+            .iter()
+            .zip(&net.status)
+            .filter(|(_, s)| **s == crate::kinematic::NodeStatus::Placed)
+            .map(|(p, _)| *p),
+    );
+    let mesh_box = bounds(&mut mesh.nodes.iter().copied());
+    let (Some((nlo, nhi)), Some((mlo, mhi))) = (net_box, mesh_box) else {
+        return "the net has no placed node".into();
+    };
+    let (net_size, mesh_size) = ((nhi - nlo).norm(), (mhi - mlo).norm());
+    let ratio = mesh_size / net_size;
+    if ratio >= UNIT_MISMATCH_RATIO {
+        format!(
+            "the mesh is {ratio:.0} times the net's size ({mesh_size:.4} against {net_size:.4} m across): it is likely in millimetres read as metres; give --mesh-units mm (drape export) or units = \"mm\" in the scene"
+        )
+    } else if ratio <= 1.0 / UNIT_MISMATCH_RATIO {
+        format!(
+            "the mesh is 1/{:.0} of the net's size ({mesh_size:.4} against {net_size:.4} m across): it is likely in metres read as millimetres; give --mesh-units m (drape export) or units = \"m\" in the scene",
+            1.0 / ratio
+        )
+    } else {
+        let gap = (mlo.coords - nhi.coords).sup(&(nlo.coords - mhi.coords)).sup(&Vector::zeros()).norm();
+        format!(
+            "the mesh (box from {:.4?} to {:.4?} m) and the net (box from {:.4?} to {:.4?} m) are of comparable size but lie {gap:.4} m apart or on different surfaces: is it the mesh of another part, or placed elsewhere? Give the flow mesh of the draped part, in the tool's position",
+            mlo.coords.as_slice(),
+            mhi.coords.as_slice(),
+            nlo.coords.as_slice(),
+            nhi.coords.as_slice()
+        )
+    }
 }
 
 /// How much of a flow mesh one ply covers and how it shears there.

@@ -276,8 +276,9 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
             let gl = refine_min(&grid, sse).ok_or_else(|| {
                 FitError::Fit("no locking angle fits the data: the data must cover angles on both sides of it".into())
             })?;
-            let (p, _) =
+            let (p, sse_two) =
                 lstsq(&cols_at(gl), &targets).ok_or_else(|| FitError::Fit("the two-slope fit is singular".into()))?;
+            check_kink(obs, &targets, gl, sse_two, &cols_at(2.0 * a_max)[0])?;
             ShearLaw::TwoSlope { g1: p[0], g2: p[1], locking_angle_deg: gl.to_degrees() }
         }
     };
@@ -294,6 +295,42 @@ fn fit_shear(obs: &[Obs], kind: ShearLawKind) -> Result<(ShearLaw, FitReport), F
     })?;
     let report = FitReport::new(&targets, &predict(&law));
     Ok((law, report))
+}
+
+/// A two-slope fit names a locking angle only when the data have points on both sides of it...
+const MIN_POINTS_EACH_SIDE: usize = 2;
+/// ...and the kink explains at least this share of what a single straight slope leaves over...
+const MIN_KINK_GAIN: f64 = 0.5;
+/// ...and more than this share of the data's sum of squares (below it both fits are exact to
+/// rounding: the data lie on one line).
+const MIN_KINK_GAIN_OF_DATA: f64 = 1e-9;
+
+/// Refuse a two-slope fit whose locking angle the data do not determine: data that never reach
+/// locking (one straight slope fits them as well; any kink placed past or among them fits
+/// exactly, which gave locking angles of 0.2 deg with R^2 = 1), or too few points on a side.
+/// `line` is the column of a single slope.
+fn check_kink(obs: &[Obs], targets: &[f64], locking: f64, sse_two: f64, line: &[f64]) -> Result<(), FitError> {
+    let angle = |o: &Obs| o.terms.iter().map(|(g, _)| g.abs()).fold(0.0, f64::max);
+    let below = obs.iter().filter(|o| angle(o) < locking).count();
+    let above = obs.len() - below;
+    let sse_line = lstsq(&[line.to_vec()], targets).map_or(f64::INFINITY, |(_, s)| s);
+    let data: f64 = targets.iter().map(|t| t * t).sum();
+    let gain = sse_line - sse_two;
+    if below >= MIN_POINTS_EACH_SIDE
+        && above >= MIN_POINTS_EACH_SIDE
+        && gain >= MIN_KINK_GAIN * sse_line
+        && gain > MIN_KINK_GAIN_OF_DATA * data
+    {
+        return Ok(());
+    }
+    let max_deg = obs.iter().map(angle).fold(0.0, f64::max).to_degrees();
+    Err(FitError::Data(format!(
+        "the data do not show a locking angle, so a two-slope law cannot be fitted: the best kink at {:.2} deg has {below} point(s) below it and {above} above, and one straight slope leaves a residual of {:.3e} against {:.3e} with the kink. \
+         The data reach {max_deg:.1} deg of shear: give test data that go past the locking angle (at least {MIN_POINTS_EACH_SIDE} points on each side), or fit --law polynomial:N",
+        locking.to_degrees(),
+        sse_line,
+        sse_two
+    )))
 }
 
 /// Points of the grid searches (locking angle, knit alpha).
@@ -666,6 +703,27 @@ mod tests {
             }
             assert!(rep.r_squared > 0.999 && rep.rms > 0.0, "{rep:?}");
         }
+    }
+
+    #[test]
+    fn two_slope_fit_to_data_that_never_lock_is_refused() {
+        // A straight slope (no locking in the data): any kink fits it exactly, so the fit
+        // named a locking angle of 0.176 deg with R^2 = 1. Now it is refused, with the reach.
+        let law = ShearLaw::Polynomial { coefficients: vec![3.0] };
+        let e = fit_shear_picture_frame(&pf_data(&law, 0.0), SIDE, ShearLawKind::TwoSlope).unwrap_err();
+        assert!(matches!(e, FitError::Data(_)), "{e:?}");
+        let m = e.to_string();
+        assert!(m.contains("do not show a locking angle") && m.contains("polynomial"), "{m}");
+        // With noise too, and for bias extension.
+        assert!(fit_shear_picture_frame(&pf_data(&law, 0.01), SIDE, ShearLawKind::TwoSlope).is_err());
+        assert!(fit_shear_bias_extension(&be_data(&law, 0.01), LEN, WID, ShearLawKind::TwoSlope).is_err());
+        // Data stopping just past locking (one point beyond it) do not determine the second slope.
+        let two = ShearLaw::TwoSlope { g1: 3.0, g2: 150.0, locking_angle_deg: 37.3 };
+        let data = pf_data(&two, 0.0);
+        let g = |d: f64| PictureFrameKinematics { side: SIDE }.shear(d).unwrap().0.to_degrees();
+        let first_past = data.iter().position(|(d, _)| g(*d) > 37.3).unwrap();
+        assert!(fit_shear_picture_frame(&data[..first_past + 1], SIDE, ShearLawKind::TwoSlope).is_err());
+        assert!(fit_shear_picture_frame(&data[..first_past + 3], SIDE, ShearLawKind::TwoSlope).is_ok());
     }
 
     #[test]

@@ -190,6 +190,15 @@ impl ShearLaw {
         self.eval(g).1
     }
 
+    /// The locking angle the law names (degrees): the two-slope law's; `None` for a polynomial
+    /// or a table, which stiffen gradually.
+    pub fn locking_angle_deg(&self) -> Option<f64> {
+        match self {
+            ShearLaw::TwoSlope { locking_angle_deg, .. } => Some(*locking_angle_deg),
+            ShearLaw::Polynomial { .. } | ShearLaw::Table(_) => None,
+        }
+    }
+
     /// The law's name in the card (`law = ...`).
     pub fn law_name(&self) -> &'static str {
         match self {

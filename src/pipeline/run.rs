@@ -2,10 +2,14 @@
 //! the run produces into one folder, telling its caller what it did through [`Event`]s (the
 //! command line prints them).
 //!
-//! Order, so that bad input costs nothing computed: the plies' settings are checked, the tool is
-//! read, every ply is draped (a bad ply stops the run before any file is written), then each
-//! net is written, the flat patterns are nested and drawn, `layup.json` is written, and last the
-//! plies are mapped onto the scene's flow mesh (a bad flow mesh costs nothing already computed).
+//! Order, so that bad input costs nothing computed: the plies' settings are checked, the flow
+//! export's mesh is read and the plies' cards checked for what it asks, the tool is read, the
+//! output folder is checked ([`super::folder`]), every ply is draped (a bad ply stops
+//! the run before any file is written), then each net is written, the flat patterns are nested
+//! and drawn, the plies are mapped onto the scene's flow mesh, `layup.json` is written listing
+//! every file, and last the files of an earlier run into the folder that this one did not write
+//! are removed.
+use super::folder::{prepare, FolderError};
 use super::scene::{Scene, SceneExport};
 use crate::geometry::ToolSurface;
 use crate::io::drawing::{write_cutting_plan, PatternError};
@@ -105,6 +109,11 @@ pub enum Event<'a> {
         /// Its files.
         files: &'a [PathBuf],
     },
+    /// Files an earlier run into the folder wrote and this one did not were removed.
+    Removed {
+        /// Those files.
+        files: &'a [PathBuf],
+    },
 }
 
 /// Why a run stopped. [`RunError::is_bad_input`] tells bad input (exit code 2) from a failed
@@ -164,6 +173,9 @@ pub enum RunError {
     /// A drawing could not be written.
     #[error(transparent)]
     Pattern(PatternError),
+    /// The output folder cannot be used.
+    #[error(transparent)]
+    Folder(#[from] FolderError),
     /// Every file was written but a mechanical ply did not reach equilibrium.
     #[error("the mechanical solver stopped without equilibrium for {plies}; the last accepted states were written")]
     Unconverged {
@@ -184,7 +196,8 @@ impl RunError {
                 | RunError::FlowMesh { .. }
                 | RunError::NoFibreRadius { .. }
                 | RunError::Map(_)
-        )
+                | RunError::Folder(_)
+        ) || matches!(self, RunError::Write(e) if e.is_bad_input())
     }
 }
 
@@ -192,7 +205,17 @@ impl RunError {
 /// nested on the roll, `layup.json` and, with the scene's `[export]`, the plies on its flow mesh.
 /// `on` hears what happens (see [`Event`]). Nets of mechanical plies that did not reach
 /// equilibrium are written, and the run ends with [`RunError::Unconverged`].
-pub fn run(scene: &Scene, out: &Path, formats: &[Format], on: &mut dyn FnMut(Event)) -> Result<(), RunError> {
+///
+/// The run owns `out` ([`super::folder`]): files an earlier run into it wrote that this one does
+/// not are removed at the end, and nets of another run or command in it refuse the run unless
+/// `replace`.
+pub fn run(
+    scene: &Scene,
+    out: &Path,
+    formats: &[Format],
+    replace: bool,
+    on: &mut dyn FnMut(Event),
+) -> Result<(), RunError> {
     for ply in &scene.layup.plies {
         check_settings(&ply.settings).map_err(|error| RunError::Settings {
             scene: scene.path.clone(),
@@ -201,15 +224,21 @@ pub fn run(scene: &Scene, out: &Path, formats: &[Format], on: &mut dyn FnMut(Eve
             error,
         })?;
     }
+    // Everything that can be checked before computing: the flow export's cards and mesh, the
+    // tool, the output folder.
+    let flow = scene.export.as_ref().map(|e| flow_input(scene, e)).transpose()?;
     let t_load = Instant::now();
     let tool = read_tool(&scene.tool, scene.scale).map_err(RunError::Tool)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     on(Event::ToolRead { path: &scene.tool, tool: &tool });
+    let folder = prepare(out, replace)?;
+    let mut written: Vec<PathBuf> = Vec::new();
     // Drape every ply first, so a bad ply is reported before any file is written.
     let count = scene.layup.plies.len();
     let mut results = drape_layup(&scene.layup, &tool, |index, name| on(Event::Draping { index, count, name }))
         .map_err(|error| RunError::Layup { scene: scene.path.clone(), error })?;
     on(Event::Draped);
+    folder.create()?;
     let mut unconverged = Vec::new();
     for (ply, r) in scene.layup.plies.iter().zip(results.iter_mut()) {
         r.net.timing.load_ms = load_ms;
@@ -227,21 +256,29 @@ pub fn run(scene: &Scene, out: &Path, formats: &[Format], on: &mut dyn FnMut(Eve
         let files = write_net(&result.net, out, formats)?;
         let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
         on(Event::PlyWritten { ply, result, files: &files, load_ms, write_ms });
+        written.extend(files);
     }
     on(Event::Layup { scene, results: &results });
-    let nesting = cutting_plan(scene, &results, out, on)?;
+    let nesting = cutting_plan(scene, &results, out, &mut written, on)?;
+    // The flow export before the table, so that the table lists its files.
+    if let Some(export) = &scene.export {
+        let flow = flow.as_ref().expect("read with the export");
+        export_flow(scene, export, flow, &results, out, &mut written, on)?;
+    }
+    let files = folder.names(&written);
     let table = LayupTable {
         scene: Some(scene.path.display().to_string()),
         tool: Some(scene.tool.display().to_string()),
         plies: scene.layup.plies.iter().zip(&results).map(|(ply, r)| LayupRow::of(ply, r)).collect(),
         nesting: nesting.as_ref().map(NestingRow::from),
+        files: files.clone(),
     };
     let path = out.join(LAYUP_FILE);
     layup_json::write(&table, &path)?;
     on(Event::TableWritten { path: &path });
-    // Last, so that a bad flow mesh costs nothing already computed.
-    if let Some(export) = &scene.export {
-        export_flow(scene, export, &results, out, on)?;
+    let removed = folder.tidy(&files)?;
+    if !removed.is_empty() {
+        on(Event::Removed { files: &removed });
     }
     if !unconverged.is_empty() {
         return Err(RunError::Unconverged { plies: unconverged.join(", ") });
@@ -255,6 +292,7 @@ fn cutting_plan(
     scene: &Scene,
     results: &[PlyResult],
     out: &Path,
+    written: &mut Vec<PathBuf>,
     on: &mut dyn FnMut(Event),
 ) -> Result<Option<Nesting>, RunError> {
     let mut patterns = Vec::new();
@@ -281,6 +319,7 @@ fn cutting_plan(
     let nesting = nest(&patterns, roll_width, scene.nesting_gap, rotation).map_err(RunError::Flat)?;
     let files = write_cutting_plan(&patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
     on(Event::CuttingPlan { pieces: patterns.len(), nesting: &nesting, files: &files });
+    written.extend(files);
     Ok(Some(nesting))
 }
 
@@ -289,17 +328,55 @@ fn cutting_plan(
 fn export_flow(
     scene: &Scene,
     export: &SceneExport,
+    flow: &FlowInput,
     results: &[PlyResult],
     out: &Path,
+    written: &mut Vec<PathBuf>,
     on: &mut dyn FnMut(Event),
 ) -> Result<(), RunError> {
     let t = Instant::now();
-    let mesh = read_flow_mesh(&export.mesh, scene.scale)
-        .map_err(|error| RunError::FlowMesh { scene: scene.path.clone(), error })?;
-    let mut plies = Vec::with_capacity(results.len());
-    for (ply, r) in scene.layup.plies.iter().zip(results) {
-        let card = ply.material.as_ref().map(|m| &m.card);
-        let permeability = if export.permeability {
+    let mesh = &flow.mesh;
+    let plies: Vec<PlyToMap> = scene
+        .layup
+        .plies
+        .iter()
+        .zip(results)
+        .zip(&flow.permeability)
+        .map(|((ply, r), permeability)| PlyToMap {
+            net: &r.net,
+            card: ply.material.as_ref().map(|m| &m.card),
+            thickness: ply.thickness,
+            permeability: *permeability,
+        })
+        .collect();
+    let map = map_plies(mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
+    let ms = flow.read_ms + t.elapsed().as_secs_f64() * 1e3;
+    on(Event::FlowMapped { path: &export.mesh, mesh, map: &map, ms });
+    for &format in &export.formats {
+        let files = write_flow(mesh, &map, format, &out.join(format.scene_file()))?;
+        on(Event::FlowWritten { files: &files });
+        written.extend(files);
+    }
+    Ok(())
+}
+
+/// What the flow export needs that can be checked before anything is draped.
+struct FlowInput {
+    /// The flow mesh, read.
+    mesh: FlowMesh,
+    /// Time to read it, ms.
+    read_ms: f64,
+    /// Each ply's permeability model, when the export asks for permeability.
+    permeability: Vec<Option<PermeabilityModel>>,
+}
+
+/// Read the scene's flow mesh and check that every ply's card gives what the export asks for,
+/// before anything is computed.
+fn flow_input(scene: &Scene, export: &SceneExport) -> Result<FlowInput, RunError> {
+    let mut permeability = Vec::with_capacity(scene.layup.plies.len());
+    for ply in &scene.layup.plies {
+        permeability.push(if export.permeability {
+            let card = ply.material.as_ref().map(|m| &m.card);
             let radius = card.and_then(|c| c.flow).map(|f| f.fibre_radius).ok_or_else(|| RunError::NoFibreRadius {
                 scene: scene.path.clone(),
                 ply: ply.settings.name.clone(),
@@ -308,14 +385,10 @@ fn export_flow(
             Some(PermeabilityModel { fibre_radius: radius })
         } else {
             None
-        };
-        plies.push(PlyToMap { net: &r.net, card, thickness: ply.thickness, permeability });
+        });
     }
-    let map = map_plies(&mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
-    on(Event::FlowMapped { path: &export.mesh, mesh: &mesh, map: &map, ms: t.elapsed().as_secs_f64() * 1e3 });
-    for &format in &export.formats {
-        let files = write_flow(&mesh, &map, format, &out.join(format.scene_file()))?;
-        on(Event::FlowWritten { files: &files });
-    }
-    Ok(())
+    let t = Instant::now();
+    let mesh = read_flow_mesh(&export.mesh, scene.scale)
+        .map_err(|error| RunError::FlowMesh { scene: scene.path.clone(), error })?;
+    Ok(FlowInput { mesh, read_ms: t.elapsed().as_secs_f64() * 1e3, permeability })
 }

@@ -15,7 +15,7 @@
 //! glass = "../../materials/glass-plain-weave.toml"
 //! [export]                    # optional: map every ply onto a resin-flow mesh
 //! mesh = "part.bdf"           # Nastran, Abaqus .inp, OBJ or Gmsh 4 .msh, in the scene's units
-//! formats = ["vtu", "csv"]    # vtu, nastran, abaqus, optistruct, rtmsim, csv
+//! formats = ["vtu", "csv"]    # vtu, nastran, abaqus, calculix, optistruct, rtmsim, csv
 //! cavity = "fixed"            # "fixed" (Vf = Vf0 / cos g) or "free" (t = t0 / cos g)
 //! permeability = true         # permeability tensors (needs [flow] in the material cards)
 //! [[ply]]
@@ -31,7 +31,8 @@
 //! origin_node = [30, 30]      # optional (default: the centre)
 //! pre_shear_deg = 0.0         # optional
 //! generators = "geodesic"     # or "min-shear" or "steer:curve.csv"
-//! locking_angle_deg = 45.0    # optional, for reporting
+//! locking_angle_deg = 45.0    # optional, for reporting (default: the card's two-slope
+//!                             # locking angle, else 45)
 //! max_shear_deg = 75.0        # optional: nodes shearing past this are not placed
 //! method = "kinematic"       # or "mechanical": kinematic, then refinement with the
 //!                             # ply's material card
@@ -67,8 +68,8 @@ use crate::io::flow::FlowFormat;
 use crate::io::points::read_points;
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
 use crate::layup::{
-    Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_LOCKING_ANGLE_DEG,
-    DEFAULT_SOLVER_ITERATIONS, MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
+    locking_angle_deg, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_SOLVER_ITERATIONS,
+    MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
 };
 use crate::material::flow::Cavity;
 use crate::material::MaterialCard;
@@ -595,7 +596,7 @@ impl Scene {
                     format!("must lie strictly between -90 and 90, got {}", p.pre_shear_deg),
                 ));
             }
-            let locking = p.locking_angle_deg.unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
+            let (locking, locking_source) = locking_angle_deg(p.locking_angle_deg, material.as_ref().map(|m| &m.card));
             if !(locking > 0.0 && locking < 90.0) {
                 return Err(at("locking_angle_deg", format!("must lie strictly between 0 and 90, got {locking}")));
             }
@@ -619,6 +620,7 @@ impl Scene {
                 thickness,
                 refinement,
                 locking_angle: locking.to_radians(),
+                locking_source,
                 line,
             });
         }

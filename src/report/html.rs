@@ -138,7 +138,7 @@ pub(crate) fn page(p: &Page) -> String {
 fn layup_table(h: &mut String, rows: &[LayupRow]) {
     let _ = writeln!(
         h,
-        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
+        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage (share of the tool or outline covered)</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
     );
     for r in rows {
         let material = r
@@ -155,11 +155,18 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
                 Some(false) => format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or(""))),
                 _ => escape(r.method.as_deref().unwrap_or("—")),
             },
-            num(r.locking_angle_deg, 1),
+            match r.locking_angle_source {
+                Some(source) if source != crate::layup::LockingSource::Ply =>
+                    format!("{} <span class=\"small\">({})</span>", num(r.locking_angle_deg, 1), source.tag()),
+                _ => num(r.locking_angle_deg, 1),
+            },
             num(r.max_abs_shear_deg, 1),
             num(r.mean_abs_shear_deg, 1),
             num(r.area_over_locking_m2, 4),
-            r.coverage.filter(|c| c.is_finite()).map_or("—".into(), |c| format!("{:.1}%", 100.0 * c)),
+            match (r.coverage.filter(|c| c.is_finite()), r.coverage_of) {
+                (Some(c), Some(of)) => format!("{:.1}% of {}", 100.0 * c, of.name()),
+                _ => "—".into(),
+            },
             num(r.draped_area_m2, 4),
             num(r.offset_m.map(|o| o * 1e3), 2),
         );

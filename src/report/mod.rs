@@ -13,6 +13,7 @@
 //!
 //! Text is rendered with the DejaVu Sans font compiled into the program (crate `dejavu`,
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
+pub mod change;
 mod html;
 mod render;
 mod view;
@@ -24,9 +25,11 @@ use crate::geometry::Point;
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::read_tool_mesh;
 use crate::io::{read_net, write_atomic, ExportError};
+use crate::kinematic::coverage::surface_coverage;
 use crate::kinematic::{DrapeNet, Method};
-use crate::layup::table::{LayupRow, LayupTable};
-use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::layup::table::{CoverageOf, LayupRow, LayupTable};
+use crate::layup::{locking_angle_deg, LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
+use crate::material::MaterialCard;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use render::{Mark, ToolLayer};
@@ -112,6 +115,9 @@ pub struct PlyReport {
     pub colour_limit_deg: f64,
     /// Whether the tool was drawn underneath.
     pub tool_drawn: bool,
+    /// For a mechanical ply: the noise floor of its change from the kinematic net (no change
+    /// map is drawn when every change lies within it).
+    pub change_noise: Option<change::ChangeNoise>,
     /// Pictures written for this ply.
     pub files: Vec<PathBuf>,
     /// What could not be drawn for this ply.
@@ -149,9 +155,18 @@ struct RawTool {
     triangles: Vec<[u32; 3]>,
     lo: Point,
     hi: Point,
+    /// Its facets' sagitta (file units), computed when a change map first needs it.
+    sagitta: std::sync::OnceLock<Option<f64>>,
 }
 
-/// Where a net's tool OBJ is: as recorded (relative to the run's working folder), else
+impl RawTool {
+    /// The median sagitta of its curved facets, file units ([`change::facet_sagitta`]).
+    fn sagitta(&self) -> Option<f64> {
+        *self.sagitta.get_or_init(|| change::facet_sagitta(&self.vertices, &self.triangles))
+    }
+}
+
+/// Where a net's tool (or material card) file is: as recorded (relative to the run's working folder), else
 /// relative to the run folder, else its file name in the run folder.
 fn locate_tool(recorded: &str, dir: &Path) -> Option<PathBuf> {
     let p = PathBuf::from(recorded);
@@ -170,7 +185,7 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
         lo = lo.inf(v);
         hi = hi.sup(v);
     }
-    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi })
+    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi, sagitta: Default::default() })
 }
 
 /// The scale (metres per file unit) the run read the tool with, for a net that does not record
@@ -207,7 +222,8 @@ struct PlyInput {
     stem: String,
     net: DrapeNet,
     locking_deg: f64,
-    row: LayupRow,
+    locking_source: LockingSource,
+    given: Option<LayupRow>,
     tool: Option<PathBuf>,
     tool_note: Option<String>,
 }
@@ -246,9 +262,19 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     let layup = read_layup(dir)?;
     let mut notes = Vec::new();
 
-    // Order: the layup's ply order, then nets it does not list, by name.
+    // With a layup.json, its plies in its order (nets it does not list belong to another run or
+    // command and are left out, with a note); without one, every net by name.
+    let listed = |stem: &str| layup.as_ref().is_none_or(|l| l.plies.iter().any(|r| r.name == stem));
+    let unlisted: Vec<&str> = net_files.iter().map(|(s, _)| s.as_str()).filter(|s| !listed(s)).collect();
+    if !unlisted.is_empty() {
+        notes.push(format!(
+            "{} also holds {} that {LAYUP_FILE} does not list (another run's or command's): not drawn.",
+            dir.display(),
+            unlisted.iter().map(|s| format!("{s}{NET_SUFFIX}")).collect::<Vec<_>>().join(", ")
+        ));
+    }
     let mut nets: BTreeMap<String, DrapeNet> = BTreeMap::new();
-    for (stem, path) in &net_files {
+    for (stem, path) in net_files.iter().filter(|(s, _)| listed(s)) {
         nets.insert(stem.clone(), read_net(path)?);
     }
     let mut order: Vec<String> = Vec::new();
@@ -278,28 +304,25 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for stem in order {
         let net = nets.remove(&stem).expect("ordered from the map's keys");
         let given = layup.as_ref().and_then(|l| l.plies.iter().find(|r| r.name == stem)).cloned();
-        let locking_deg = given
-            .as_ref()
-            .and_then(|r| r.locking_angle_deg)
-            .filter(|a| a.is_finite() && *a > 0.0)
-            .unwrap_or(DEFAULT_LOCKING_ANGLE_DEG);
-        let st = net.shear_stats(locking_deg.to_radians());
-        let row = given.unwrap_or_else(|| LayupRow {
-            name: stem.clone(),
-            material: net.meta.material.clone(),
-            angle_deg: net.meta.angle_deg,
-            method: Some(method_name(net.method).into()),
-            locking_angle_deg: Some(locking_deg),
-            max_abs_shear_deg: Some(st.max_abs.to_degrees()),
-            mean_abs_shear_deg: Some(st.mean_abs.to_degrees()),
-            area_over_locking_m2: Some(st.area_over_locking),
-            coverage: (net.num_cells() > 0).then(|| st.coverage()),
-            draped_area_m2: Some(st.area),
-            offset_m: net.meta.stack_offset_max_m,
-            converged: net.meta.solver.as_ref().map(|s| s.converged),
-            solver_failure: net.meta.solver.as_ref().and_then(|s| s.reason.clone()),
-            ..LayupRow::default()
-        });
+        let recorded_locking = given.as_ref().and_then(|r| r.locking_angle_deg).filter(|a| a.is_finite() && *a > 0.0);
+        let (locking_deg, locking_source) = match recorded_locking {
+            Some(a) => (a, given.as_ref().and_then(|r| r.locking_angle_source).unwrap_or(LockingSource::Ply)),
+            None => {
+                // The card the net records, found as the tool is.
+                let card = net
+                    .meta
+                    .material
+                    .as_deref()
+                    .and_then(|m| locate_tool(m, dir))
+                    .and_then(|p| MaterialCard::load(&p).ok());
+                locking_angle_deg(None, card.as_ref())
+            }
+        };
+        if locking_source == LockingSource::Default {
+            notes.push(format!(
+                "ply '{stem}': neither {LAYUP_FILE} nor a material card gives a locking angle: judged against the default {DEFAULT_LOCKING_ANGLE_DEG}°"
+            ));
+        }
         let recorded = net.meta.tool.clone().or_else(|| layup.as_ref().and_then(|l| l.tool.clone()));
         let (tool, tool_note) = match recorded {
             None => (None, Some("the net records no tool file: drawn without the tool".to_string())),
@@ -314,7 +337,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                 ),
             },
         };
-        inputs.push(PlyInput { stem, net, locking_deg, row, tool, tool_note });
+        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note });
     }
 
     std::fs::create_dir_all(out).map_err(|source| ReportError::CreateDir { path: out.to_path_buf(), source })?;
@@ -324,6 +347,17 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for p in inputs.iter().filter_map(|i| i.tool.clone()) {
         tools.entry(p.clone()).or_insert_with(|| load_tool(&p));
     }
+    // The table rows: layup.json's, else computed from the net (its coverage of the tool).
+    let rows: Vec<LayupRow> = inputs
+        .iter()
+        .map(|i| match &i.given {
+            Some(row) => row.clone(),
+            None => {
+                let tool = i.tool.as_ref().and_then(|p| tools.get(p)).and_then(|t| t.as_ref().ok());
+                row_of_net(i, tool)
+            }
+        })
+        .collect();
 
     let pictures: u64 = inputs.iter().map(|i| if i.net.method == Method::Mechanical { 3 } else { 2 }).sum();
     let bar = if progress {
@@ -378,7 +412,6 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     for i in &inputs {
         extra.insert(i.stem.clone(), html::net_facts(&i.net));
     }
-    let rows: Vec<LayupRow> = inputs.iter().map(|i| i.row.clone()).collect();
     let title = layup
         .as_ref()
         .and_then(|l| l.scene.clone())
@@ -399,6 +432,38 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     files.push(index);
     let Page { plies, notes, .. } = page;
     Ok(ReportSummary { out: out.to_path_buf(), files, plies, notes })
+}
+
+/// The table row of a net that `layup.json` does not list: its shear statistics and, when its
+/// tool could be read, its coverage of the tool.
+fn row_of_net(input: &PlyInput, tool: Option<&RawTool>) -> LayupRow {
+    let (net, locking_deg) = (&input.net, input.locking_deg);
+    let st = net.shear_stats(locking_deg.to_radians());
+    let coverage = tool.map(|t| {
+        let s = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or_else(|| guess_scale(t, net));
+        let triangles: Vec<[Point; 3]> =
+            t.triangles.iter().map(|tri| tri.map(|v| Point::from(t.vertices[v as usize].coords * s))).collect();
+        surface_coverage(net, &triangles, None)
+    });
+    LayupRow {
+        name: input.stem.clone(),
+        material: net.meta.material.clone(),
+        angle_deg: net.meta.angle_deg,
+        method: Some(method_name(net.method).into()),
+        locking_angle_deg: Some(locking_deg),
+        locking_angle_source: Some(input.locking_source),
+        max_abs_shear_deg: Some(st.max_abs.to_degrees()),
+        mean_abs_shear_deg: Some(st.mean_abs.to_degrees()),
+        area_over_locking_m2: Some(st.area_over_locking),
+        coverage: coverage.map(|c| c.share()),
+        coverage_of: coverage.as_ref().map(CoverageOf::of),
+        covered_area_m2: coverage.map(|c| c.covered_area),
+        draped_area_m2: Some(st.area),
+        offset_m: net.meta.stack_offset_max_m,
+        converged: net.meta.solver.as_ref().map(|s| s.converged),
+        solver_failure: net.meta.solver.as_ref().and_then(|s| s.reason.clone()),
+        ..LayupRow::default()
+    }
 }
 
 /// A link from the page in `out` to `file` in `dir`: relative when `out` is inside `dir`.
@@ -430,11 +495,15 @@ fn draw_ply(
     let st = net.shear_stats(input.locking_deg.to_radians());
     let (max_abs_deg, mean_abs_deg) = (st.max_abs.to_degrees(), st.mean_abs.to_degrees());
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
+    let mut sagitta = None;
     let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
         Some(Ok(t)) => {
             // The scale the run read the tool with, when the net records it.
             let recorded = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0);
             let s = recorded.unwrap_or_else(|| guess_scale(t, net));
+            if net.method == Method::Mechanical {
+                sagitta = t.sagitta().map(|v| v * s);
+            }
             Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
         }
         Some(Err(e)) => {
@@ -491,16 +560,41 @@ fn draw_ply(
     )?;
     bar.inc(1);
 
+    let mut change_noise = None;
     if net.method == Method::Mechanical {
         match change_values(net) {
             Ok(change) => {
                 let max = change.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-                let limit = change_limit(max);
-                let mut map = render::layout_map(net, &change, layer.as_ref(), limit);
-                map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
-                map.subtitle = format!("largest change {max:.2}°, drawn on the mechanical net; {tool_text}");
-                map.bar_label = "shear change (deg)".into();
-                write_pair(&name("change"), |r| render::draw_map(r, &map), |r| render::draw_map(r, &map), &mut files)?;
+                let noise = change::change_noise(&change, net.nu, net.nv, net.spacing, sagitta);
+                let floor = noise.floor_deg;
+                if max <= floor {
+                    notes.push(format!(
+                        "the change from the kinematic net is within the solver's noise (largest |change| {max:.3}° against a noise floor of {floor:.3}°: {}): no change map drawn",
+                        noise_parts(&noise)
+                    ));
+                } else {
+                    // Changes within the noise are drawn as no change; the scale starts above it.
+                    let shown: Vec<Option<f64>> =
+                        change.iter().map(|v| v.map(|x| if x.abs() <= floor { 0.0 } else { x })).collect();
+                    let limit = change_limit(max);
+                    let mut map = render::layout_map(net, &shown, layer.as_ref(), limit);
+                    map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
+                    map.subtitle = format!(
+                        "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
+                    );
+                    map.bar_label = "shear change (deg)".into();
+                    map.marks = vec![
+                        Mark { value: floor, label: format!("+{floor:.2}° noise") },
+                        Mark { value: -floor, label: format!("−{floor:.2}° noise") },
+                    ];
+                    write_pair(
+                        &name("change"),
+                        |r| render::draw_map(r, &map),
+                        |r| render::draw_map(r, &map),
+                        &mut files,
+                    )?;
+                }
+                change_noise = Some(noise);
             }
             Err(why) => notes.push(format!("no change picture: {why}")),
         }
@@ -515,9 +609,16 @@ fn draw_ply(
         mean_abs_shear_deg: mean_abs_deg,
         colour_limit_deg: limit,
         tool_drawn: layer.is_some(),
+        change_noise,
         files,
         notes,
     })
+}
+
+/// What a noise floor is made of, in words.
+fn noise_parts(n: &change::ChangeNoise) -> String {
+    let facets = n.facets_deg.map_or("tool not read".to_string(), |f| format!("{f:.3}°"));
+    format!("the tool's facet sagitta over the spacing {facets}, the cell-to-cell scatter {:.3}°", n.scatter_deg)
 }
 
 /// The per-cell shear change (degrees) a mechanical net records in meta
@@ -575,6 +676,7 @@ mod tests {
             triangles: vec![],
             lo: Point::new(-k, -k, 0.0),
             hi: Point::new(k, k, k),
+            sagitta: Default::default(),
         };
         let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
         for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {

@@ -7,10 +7,14 @@
 //! G4 THETA), a real in degrees measured from the element's G1 -> G2 edge about its normal: the
 //! map's `theta`. An element card carries one angle, so one deck carries one ply: for one net
 //! the deck is `out`; for a layup each ply gets its own deck `STEM_<ply>.<ext>` beside `out`
-//! (same GRIDs and element ids in all of them). This is a mesh + orientation deck to INCLUDE:
-//! elements covered by the ply have PID 1, the others PID 2 and no THETA (the field is left
-//! blank, and a comment lists them); define PSHELL/PCOMP 1 and 2 yourself. The executive and
-//! case control sections are empty (`CEND`, `BEGIN BULK`, ..., `ENDDATA`).
+//! (same GRIDs and element ids in all of them).
+//!
+//! The deck is bulk data only, to `INCLUDE` in the bulk section of your own deck, which defines
+//! the properties and materials: every element keeps the property id (PID) it has in the flow
+//! mesh (elements of a mesh without PIDs, like OBJ, get [`DEFAULT_PID`]), so a solver, or
+//! pyNastran with cross-referencing, finds the user's PSHELL/PCOMP and MAT cards. Elements the
+//! ply does not cover keep their PID and get no THETA (the field is left blank, and a comment
+//! lists them).
 use super::{large, real};
 use crate::io::flow::{deg, file_tag, sibling};
 use crate::io::{write_atomic, ExportError};
@@ -18,10 +22,17 @@ use crate::mapping::{ElementShape, FlowElement, FlowMesh, LayupMap, PlyMap};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-/// Property id of the elements the ply covers.
-pub(crate) const PID_COVERED: u64 = 1;
-/// Property id of the elements the ply does not cover.
-pub(crate) const PID_UNCOVERED: u64 = 2;
+/// Property id of elements the flow mesh gives none (an OBJ mesh, say).
+pub const DEFAULT_PID: u64 = 1;
+
+/// The PID an element keeps: its own, else [`DEFAULT_PID`].
+pub(crate) fn pid(el: &FlowElement) -> u64 {
+    if el.property > 0 {
+        el.property
+    } else {
+        DEFAULT_PID
+    }
+}
 
 pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Vec<PathBuf>, ExportError> {
     let ext = out.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
@@ -43,13 +54,14 @@ pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<
 
 fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<()> {
     writeln!(w, "$ drape: material orientation of ply '{}' on flow mesh {}", ply.ply, mesh.path.display())?;
-    writeln!(w, "$ THETA (deg) from edge G1->G2 to the warp; PID {PID_COVERED} = covered, PID {PID_UNCOVERED} = not covered by this ply.")?;
+    writeln!(w, "$ THETA (deg) from edge G1->G2 to the warp. Bulk data to INCLUDE after BEGIN BULK in your deck,")?;
+    writeln!(w, "$ which defines the properties (PIDs as in the flow mesh, {DEFAULT_PID} where it had none) and materials.")?;
     let uncovered: Vec<u64> =
         mesh.elements.iter().zip(&ply.elements).filter(|(_, f)| f.is_none()).map(|(e, _)| e.id).collect();
     if !uncovered.is_empty() {
         writeln!(
             w,
-            "$ {} element(s) not covered by ply '{}' (PID {PID_UNCOVERED}, no THETA):",
+            "$ {} element(s) not covered by ply '{}' (their own PID, no THETA):",
             uncovered.len(),
             ply.ply
         )?;
@@ -58,16 +70,12 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<
             writeln!(w, "$   {}", ids.join(" "))?;
         }
     }
-    // Empty executive and case control sections: a deck pyNastran and meshio read whole; add
-    // SOL and case control above CEND to run it, or INCLUDE the bulk lines in your own deck.
-    writeln!(w, "CEND")?;
-    writeln!(w, "BEGIN BULK")?;
     write_grids(mesh, w)?;
     for (el, f) in mesh.elements.iter().zip(&ply.elements) {
         let theta = f.as_ref().map(|f| real(deg(f.theta)));
-        write_element(mesh, el, f.as_ref().map_or(PID_UNCOVERED, |_| PID_COVERED), theta, w)?;
+        write_element(mesh, el, pid(el), theta, w)?;
     }
-    writeln!(w, "ENDDATA")
+    Ok(())
 }
 
 /// Every node as a large-field GRID*.
