@@ -194,7 +194,7 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
     assert_eq!(plies.len(), 4);
     let angles: Vec<f64> = plies.iter().map(|p| p["angle_deg"].as_f64().unwrap()).collect();
     assert_eq!(angles, [0.0, 45.0, 90.0, -45.0]);
-    assert!(plies.iter().all(|p| p["method"] == "kinematic"));
+    assert!(plies.iter().all(|p| p["method"] == "mechanical" && p["converged"] == true), "every ply pressed to equilibrium");
     // The carbon card: 0.35 mm a ply; offsets grow up the stack, never fold on this part.
     let mut last = 0.0;
     for (k, p) in plies.iter().enumerate() {
@@ -204,7 +204,9 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
         last = off;
         let net = read_json(&out.join(format!("{}.drape.json", p["name"].as_str().unwrap())));
         let o = origin_node(&net);
-        assert!((o[2] - (0.06 + k as f64 * 3.5e-4)).abs() < 1e-9, "ply {k}: seed on the flat top at z {}", o[2]);
+        // Pressed plies rest on the smooth surface through the offset tool's vertices, whose
+        // heights follow the shear of the plies below (t0 / cos g): within 3% of a ply.
+        assert!((o[2] - (0.06 + k as f64 * 3.5e-4)).abs() < 1e-5, "ply {k}: seed on the flat top at z {}", o[2]);
     }
     // The 0 and 90 plies of a doubly symmetric part shear alike (within the grid's asymmetry).
     let (m0, m90) = (plies[0]["max_abs_shear_deg"].as_f64().unwrap(), plies[2]["max_abs_shear_deg"].as_f64().unwrap());
