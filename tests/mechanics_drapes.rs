@@ -224,3 +224,20 @@ fn a_ply_that_did_not_converge_is_marked_everywhere_and_the_run_exits_1() {
     assert!(html.contains("<title>NOT CONVERGED (sheet)"));
     assert!(html.contains("<strong>NOT CONVERGED</strong>"));
 }
+
+#[test]
+fn a_free_drape_is_the_same_on_one_thread_and_on_two() {
+    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
+        .unwrap()
+        .replace("\"square-table.obj\"", "\"@/geometries/square-table/square-table.obj\"")
+        .replace("../../materials", "@/materials")
+        .replace("spacing = 0.005", "spacing = 0.01")
+        .replace("grid = [41, 41]", "grid = [21, 21]");
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| drape_text(&text).1.remove(0))
+    };
+    let (one, two) = (on(1), on(2));
+    assert!(converged(&one));
+    assert_eq!(one.net.positions, two.net.positions, "bit for bit");
+}
