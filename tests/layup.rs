@@ -194,7 +194,10 @@ fn a_four_ply_layup_runs_on_the_double_dome() {
     assert_eq!(plies.len(), 4);
     let angles: Vec<f64> = plies.iter().map(|p| p["angle_deg"].as_f64().unwrap()).collect();
     assert_eq!(angles, [0.0, 45.0, 90.0, -45.0]);
-    assert!(plies.iter().all(|p| p["method"] == "mechanical" && p["converged"] == true), "every ply pressed to equilibrium");
+    assert!(
+        plies.iter().all(|p| p["method"] == "mechanical" && p["converged"] == true),
+        "every ply pressed to equilibrium"
+    );
     // The carbon card: 0.35 mm a ply; offsets grow up the stack, never fold on this part.
     let mut last = 0.0;
     for (k, p) in plies.iter().enumerate() {

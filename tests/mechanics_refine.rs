@@ -19,7 +19,7 @@ fn hemisphere_net(tool: &ToolSurface, n: usize) -> DrapeNet {
 }
 
 /// Largest relative change of a fibre segment's length from d.
-fn max_strain(net: &DrapeNet) -> f64 {
+pub(crate) fn max_strain(net: &DrapeNet) -> f64 {
     let mut worst = 0.0f64;
     for i in 0..net.nu {
         for j in 0..net.nv {
