@@ -52,7 +52,7 @@
 use super::calculix::short;
 use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
 use super::{write_atomic, ExportError};
-use crate::mapping::{ElementShape, FlowMesh, LayupMap};
+use crate::mapping::{FlowMesh, LayupMap};
 use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::io::{self, Write};
@@ -477,21 +477,7 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
     for (k, ply) in map.plies.iter().enumerate() {
         writeln!(w, "** ply {} '{}' -> {}", k + 1, ply.ply.replace(['\n', '\r'], " "), ply_tag(k, &ply.ply))?;
     }
-    writeln!(w, "*NODE, NSET=DRAPE_NODES")?;
-    for (p, id) in mesh.nodes.iter().zip(&mesh.node_ids) {
-        writeln!(w, "{id}, {}, {}, {}", short(p.x), short(p.y), short(p.z))?;
-    }
-    for (shape, ty) in [(ElementShape::Tria3, "S3"), (ElementShape::Quad4, "S4")] {
-        let els: Vec<_> = mesh.elements.iter().filter(|e| e.shape == shape).collect();
-        if els.is_empty() {
-            continue;
-        }
-        writeln!(w, "*ELEMENT, TYPE={ty}, ELSET=DRAPE_{ty}")?;
-        for el in els {
-            let nodes: Vec<String> = el.nodes.iter().map(|&k| mesh.node_ids[k].to_string()).collect();
-            writeln!(w, "{}, {}", el.id, nodes.join(", "))?;
-        }
-    }
+    super::calculix::write_mesh(mesh, w)?;
     writeln!(w, "*DISTRIBUTION TABLE, NAME={TABLE}")?;
     writeln!(w, "COORD3D, COORD3D")?;
     for (k, ply) in map.plies.iter().enumerate() {

@@ -85,11 +85,9 @@ pub(crate) fn write_flow(
     Ok(targets.into_iter().map(|(p, _)| p).collect())
 }
 
-fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, material: &str, w: &mut W) -> io::Result<()> {
-    let name = ply.ply.replace(['\n', '\r'], " ");
-    writeln!(w, "** drape: fibre orientation of ply '{name}' on flow mesh {}", mesh.path.display())?;
-    writeln!(w, "** local 1 = warp, local 2 in the plane of warp and weft, local 3 = element normal.")?;
-    writeln!(w, "** Define *MATERIAL, NAME={material} (orthotropic, 1 = warp) in the deck that includes this one.")?;
+/// The flow mesh as Abaqus/CalculiX input: its nodes (set DRAPE_NODES) and shell elements (S3
+/// in DRAPE_S3, S4 in DRAPE_S4), numbers in [`short`] form. Shared with the Abaqus writer.
+pub(crate) fn write_mesh<W: Write>(mesh: &FlowMesh, w: &mut W) -> io::Result<()> {
     writeln!(w, "*NODE, NSET=DRAPE_NODES")?;
     for (p, id) in mesh.nodes.iter().zip(&mesh.node_ids) {
         writeln!(w, "{id}, {}, {}, {}", short(p.x), short(p.y), short(p.z))?;
@@ -105,6 +103,15 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, material: &str, w: &mut W
             writeln!(w, "{}, {}", el.id, nodes.join(", "))?;
         }
     }
+    Ok(())
+}
+
+fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, material: &str, w: &mut W) -> io::Result<()> {
+    let name = ply.ply.replace(['\n', '\r'], " ");
+    writeln!(w, "** drape: fibre orientation of ply '{name}' on flow mesh {}", mesh.path.display())?;
+    writeln!(w, "** local 1 = warp, local 2 in the plane of warp and weft, local 3 = element normal.")?;
+    writeln!(w, "** Define *MATERIAL, NAME={material} (orthotropic, 1 = warp) in the deck that includes this one.")?;
+    write_mesh(mesh, w)?;
     // Elements whose orientation and thickness read the same in the file share a section.
     let mut groups: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
     let mut order: Vec<(String, String)> = Vec::new();
