@@ -1,5 +1,7 @@
-//! Mechanical refinement of a hemisphere net (pressed, stiff fibres, nonlinear shear: the carbon
-//! twill card) on the 200k-triangle hemisphere, nets from the pole to the rim.
+//! Mechanical refinement: a hemisphere net (pressed, stiff fibres, nonlinear shear: the carbon
+//! twill card) on the 200k-triangle hemisphere, nets from the pole to the rim; and whole plies of
+//! the bundled scenes (kinematic drape, then refinement): the double dome's first ply pressed
+//! (101 x 81 at 5 mm) and seed 000's square table from a flat sheet (41 x 41 at 5 mm).
 //! Run: `cargo bench --bench refine`. `drape bench --refine CARD` prints iterations per run.
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use drape::geometry::shapes;
@@ -28,5 +30,27 @@ fn pressed_hemisphere(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, pressed_hemisphere);
+/// The first ply of a bundled scene, draped and refined.
+fn scene_ply(c: &mut Criterion, name: &str, scene: &str) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scene = drape::pipeline::Scene::load(&root.join(scene)).unwrap();
+    scene.layup.plies.truncate(1);
+    let tool = drape::io::read_tool(&scene.tool, scene.scale).unwrap();
+    let mut group = c.benchmark_group("refine_scene");
+    group.sample_size(10);
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            let r = drape::layup::stack::drape_layup(&scene.layup, &tool, |_, _| {}).unwrap();
+            assert!(r[0].refined.as_ref().unwrap().ok(), "{name} did not converge");
+        })
+    });
+    group.finish();
+}
+
+fn scenes(c: &mut Criterion) {
+    scene_ply(c, "double_dome_p0_101x81_pressed", "geometries/double-dome/scene.toml");
+    scene_ply(c, "square_table_41x41_free", "geometries/square-table/scene.toml");
+}
+
+criterion_group!(benches, pressed_hemisphere, scenes);
 criterion_main!(benches);
