@@ -545,3 +545,87 @@ fn a_flow_mesh_the_net_misses_is_refused_with_the_cause() {
     let covered: f64 = line.split("elements (").nth(1).unwrap().split('%').next().unwrap().parse().unwrap();
     assert!((covered - 4.0).abs() <= 2.0 && stdout.contains("covers only part of the flow mesh"), "{stdout}");
 }
+
+/// A 1 m dome over 10 x 10 quads split into triangles, every coordinate an `f32` (what a binary
+/// STL holds): the OBJ, ASCII STL and binary STL of the same triangles.
+fn dome_files(dir: &Path) -> [PathBuf; 3] {
+    let n = 10;
+    let at = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+        [x, y, 0.2 - 0.4 * (x * x + y * y)]
+    };
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let (mut obj, mut ascii, mut binary) = (String::new(), String::from("solid dome\n"), vec![0u8; 80]);
+    binary.extend_from_slice(&(triangles.len() as u32).to_le_bytes());
+    for (t, corners) in triangles.iter().enumerate() {
+        ascii += "facet normal 0 0 1\nouter loop\n";
+        binary.extend([0f32, 0.0, 1.0].iter().flat_map(|c| c.to_le_bytes()));
+        for p in corners {
+            // Every corner its own OBJ vertex, as STL repeats them: the reader welds both.
+            obj += &format!("v {} {} {}\n", p[0] as f64, p[1] as f64, p[2] as f64);
+            ascii += &format!("vertex {} {} {}\n", p[0] as f64, p[1] as f64, p[2] as f64);
+            binary.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+        }
+        obj += &format!("f {} {} {}\n", 3 * t + 1, 3 * t + 2, 3 * t + 3);
+        ascii += "endloop\nendfacet\n";
+        binary.extend([0, 0]);
+    }
+    ascii += "endsolid dome\n";
+    let paths = [dir.join("dome.obj"), dir.join("dome_ascii.stl"), dir.join("dome_binary.STL")];
+    std::fs::write(&paths[0], obj).unwrap();
+    std::fs::write(&paths[1], ascii).unwrap();
+    std::fs::write(&paths[2], binary).unwrap();
+    paths
+}
+
+#[test]
+fn stl_tools_ascii_and_binary_drape_as_their_obj_and_bad_ones_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let tools = dome_files(dir.path());
+    let nets: Vec<serde_json::Value> = tools
+        .iter()
+        .enumerate()
+        .map(|(k, tool)| {
+            let out = dir.path().join(format!("out{k}"));
+            let mut args = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap());
+            set_str(&mut args, "--origin", "0,0,0.2");
+            args.extend(["--name", "p", "--format", "json"]);
+            drape().args(&args).assert().success();
+            serde_json::from_str(&std::fs::read_to_string(out.join("p.drape.json")).unwrap()).unwrap()
+        })
+        .collect();
+    let placed = nets[0]["nodes"].as_array().unwrap().iter().filter(|n| !n.is_null()).count();
+    assert!(placed > 300, "{placed} nodes placed");
+    for net in &nets[1..] {
+        assert_eq!(net["nodes"], nets[0]["nodes"]);
+        assert_eq!(net["cell_shear_deg"], nets[0]["cell_shear_deg"]);
+    }
+    // Malformed and truncated STL: exit 2, saying where and what to do.
+    let ascii = std::fs::read_to_string(&tools[1]).unwrap();
+    let cut = dir.path().join("cut.stl");
+    let half = ascii.len() / 2 + ascii[ascii.len() / 2..].find("endloop").unwrap();
+    std::fs::write(&cut, &ascii[..half]).unwrap();
+    refused(|a| set(a, "--tool", cut.to_str().unwrap()), "is truncated");
+    refused(|a| set(a, "--tool", cut.to_str().unwrap()), "Export the surface again as an STL");
+    let bad = dir.path().join("bad.stl");
+    std::fs::write(&bad, ascii.replacen("vertex", "vertex 1 2", 1)).unwrap();
+    refused(|a| set(a, "--tool", bad.to_str().unwrap()), "line 4: `vertex` needs three numbers");
+    let binary = std::fs::read(&tools[2]).unwrap();
+    let short = dir.path().join("short.stl");
+    std::fs::write(&short, &binary[..binary.len() - 10]).unwrap();
+    refused(|a| set(a, "--tool", short.to_str().unwrap()), "declares 200 triangles");
+    let empty = dir.path().join("empty.stl");
+    std::fs::write(&empty, "solid nothing\nendsolid nothing\n").unwrap();
+    refused(|a| set(a, "--tool", empty.to_str().unwrap()), "no faces");
+}
+
+fn set_str<'a>(args: &mut [&'a str], flag: &str, value: &'a str) {
+    let k = args.iter().position(|a| *a == flag).unwrap();
+    args[k + 1] = value;
+}

@@ -27,7 +27,7 @@ pub struct RefineArgs {
     /// Kinematic net (`<ply>.drape.json` from `drape kinematic` or `drape run`).
     #[arg(long)]
     pub net: PathBuf,
-    /// Tool surface (OBJ, or a shell mesh: .inp, .bdf, .msh), in the net's units (metres).
+    /// Tool surface (OBJ, STL, or a shell mesh: .inp, .bdf, .msh), in the net's units (metres).
     #[arg(long)]
     pub tool: PathBuf,
     /// Material card (TOML).
