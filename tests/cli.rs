@@ -629,3 +629,43 @@ fn set_str<'a>(args: &mut [&'a str], flag: &str, value: &'a str) {
     let k = args.iter().position(|a| *a == flag).unwrap();
     args[k + 1] = value;
 }
+
+#[test]
+fn a_net_coordinate_beyond_any_part_and_a_spacing_below_the_tool_are_refused() {
+    // A spacing far below what the tool resolves (the plate's diagonal is 1.4 m).
+    refused(|a| set(a, "--spacing", "4e-12"), "below what");
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let ply = |name: &str, spacing: &str| {
+        format!(
+            "[[ply]]\nname = \"{name}\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = {spacing}\ngrid = [11, 11]\nthickness = 0.5\n"
+        )
+    };
+    std::fs::write(&scene, format!("tool = \"plate.obj\"\n{}{}", ply("a", "0.02"), ply("b", "4e-12"))).unwrap();
+    let out = dir.path().join("run");
+    let assert = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains("ply 'b'") && err.contains("spacing 0.000000000004 is below"), "{err}");
+    assert!(!out.join("a.drape.json").exists(), "a ply was written before the bad one was refused");
+
+    // A net node at 1e308 m.
+    let k = dir.path().join("k");
+    let mut args = kinematic_args(tool.to_str().unwrap(), k.to_str().unwrap());
+    args.extend(["--name", "p", "--format", "json"]);
+    drape().args(&args).assert().success();
+    let mut net: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(k.join("p.drape.json")).unwrap()).unwrap();
+    net["nodes"][200][0] = serde_json::json!(1e308);
+    let bad = dir.path().join("bad.drape.json");
+    std::fs::write(&bad, net.to_string()).unwrap();
+    let flow = dir.path().join("flow.vtu");
+    let assert = drape()
+        .args(["export", "--net", bad.to_str().unwrap(), "--mesh", tool.to_str().unwrap(), "--format", "vtu"])
+        .args(["--out", flow.to_str().unwrap()])
+        .assert()
+        .code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains("node (9, 11) the coordinate 1e308 m, beyond 1e6 m") && !err.contains("panicked"), "{err}");
+    assert!(!flow.exists());
+}
