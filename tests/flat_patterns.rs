@@ -558,6 +558,13 @@ fn drawings_read_back_independently() {
     assert_eq!(d["by_layer"]["ARROWS"]["lines"], 3 * patterns.len());
     assert_eq!(d["by_layer"]["ARROWS"]["closed_polylines"], 0);
     assert_eq!(d["by_layer"]["LABELS"]["texts"], patterns.len());
+    // Every label inside the roll, as ezdxf measures its text.
+    let tb: Vec<f64> = d["by_layer"]["LABELS"]["text_bbox_mm"].as_array().unwrap().iter().map(num).collect();
+    let (len_mm, w_mm) = (n.length * 1e3, n.roll_width * 1e3);
+    assert!(
+        tb[0] >= 0.0 && tb[1] >= 0.0 && tb[2] <= len_mm && tb[3] <= w_mm,
+        "labels {tb:?} off the {len_mm} x {w_mm} mm roll"
+    );
     let texts = d["by_layer"]["LABELS"]["text"].as_array().unwrap();
     for p in &patterns {
         let area = format!("area {:.6} m2", p.area);
