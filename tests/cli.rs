@@ -649,11 +649,27 @@ fn a_net_coordinate_beyond_any_part_and_a_spacing_below_the_tool_are_refused() {
     assert!(err.contains("ply 'b'") && err.contains("spacing 0.000000000004 is below"), "{err}");
     assert!(!out.join("a.drape.json").exists(), "a ply was written before the bad one was refused");
 
-    // A net node at 1e308 m.
+    // A net whose spacing is below what the tool resolves, refined.
     let k = dir.path().join("k");
     let mut args = kinematic_args(tool.to_str().unwrap(), k.to_str().unwrap());
     args.extend(["--name", "p", "--format", "json"]);
     drape().args(&args).assert().success();
+    let mut net: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(k.join("p.drape.json")).unwrap()).unwrap();
+    net["spacing"] = serde_json::json!(4e-12);
+    let tiny = dir.path().join("tiny.drape.json");
+    std::fs::write(&tiny, net.to_string()).unwrap();
+    let card = concat!(env!("CARGO_MANIFEST_DIR"), "/materials/glass-plain-weave.toml");
+    let refined = dir.path().join("refined");
+    let assert = drape()
+        .args(["refine", "--net", tiny.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card])
+        .args(["--mode", "pressed", "--out", refined.to_str().unwrap()])
+        .assert()
+        .code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains("tiny.drape.json: spacing 0.000000000004 is below what the tool resolves"), "{err}");
+
+    // A net node at 1e308 m.
     let mut net: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(k.join("p.drape.json")).unwrap()).unwrap();
     net["nodes"][200][0] = serde_json::json!(1e308);

@@ -282,7 +282,7 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
     let start = Instant::now();
     check_settings(settings)?;
     let d = settings.spacing;
-    check_spacing_on_tool(tool, settings)?;
+    check_spacing_on_tool(tool, settings.spacing)?;
     let seed = tool.closest_point(&settings.origin);
     if !(seed.distance <= d) {
         let o = settings.origin;
@@ -382,9 +382,10 @@ pub fn check_settings(s: &KinematicSettings) -> Result<(), DrapeError> {
 }
 
 /// The check of the settings against the tool: a spacing of at least [`MIN_SPACING_REL`] of the
-/// tool's size. [`drape`] runs it; a run checks every ply with it before draping any.
-pub fn check_spacing_on_tool(tool: &ToolSurface, settings: &KinematicSettings) -> Result<(), DrapeError> {
-    let (d, diagonal) = (settings.spacing, tool.diagonal());
+/// tool's size. [`drape`] runs it; a run checks every ply with it before draping any, and
+/// `drape refine` the net it reads.
+pub fn check_spacing_on_tool(tool: &ToolSurface, spacing: f64) -> Result<(), DrapeError> {
+    let (d, diagonal) = (spacing, tool.diagonal());
     let min = MIN_SPACING_REL * diagonal;
     if !(d >= min) {
         return Err(DrapeError::SpacingBelowTool { spacing: d, min, rel: MIN_SPACING_REL, diagonal });

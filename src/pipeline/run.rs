@@ -232,7 +232,7 @@ pub fn run(
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     on(Event::ToolRead { path: &scene.tool, tool: &tool });
     for ply in &scene.layup.plies {
-        check_spacing_on_tool(&tool, &ply.settings).map_err(|error| RunError::Settings {
+        check_spacing_on_tool(&tool, ply.settings.spacing).map_err(|error| RunError::Settings {
             scene: scene.path.clone(),
             ply: ply.settings.name.clone(),
             line: ply.line,
