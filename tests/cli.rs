@@ -545,3 +545,143 @@ fn a_flow_mesh_the_net_misses_is_refused_with_the_cause() {
     let covered: f64 = line.split("elements (").nth(1).unwrap().split('%').next().unwrap().parse().unwrap();
     assert!((covered - 4.0).abs() <= 2.0 && stdout.contains("covers only part of the flow mesh"), "{stdout}");
 }
+
+/// A 1 m dome over 10 x 10 quads split into triangles, every coordinate an `f32` (what a binary
+/// STL holds): the OBJ, ASCII STL and binary STL of the same triangles.
+fn dome_files(dir: &Path) -> [PathBuf; 3] {
+    let n = 10;
+    let at = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+        [x, y, 0.2 - 0.4 * (x * x + y * y)]
+    };
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let (mut obj, mut ascii, mut binary) = (String::new(), String::from("solid dome\n"), vec![0u8; 80]);
+    binary.extend_from_slice(&(triangles.len() as u32).to_le_bytes());
+    for (t, corners) in triangles.iter().enumerate() {
+        ascii += "facet normal 0 0 1\nouter loop\n";
+        binary.extend([0f32, 0.0, 1.0].iter().flat_map(|c| c.to_le_bytes()));
+        for p in corners {
+            // Every corner its own OBJ vertex, as STL repeats them: the reader welds both.
+            obj += &format!("v {} {} {}\n", p[0] as f64, p[1] as f64, p[2] as f64);
+            ascii += &format!("vertex {} {} {}\n", p[0] as f64, p[1] as f64, p[2] as f64);
+            binary.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+        }
+        obj += &format!("f {} {} {}\n", 3 * t + 1, 3 * t + 2, 3 * t + 3);
+        ascii += "endloop\nendfacet\n";
+        binary.extend([0, 0]);
+    }
+    ascii += "endsolid dome\n";
+    let paths = [dir.join("dome.obj"), dir.join("dome_ascii.stl"), dir.join("dome_binary.STL")];
+    std::fs::write(&paths[0], obj).unwrap();
+    std::fs::write(&paths[1], ascii).unwrap();
+    std::fs::write(&paths[2], binary).unwrap();
+    paths
+}
+
+#[test]
+fn stl_tools_ascii_and_binary_drape_as_their_obj_and_bad_ones_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let tools = dome_files(dir.path());
+    let nets: Vec<serde_json::Value> = tools
+        .iter()
+        .enumerate()
+        .map(|(k, tool)| {
+            let out = dir.path().join(format!("out{k}"));
+            let mut args = kinematic_args(tool.to_str().unwrap(), out.to_str().unwrap());
+            set_str(&mut args, "--origin", "0,0,0.2");
+            args.extend(["--name", "p", "--format", "json"]);
+            drape().args(&args).assert().success();
+            serde_json::from_str(&std::fs::read_to_string(out.join("p.drape.json")).unwrap()).unwrap()
+        })
+        .collect();
+    let placed = nets[0]["nodes"].as_array().unwrap().iter().filter(|n| !n.is_null()).count();
+    assert!(placed > 300, "{placed} nodes placed");
+    for net in &nets[1..] {
+        assert_eq!(net["nodes"], nets[0]["nodes"]);
+        assert_eq!(net["cell_shear_deg"], nets[0]["cell_shear_deg"]);
+    }
+    // Malformed and truncated STL: exit 2, saying where and what to do.
+    let ascii = std::fs::read_to_string(&tools[1]).unwrap();
+    let cut = dir.path().join("cut.stl");
+    let half = ascii.len() / 2 + ascii[ascii.len() / 2..].find("endloop").unwrap();
+    std::fs::write(&cut, &ascii[..half]).unwrap();
+    refused(|a| set(a, "--tool", cut.to_str().unwrap()), "is truncated");
+    refused(|a| set(a, "--tool", cut.to_str().unwrap()), "Export the surface again as an STL");
+    let bad = dir.path().join("bad.stl");
+    std::fs::write(&bad, ascii.replacen("vertex", "vertex 1 2", 1)).unwrap();
+    refused(|a| set(a, "--tool", bad.to_str().unwrap()), "line 4: `vertex` needs three numbers");
+    let binary = std::fs::read(&tools[2]).unwrap();
+    let short = dir.path().join("short.stl");
+    std::fs::write(&short, &binary[..binary.len() - 10]).unwrap();
+    refused(|a| set(a, "--tool", short.to_str().unwrap()), "declares 200 triangles");
+    let empty = dir.path().join("empty.stl");
+    std::fs::write(&empty, "solid nothing\nendsolid nothing\n").unwrap();
+    refused(|a| set(a, "--tool", empty.to_str().unwrap()), "no faces");
+}
+
+fn set_str<'a>(args: &mut [&'a str], flag: &str, value: &'a str) {
+    let k = args.iter().position(|a| *a == flag).unwrap();
+    args[k + 1] = value;
+}
+
+#[test]
+fn a_net_coordinate_beyond_any_part_and_a_spacing_below_the_tool_are_refused() {
+    // A spacing far below what the tool resolves (the plate's diagonal is 1.4 m).
+    refused(|a| set(a, "--spacing", "4e-12"), "below what");
+    let dir = tempfile::tempdir().unwrap();
+    let tool = plate_obj(dir.path());
+    let scene = dir.path().join("scene.toml");
+    let ply = |name: &str, spacing: &str| {
+        format!(
+            "[[ply]]\nname = \"{name}\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = {spacing}\ngrid = [11, 11]\nthickness = 0.5\n"
+        )
+    };
+    std::fs::write(&scene, format!("tool = \"plate.obj\"\n{}{}", ply("a", "0.02"), ply("b", "4e-12"))).unwrap();
+    let out = dir.path().join("run");
+    let assert = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains("ply 'b'") && err.contains("spacing 0.000000000004 is below"), "{err}");
+    assert!(!out.join("a.drape.json").exists(), "a ply was written before the bad one was refused");
+
+    // A net whose spacing is below what the tool resolves, refined.
+    let k = dir.path().join("k");
+    let mut args = kinematic_args(tool.to_str().unwrap(), k.to_str().unwrap());
+    args.extend(["--name", "p", "--format", "json"]);
+    drape().args(&args).assert().success();
+    let mut net: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(k.join("p.drape.json")).unwrap()).unwrap();
+    net["spacing"] = serde_json::json!(4e-12);
+    let tiny = dir.path().join("tiny.drape.json");
+    std::fs::write(&tiny, net.to_string()).unwrap();
+    let card = concat!(env!("CARGO_MANIFEST_DIR"), "/materials/glass-plain-weave.toml");
+    let refined = dir.path().join("refined");
+    let assert = drape()
+        .args(["refine", "--net", tiny.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card])
+        .args(["--mode", "pressed", "--out", refined.to_str().unwrap()])
+        .assert()
+        .code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains("tiny.drape.json: spacing 0.000000000004 is below what the tool resolves"), "{err}");
+
+    // A net node at 1e308 m.
+    let mut net: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(k.join("p.drape.json")).unwrap()).unwrap();
+    net["nodes"][200][0] = serde_json::json!(1e308);
+    let bad = dir.path().join("bad.drape.json");
+    std::fs::write(&bad, net.to_string()).unwrap();
+    let flow = dir.path().join("flow.vtu");
+    let assert = drape()
+        .args(["export", "--net", bad.to_str().unwrap(), "--mesh", tool.to_str().unwrap(), "--format", "vtu"])
+        .args(["--out", flow.to_str().unwrap()])
+        .assert()
+        .code(2);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
+    assert!(err.contains("node (9, 11) the coordinate 1e308 m, beyond 1e6 m") && !err.contains("panicked"), "{err}");
+    assert!(!flow.exists());
+}

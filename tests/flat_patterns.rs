@@ -530,7 +530,7 @@ fn drawings_read_back_independently() {
     let d = &r[dxf.to_str().unwrap()];
     assert_eq!(d["dxfversion"], "AC1009");
     assert_eq!(d["insunits"], 4);
-    let mut want: Vec<String> = layers.iter().cloned().chain(["ROLL".to_string()]).collect();
+    let mut want: Vec<String> = layers.iter().cloned().chain(["ROLL", "ARROWS", "LABELS"].map(String::from)).collect();
     want.sort();
     let got: Vec<String> = d["layers"].as_array().unwrap().iter().map(|v| v.as_str().unwrap().to_string()).collect();
     assert!(want.iter().all(|l| got.contains(l)), "layers {got:?}, want {want:?}");
@@ -551,8 +551,24 @@ fn drawings_read_back_independently() {
         for (k, v) in [q.min[0], q.min[1], q.max[0], q.max[1]].into_iter().enumerate() {
             assert!((bb[k] * 1e-3 - v).abs() < 1e-9, "{layer}: bbox {bb:?} vs {q:?}");
         }
-        assert_eq!((s["lines"].as_u64(), s["texts"].as_u64()), (Some(3), Some(1)), "{layer}: arrow and label");
-        assert!(s["text"][0].as_str().unwrap().contains(&format!("area {:.6} m2", p.area)));
+        // The ply's layer holds its cut loops alone: a cutter cuts the layer as it is.
+        assert_eq!(s["lines"].as_u64().unwrap_or(0) + s["texts"].as_u64().unwrap_or(0), 0, "{layer}: loops only");
+    }
+    // Arrows (three lines a ply) and labels on their own layers.
+    assert_eq!(d["by_layer"]["ARROWS"]["lines"], 3 * patterns.len());
+    assert_eq!(d["by_layer"]["ARROWS"]["closed_polylines"], 0);
+    assert_eq!(d["by_layer"]["LABELS"]["texts"], patterns.len());
+    // Every label inside the roll, as ezdxf measures its text.
+    let tb: Vec<f64> = d["by_layer"]["LABELS"]["text_bbox_mm"].as_array().unwrap().iter().map(num).collect();
+    let (len_mm, w_mm) = (n.length * 1e3, n.roll_width * 1e3);
+    assert!(
+        tb[0] >= 0.0 && tb[1] >= 0.0 && tb[2] <= len_mm && tb[3] <= w_mm,
+        "labels {tb:?} off the {len_mm} x {w_mm} mm roll"
+    );
+    let texts = d["by_layer"]["LABELS"]["text"].as_array().unwrap();
+    for p in &patterns {
+        let area = format!("area {:.6} m2", p.area);
+        assert!(texts.iter().any(|t| t.as_str().unwrap().contains(&area)), "{area} in {texts:?}");
     }
 
     let s = &r[svg.to_str().unwrap()];

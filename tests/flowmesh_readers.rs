@@ -243,7 +243,9 @@ fn errors_name_the_line_and_what_to_do() {
     let e = err_text("bin.msh", "$MeshFormat\n4.1 1 8\n\u{0}\u{0}\u{0}\u{1}\n$EndMeshFormat\n");
     assert!(e.contains("not little-endian") && e.contains("re-save as 4.1 ASCII"), "{e}");
     let e = err_text("plate.stl", "solid x\n");
-    assert!(e.contains("unknown file type"), "{e}");
+    assert!(e.contains("without `endsolid`: it is truncated"), "{e}");
+    let e = err_text("plate.ply", "ply\n");
+    assert!(e.contains("unknown file type") && e.contains(".stl (STL)"), "{e}");
     let e = read_flow_mesh(Path::new("/nonexistent/plate.bdf"), 1.0).unwrap_err().to_string();
     assert!(e.contains("/nonexistent/plate.bdf"), "{e}");
 }

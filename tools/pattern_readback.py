@@ -9,7 +9,8 @@ Prints one JSON object to stdout, {path: summary}, where a DXF summary has
   dxfversion, insunits, layers (sorted layer-table names)
   by_layer: {layer: {closed_polylines, open_polylines, lines, texts, text (list),
              signed_area_mm2, abs_area_mm2, vertices, bbox_mm [xmin, ymin, xmax, ymax] of the
-             polylines, self_intersecting (loops that cross or repeat a vertex),
+             polylines, text_bbox_mm the same of the texts as ezdxf measures them,
+             self_intersecting (loops that cross or repeat a vertex),
              loops_ccw, loops_cw}}
 and an SVG summary has
   width, height (attribute strings), viewbox [x, y, w, h]
@@ -24,6 +25,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 import ezdxf
+import ezdxf.bbox
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 
@@ -82,7 +84,7 @@ def read_dxf(path):
         s = out["by_layer"].setdefault(e.dxf.layer, {
             "closed_polylines": 0, "open_polylines": 0, "lines": 0, "texts": 0, "text": [],
             "signed_area_mm2": 0.0, "abs_area_mm2": 0.0, "vertices": 0,
-            "bbox_mm": [inf, inf, -inf, -inf], "self_intersecting": 0, "loops_ccw": 0, "loops_cw": 0,
+            "bbox_mm": [inf, inf, -inf, -inf], "text_bbox_mm": [inf, inf, -inf, -inf], "self_intersecting": 0, "loops_ccw": 0, "loops_cw": 0,
         })
         kind = e.dxftype()
         if kind in ("POLYLINE", "LWPOLYLINE"):
@@ -106,6 +108,8 @@ def read_dxf(path):
         elif kind == "TEXT":
             s["texts"] += 1
             s["text"].append(e.dxf.text)
+            box = ezdxf.bbox.extents([e])
+            bbox_update(s["text_bbox_mm"], [(box.extmin[0], box.extmin[1]), (box.extmax[0], box.extmax[1])])
     return out
 
 

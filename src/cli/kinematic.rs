@@ -15,7 +15,7 @@ use std::time::Instant;
 /// Arguments of `drape kinematic`.
 #[derive(Debug, Args)]
 pub struct KinematicArgs {
-    /// Tool surface: Wavefront OBJ, or a shell mesh (Abaqus .inp, Nastran .bdf, Gmsh .msh).
+    /// Tool surface: Wavefront OBJ, STL (ASCII or binary), or a shell mesh (Abaqus .inp, Nastran .bdf, Gmsh .msh).
     #[arg(long)]
     pub tool: PathBuf,
     /// Seed point X,Y,Z (projected onto the tool; must lie within one spacing of it).

@@ -27,7 +27,7 @@ pub struct RefineArgs {
     /// Kinematic net (`<ply>.drape.json` from `drape kinematic` or `drape run`).
     #[arg(long)]
     pub net: PathBuf,
-    /// Tool surface (OBJ, or a shell mesh: .inp, .bdf, .msh), in the net's units (metres).
+    /// Tool surface (OBJ, STL, or a shell mesh: .inp, .bdf, .msh), in the net's units (metres).
     #[arg(long)]
     pub tool: PathBuf,
     /// Material card (TOML).
@@ -72,6 +72,8 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     let tool = crate::io::read_tool(&a.tool, 1.0).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
+    crate::kinematic::fishnet::check_spacing_on_tool(&tool, net.spacing)
+        .map_err(|e| input(anyhow::anyhow!("net {}: {e}", a.net.display())))?;
     let settings = RefineSettings {
         mode: match a.mode {
             Mode::Pressed => ContactMode::Pressed,

@@ -90,6 +90,16 @@ pub enum ToolError {
         /// Where and why.
         reason: String,
     },
+    /// The file is not a valid STL.
+    #[error(
+        "tool mesh {path} is not a valid STL file: {reason}. Export the surface again as an STL (ASCII or binary)."
+    )]
+    ParseStl {
+        /// The file.
+        path: PathBuf,
+        /// Where and why.
+        reason: String,
+    },
     /// The mesh has no faces.
     #[error(
         "tool mesh {path} has no faces. Export the surface (not only its points or curves) as triangles or polygons."

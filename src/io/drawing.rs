@@ -56,6 +56,11 @@ const HEAD_HALF_ANGLE_DEG: f64 = 25.0;
 const LABEL_FRACTION: f64 = 0.05;
 const LABEL_MIN_M: f64 = 0.002;
 const LABEL_MAX_M: f64 = 0.025;
+/// Advance of one label character as a fraction of the text height: a generous estimate for the
+/// fonts cutters and CAD draw TEXT with (ezdxf measures 0.68 for its default font).
+const LABEL_CHAR_WIDTH: f64 = 0.75;
+/// Descent below the baseline as a fraction of the text height.
+const LABEL_DESCENT: f64 = 0.3;
 
 /// One piece as drawn: roll-frame (m) loops, arrow segments and label.
 pub(crate) struct Piece {
@@ -87,6 +92,22 @@ pub(crate) fn piece(p: &FlatPattern, at: &Placement) -> Piece {
     Piece { ply: p.ply.clone(), loops, arrow, label_at, label_height, label }
 }
 
+/// Keep a piece's label (horizontal, centred on `label_at` at its baseline) inside the box
+/// `lo`..`hi` (the roll): its height lowered until its estimated width and height fit, then moved
+/// in as little as it takes.
+pub(crate) fn keep_label_inside(pc: &mut Piece, lo: [f64; 2], hi: [f64; 2]) {
+    let chars = pc.label.chars().count().max(1) as f64;
+    let (room_x, room_y) = (hi[0] - lo[0], hi[1] - lo[1]);
+    let h = pc.label_height.min(room_x / (LABEL_CHAR_WIDTH * chars)).min(room_y / (1.0 + LABEL_DESCENT));
+    if !(h > 0.0) {
+        return;
+    }
+    let half = 0.5 * LABEL_CHAR_WIDTH * chars * h;
+    pc.label_height = h;
+    pc.label_at[0] = pc.label_at[0].clamp(lo[0] + half, (hi[0] - half).max(lo[0] + half));
+    pc.label_at[1] = pc.label_at[1].clamp(lo[1] + LABEL_DESCENT * h, (hi[1] - h).max(lo[1] + LABEL_DESCENT * h));
+}
+
 /// The pieces of a nesting, checked against the patterns and for finite numbers.
 pub(crate) fn pieces(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Result<Vec<Piece>, PatternError> {
     let same = patterns.len() == nesting.placements.len()
@@ -100,7 +121,10 @@ pub(crate) fn pieces(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -
             given_names: patterns.iter().map(|p| p.ply.as_str()).collect::<Vec<_>>().join(", "),
         });
     }
-    let out: Vec<Piece> = patterns.iter().zip(&nesting.placements).map(|(p, q)| piece(p, q)).collect();
+    let mut out: Vec<Piece> = patterns.iter().zip(&nesting.placements).map(|(p, q)| piece(p, q)).collect();
+    for pc in &mut out {
+        keep_label_inside(pc, [0.0, 0.0], [nesting.length, nesting.roll_width]);
+    }
     for pc in &out {
         check_finite(pc, path)?;
     }

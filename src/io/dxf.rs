@@ -1,7 +1,8 @@
 //! DXF cutting plans (ASCII release 12, AC1009, the simplest release every reader takes): each
 //! loop of a flat pattern is a closed `POLYLINE` (flag 1) of `VERTEX`es, arrows are `LINE`s,
 //! labels `TEXT`; one layer per ply (its name made DXF-safe, see [`dxf_layer_names`]) holds that
-//! ply's loops, arrow and label, and layer `ROLL` the roll edges. Millimetres, said with
+//! ply's cut loops and nothing else, so a cutter cuts a layer as it is; the warp arrows are on
+//! layer `ARROWS`, the labels on `LABELS` and the roll edges on `ROLL`. Millimetres, said with
 //! `$INSUNITS = 4`. The picture is laid out by [`super::drawing`].
 use super::drawing::{mm, pieces, PatternError};
 use super::write_atomic;
@@ -10,14 +11,17 @@ use crate::layup::nest::Nesting;
 use std::io::{self, Write};
 use std::path::Path;
 
+/// The layers that are not plies' cut loops.
+const DXF_OTHER_LAYERS: [&str; 3] = ["ROLL", "ARROWS", "LABELS"];
+
 /// Longest layer name release 12 accepts.
 const DXF_LAYER_MAX: usize = 31;
 
 /// DXF layer names of the plies, in order: each name with characters other than ASCII letters,
 /// digits, `_`, `-` and `$` replaced by `_`, cut to 31 characters, and made unique (and distinct
-/// from `ROLL`) with a `_2`, `_3`... suffix.
+/// from `ROLL`, `ARROWS` and `LABELS`) with a `_2`, `_3`... suffix.
 pub fn dxf_layer_names(patterns: &[FlatPattern]) -> Vec<String> {
-    let mut taken = vec!["ROLL".to_string()];
+    let mut taken: Vec<String> = DXF_OTHER_LAYERS.iter().map(|l| l.to_string()).collect();
     let mut out = Vec::with_capacity(patterns.len());
     for p in patterns {
         let base: String = p
@@ -80,10 +84,10 @@ pub fn write_dxf(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Re
         g(0, "ENDTAB")?;
         g(0, "TABLE")?;
         g(2, "LAYER")?;
-        g(70, &(layers.len() + 1).to_string())?;
-        // ROLL in grey (8), plies in colours 1..6 in turn.
-        let colours = std::iter::once(8).chain((0..layers.len()).map(|k| 1 + k % 6));
-        for (name, colour) in std::iter::once("ROLL").chain(layers.iter().map(String::as_str)).zip(colours) {
+        g(70, &(layers.len() + DXF_OTHER_LAYERS.len()).to_string())?;
+        // ROLL in grey (8), arrows and labels in white/black (7), plies in colours 1..6 in turn.
+        let colours = [8, 7, 7].into_iter().chain((0..layers.len()).map(|k| 1 + k % 6));
+        for (name, colour) in DXF_OTHER_LAYERS.into_iter().chain(layers.iter().map(String::as_str)).zip(colours) {
             for (c, v) in [(0, "LAYER"), (2, name), (70, "0"), (62, &colour.to_string()), (6, "CONTINUOUS")] {
                 g(c, v)?;
             }
@@ -120,10 +124,10 @@ pub fn write_dxf(patterns: &[FlatPattern], nesting: &Nesting, path: &Path) -> Re
                 g(8, layer)?;
             }
             for s in &pc.arrow {
-                line(&mut g, layer, s[0], s[1])?;
+                line(&mut g, "ARROWS", s[0], s[1])?;
             }
             g(0, "TEXT")?;
-            g(8, layer)?;
+            g(8, "LABELS")?;
             g(10, &mm(pc.label_at[0]))?;
             g(20, &mm(pc.label_at[1]))?;
             g(30, "0")?;

@@ -7,6 +7,7 @@
 //! | [`vtk`] | | `<ply>.vtu`, the flow mesh with fibres (`flow.vtu`) |
 //! | [`csv`] | | `<ply>.cells.csv`, `flow.csv` |
 //! | [`obj`] | tools and flow meshes | OBJ text of a triangle mesh |
+//! | [`stl`] | tools and flow meshes (ASCII and binary) | ASCII and binary STL of a triangle mesh |
 //! | [`nastran`] | flow meshes and tools (bulk data) | THETA decks |
 //! | [`optistruct`], [`rtmsim`] | | ply-based decks, RTMsim mesh and parameters |
 //! | [`abaqus`] | flow meshes and tools (input decks) | orientation decks |
@@ -68,7 +69,7 @@ macro_rules! mesh_formats {
     };
 }
 
-mesh_formats!(nastran, abaqus, obj, gmsh);
+mesh_formats!(nastran, abaqus, obj, stl, gmsh);
 
 /// Read a shell mesh (a flow mesh, or a tool given as a mesh), choosing the reader by the file
 /// extension (case ignored, see [`MESH_FORMATS`]). Lengths are multiplied by `scale` (metres per

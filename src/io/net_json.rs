@@ -157,6 +157,11 @@ struct TimingFile {
     total: f64,
 }
 
+/// The largest coordinate of a net node, m: a thousand kilometres, beyond any part, and far
+/// below where squared distances overflow (a coordinate of 1e308 made every distance NaN or
+/// infinite and the mapping of `drape export` fail or run on without end).
+pub const MAX_NET_COORDINATE: f64 = 1e6;
+
 /// Read a net written by [`write_json`] back, checking that its arrays fit its grid and agree with
 /// each other (node null exactly where its code is not "placed", counts, cell nulls). The cell
 /// shears are checked for presence only: they are derived from the nodes, which are what is kept.
@@ -227,7 +232,17 @@ pub fn read_net(path: &Path) -> Result<DrapeNet, ExportError> {
             )
         })?;
         match (node, status) {
-            (Some(p), NodeStatus::Placed) => net.positions[k] = Point::new(p[0], p[1], p[2]),
+            (Some(p), NodeStatus::Placed) => {
+                if let Some(c) = p.iter().find(|c| !(c.abs() <= MAX_NET_COORDINATE)) {
+                    return Err(invalid(
+                        "nodes",
+                        format!(
+                            "gives node ({i}, {j}) the coordinate {c:e} m, beyond {MAX_NET_COORDINATE:e} m from the origin: no part is that large"
+                        ),
+                    ));
+                }
+                net.positions[k] = Point::new(p[0], p[1], p[2])
+            }
             (None, s) if s != NodeStatus::Placed => {}
             (Some(_), s) => {
                 return Err(invalid(

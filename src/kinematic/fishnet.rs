@@ -22,6 +22,11 @@ const COS_DIAGONAL: f64 = -0.95;
 const MAX_PARENT_GAP: f64 = 1.0 - 1e-12;
 /// Anti-diagonals shorter than this are filled on one thread (parallel overhead dominates).
 const PARALLEL_DIAGONAL: usize = 256;
+/// The smallest spacing, as a fraction of the tool's bounding-box diagonal. Points closer than
+/// [`crate::geometry::surface::WELD_TOLERANCE_REL`] of the diagonal are one point of the tool, so a spacing
+/// within a hundred of those is below what the tool resolves: such a net is a dot, and refining
+/// it mechanically runs for hours (every node in contact with the same triangles).
+pub const MIN_SPACING_REL: f64 = 1e-7;
 /// Bytes of memory per node while a net is being built (positions, triangle, status, quadrant copy).
 pub const BYTES_PER_NODE: usize = 2 * (24 + 4 + 1) + 8;
 
@@ -31,6 +36,18 @@ pub enum DrapeError {
     /// The spacing is not a positive length.
     #[error("spacing must be a positive length, got {0}. Give the fibre segment length d, e.g. --spacing 0.005")]
     Spacing(f64),
+    /// The spacing is far below the tool's precision.
+    #[error("spacing {spacing} is below what the tool resolves: at least {min:.3e}, {rel:e} of the tool's bounding-box diagonal ({diagonal:.6}). Give the spacing in the tool's units: a fibre segment of a few mm is usual, e.g. 0.005 for a tool in m")]
+    SpacingBelowTool {
+        /// The spacing given.
+        spacing: f64,
+        /// The smallest spacing for this tool.
+        min: f64,
+        /// [`MIN_SPACING_REL`].
+        rel: f64,
+        /// The tool's bounding-box diagonal.
+        diagonal: f64,
+    },
     /// The grid is smaller than 2 x 2.
     #[error("grid must be at least 2 x 2 nodes, got {0} x {1}")]
     GridTooSmall(usize, usize),
@@ -265,6 +282,7 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
     let start = Instant::now();
     check_settings(settings)?;
     let d = settings.spacing;
+    check_spacing_on_tool(tool, settings.spacing)?;
     let seed = tool.closest_point(&settings.origin);
     if !(seed.distance <= d) {
         let o = settings.origin;
@@ -359,6 +377,18 @@ pub fn check_settings(s: &KinematicSettings) -> Result<(), DrapeError> {
             }
         }
         check_memory(nu, nv)?;
+    }
+    Ok(())
+}
+
+/// The check of the settings against the tool: a spacing of at least [`MIN_SPACING_REL`] of the
+/// tool's size. [`drape`] runs it; a run checks every ply with it before draping any, and
+/// `drape refine` the net it reads.
+pub fn check_spacing_on_tool(tool: &ToolSurface, spacing: f64) -> Result<(), DrapeError> {
+    let (d, diagonal) = (spacing, tool.diagonal());
+    let min = MIN_SPACING_REL * diagonal;
+    if !(d >= min) {
+        return Err(DrapeError::SpacingBelowTool { spacing: d, min, rel: MIN_SPACING_REL, diagonal });
     }
     Ok(())
 }

@@ -16,7 +16,7 @@ use crate::io::drawing::{write_cutting_plan, PatternError};
 use crate::io::flow::write_flow;
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::{read_flow_mesh, read_tool, write_net, ExportError, Format, ReadToolError};
-use crate::kinematic::fishnet::{check_settings, DrapeError};
+use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeError};
 use crate::layup::flat::{flat_pattern_with_margin, FlatError};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::stack::{drape_layup, LayupError, PlyResult};
@@ -231,6 +231,14 @@ pub fn run(
     let tool = read_tool(&scene.tool, scene.scale).map_err(RunError::Tool)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     on(Event::ToolRead { path: &scene.tool, tool: &tool });
+    for ply in &scene.layup.plies {
+        check_spacing_on_tool(&tool, ply.settings.spacing).map_err(|error| RunError::Settings {
+            scene: scene.path.clone(),
+            ply: ply.settings.name.clone(),
+            line: ply.line,
+            error,
+        })?;
+    }
     let folder = prepare(out, replace)?;
     let mut written: Vec<PathBuf> = Vec::new();
     // Drape every ply first, so a bad ply is reported before any file is written.

@@ -3,7 +3,7 @@
 //!
 //! ```toml
 //! units = "m"                 # "m" (default) or "mm": lengths here and in the OBJ
-//! tool = "hemisphere-20k.obj" # relative to this file: OBJ, or a shell mesh (.inp .bdf .msh)
+//! tool = "hemisphere-20k.obj" # relative to this file: OBJ, STL, or a shell mesh (.inp .bdf .msh)
 //! reference = [1.0, 0.0, 0.0] # optional: the 0 deg direction of ply angles (default +x)
 //! stack_side = "normal"       # optional: plies stack on the side the tool normals point to
 //!                             # ("normal", default) or the other ("opposite")
