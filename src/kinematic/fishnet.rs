@@ -8,6 +8,7 @@ use super::net::{corner_shear, DrapeNet, Method, NodeStatus};
 use super::{Extent, KinematicSettings};
 use crate::geometry::surface::{Circle, CircleRoot};
 use crate::geometry::{Point, ToolSurface, Vector};
+use crate::io::net_json::MAX_NET_COORDINATE;
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::time::Instant;
@@ -47,6 +48,18 @@ pub enum DrapeError {
         rel: f64,
         /// The tool's bounding-box diagonal.
         diagonal: f64,
+    },
+    /// The origin lies beyond any part ([`MAX_NET_COORDINATE`] from the coordinate origin).
+    #[error("the origin ({x}, {y}, {z}) lies beyond {max:e} from the coordinate origin: no part is that large. Give the seed point on the tool, in the tool's units")]
+    OriginFar {
+        /// The seed: x,
+        x: f64,
+        /// y
+        y: f64,
+        /// and z.
+        z: f64,
+        /// [`MAX_NET_COORDINATE`].
+        max: f64,
     },
     /// The grid is smaller than 2 x 2.
     #[error("grid must be at least 2 x 2 nodes, got {0} x {1}")]
@@ -364,8 +377,15 @@ pub fn check_settings(s: &KinematicSettings) -> Result<(), DrapeError> {
     if !(s.max_shear > 0.0 && s.max_shear < std::f64::consts::FRAC_PI_2) {
         return Err(DrapeError::MaxShear(s.max_shear.to_degrees()));
     }
-    if s.warp.norm() == 0.0 {
+    // A warp of 1e308 has an infinite norm and normalizes to zero.
+    if !(s.warp.norm() > 0.0 && s.warp.norm().is_finite()) {
         return Err(DrapeError::WarpNormal([s.warp.x, s.warp.y, s.warp.z]));
+    }
+    // Distances to a point at 1e308 overflow: the closest-point search finds nothing (a panic
+    // in parry, found by the mutation harness).
+    if !s.origin.iter().all(|c| c.abs() <= MAX_NET_COORDINATE) {
+        let o = s.origin;
+        return Err(DrapeError::OriginFar { x: o.x, y: o.y, z: o.z, max: MAX_NET_COORDINATE });
     }
     if let Extent::Grid { nu, nv, origin_node } = s.extent {
         if nu < 2 || nv < 2 {
