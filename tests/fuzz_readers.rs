@@ -168,6 +168,20 @@ fn mutate(rng: &mut Rng, input: &[u8]) -> (Vec<u8>, String) {
 /// A reader under test: reads the file at the path, Ok or a message.
 type Read = fn(&Path) -> Result<(), String>;
 
+/// The generator of `reader`'s mutants.
+fn reader_rng(reader: &str, seed: u64) -> Rng {
+    Rng(seed ^ reader.bytes().fold(0u64, |h, c| h.wrapping_mul(31).wrapping_add(c as u64)))
+}
+
+/// Mutant number `case` of a run of `reader` with `seed`, as [`fuzz`] makes it.
+fn mutant(reader: &str, inputs: &[(String, Vec<u8>)], seed: u64, case: usize) -> Vec<u8> {
+    let mut rng = reader_rng(reader, seed);
+    for k in 0..case {
+        mutate(&mut rng, &inputs[k % inputs.len()].1);
+    }
+    mutate(&mut rng, &inputs[case % inputs.len()].1).0
+}
+
 /// The case running now, for the watchdog: its number (u64::MAX when none) and its description.
 struct Running {
     case: AtomicU64,
@@ -195,7 +209,7 @@ fn fuzz(reader: &str, inputs: &[(String, Vec<u8>)], file: &Path, read: Read, cas
             }
         })
     };
-    let mut rng = Rng(seed ^ reader.bytes().fold(0u64, |h, c| h.wrapping_mul(31).wrapping_add(c as u64)));
+    let mut rng = reader_rng(reader, seed);
     let mut failures = Vec::new();
     for case in 0..cases {
         let (name, input) = &inputs[case % inputs.len()];
@@ -259,15 +273,19 @@ fn fuzz_obj() {
     fuzz_files("obj", "obj", &inputs, shell_mesh);
 }
 
-#[test]
-fn fuzz_stl() {
+fn stl_inputs() -> Vec<(String, Vec<u8>)> {
     let mut inputs = Vec::new();
     for p in ["tests/data/flowmesh/plate.obj", "geometries/square-table/square-table.obj"] {
         let (mesh, _) = drape::io::obj::read_obj(&root().join(p)).unwrap();
         inputs.push((format!("{p} as ASCII STL"), mesh.to_stl_ascii("part").into_bytes()));
         inputs.push((format!("{p} as binary STL"), mesh.to_stl_binary()));
     }
-    fuzz_files("stl", "stl", &inputs, shell_mesh);
+    inputs
+}
+
+#[test]
+fn fuzz_stl() {
+    fuzz_files("stl", "stl", &stl_inputs(), shell_mesh);
 }
 
 #[test]
@@ -461,4 +479,27 @@ fn a_scene_grid_beyond_memory_is_refused_when_read() {
     let Err(e) = Scene::load(&p) else { panic!("read") };
     let e = e.to_string();
     assert!(e.contains("field `grid`") && e.contains("MB of memory"), "{e}");
+}
+
+/// Found by the harness: corners at 1e-320 beside corners at 0 (triangles whose centres differ by
+/// a subnormal number) made parry's BVH build index a bin at infinity; and a fold row of
+/// 2^64 - 1 wrapped past the check that it lies inside the grid.
+#[test]
+fn subnormal_corners_and_a_fold_row_beyond_the_grid_are_read_without_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    // Seed 7, case 9030: a line duplicated, a coordinate set to 1e-320 and one to -4e-12.
+    let p = dir.path().join("case.stl");
+    std::fs::write(&p, mutant("stl", &stl_inputs(), 7, 9030)).unwrap();
+    assert!(shell_mesh(&p).is_ok());
+    let text = std::fs::read_to_string(root().join("geometries/sphere/fold.toml")).unwrap();
+    let card = root().join("materials/sze-liu-table1.toml");
+    let text = text.replace("\"../../materials/sze-liu-table1.toml\"", &format!("{card:?}")).replacen(
+        "row = ",
+        "row = 18446744073709551615 # ",
+        1,
+    );
+    let p = dir.path().join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    let Err(e) = Scene::load(&p) else { panic!("read") };
+    assert!(e.to_string().contains("fold at row 18446744073709551615"), "{e}");
 }
