@@ -8,7 +8,6 @@ use super::net::{corner_shear, DrapeNet, Method, NodeStatus};
 use super::{Extent, KinematicSettings};
 use crate::geometry::surface::{Circle, CircleRoot};
 use crate::geometry::{Point, ToolSurface, Vector};
-use crate::io::net_json::MAX_NET_COORDINATE;
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::time::Instant;
@@ -28,6 +27,10 @@ const PARALLEL_DIAGONAL: usize = 256;
 /// within a hundred of those is below what the tool resolves: such a net is a dot, and refining
 /// it mechanically runs for hours (every node in contact with the same triangles).
 pub const MIN_SPACING_REL: f64 = 1e-7;
+/// The largest coordinate of an origin or net node, m: a thousand kilometres, beyond any part,
+/// and far below where squared distances overflow (`io::net_json::MAX_NET_COORDINATE` is this).
+pub const MAX_COORDINATE: f64 = 1e6;
+
 /// Bytes of memory per node while a net is being built (positions, triangle, status, quadrant copy).
 pub const BYTES_PER_NODE: usize = 2 * (24 + 4 + 1) + 8;
 
@@ -49,7 +52,7 @@ pub enum DrapeError {
         /// The tool's bounding-box diagonal.
         diagonal: f64,
     },
-    /// The origin lies beyond any part ([`MAX_NET_COORDINATE`] from the coordinate origin).
+    /// The origin lies beyond any part ([`MAX_COORDINATE`] from the coordinate origin).
     #[error("the origin ({x}, {y}, {z}) lies beyond {max:e} from the coordinate origin: no part is that large. Give the seed point on the tool, in the tool's units")]
     OriginFar {
         /// The seed: x,
@@ -58,7 +61,7 @@ pub enum DrapeError {
         y: f64,
         /// and z.
         z: f64,
-        /// [`MAX_NET_COORDINATE`].
+        /// [`MAX_COORDINATE`].
         max: f64,
     },
     /// The grid is smaller than 2 x 2.
@@ -383,9 +386,9 @@ pub fn check_settings(s: &KinematicSettings) -> Result<(), DrapeError> {
     }
     // Distances to a point at 1e308 overflow: the closest-point search finds nothing (a panic
     // in parry, found by the mutation harness).
-    if !s.origin.iter().all(|c| c.abs() <= MAX_NET_COORDINATE) {
+    if !s.origin.iter().all(|c| c.abs() <= MAX_COORDINATE) {
         let o = s.origin;
-        return Err(DrapeError::OriginFar { x: o.x, y: o.y, z: o.z, max: MAX_NET_COORDINATE });
+        return Err(DrapeError::OriginFar { x: o.x, y: o.y, z: o.z, max: MAX_COORDINATE });
     }
     if let Extent::Grid { nu, nv, origin_node } = s.extent {
         if nu < 2 || nv < 2 {
