@@ -634,6 +634,10 @@ fn set_str<'a>(args: &mut [&'a str], flag: &str, value: &'a str) {
 fn a_net_coordinate_beyond_any_part_and_a_spacing_below_the_tool_are_refused() {
     // A spacing far below what the tool resolves (the plate's diagonal is 1.4 m).
     refused(|a| set(a, "--spacing", "4e-12"), "below what");
+    // An origin at 1e308 m (found by tests/fuzz_readers.rs: parry's closest-point search
+    // panicked) and a warp whose length overflows.
+    refused(|a| set(a, "--origin", "0,0,-1e308"), "beyond 1e6");
+    refused(|a| set(a, "--warp", "1e308,1e308,0"), "warp direction");
     let dir = tempfile::tempdir().unwrap();
     let tool = plate_obj(dir.path());
     let scene = dir.path().join("scene.toml");

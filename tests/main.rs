@@ -17,6 +17,7 @@ mod flat_patterns;
 mod flow_export;
 mod flow_writers;
 mod flowmesh_readers;
+mod fuzz_readers;
 mod layup;
 mod material_cli;
 mod mechanics_cantilever;

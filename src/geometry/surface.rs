@@ -120,8 +120,9 @@ impl ToolSurface {
     /// Check and mend `mesh` (read from `path`, with what reading it found in `report`) and build
     /// the surface: welding, degenerate and duplicate faces, adjacency, orientation
     /// ([`super::check::mend`]), then the BVH.
-    pub fn from_mesh(raw: TriangleMesh, mut report: MeshReport, path: &Path) -> Result<Self, ToolError> {
+    pub fn from_mesh(mut raw: TriangleMesh, mut report: MeshReport, path: &Path) -> Result<Self, ToolError> {
         let diagonal = bounding_diagonal(&raw.vertices);
+        snap_coordinates(&mut raw.vertices, diagonal);
         let MendedMesh { vertices, triangles, neighbours } =
             mend(raw, WELD_TOLERANCE_REL * diagonal, path, &mut report)?;
         if triangles.is_empty() {
@@ -339,6 +340,24 @@ impl ToolSurface {
                 break;
             }
         }
+    }
+}
+
+/// Round every coordinate to a multiple of a power of two 2^-80 of the bounding-box diagonal
+/// (about 1e-24 of it, far below the weld tolerance): coordinates beyond 2^-28 of the diagonal
+/// are exact multiples already and do not change. Without it two triangles whose centres
+/// differed by a subnormal number (a corner at 1e-320 beside one at 0) made parry's BVH build
+/// divide by that difference and index a bin at infinity (a panic found by the mutation harness).
+/// A mesh smaller than the smallest step (2^-1000 m) collapses and is refused as degenerate.
+fn snap_coordinates(points: &mut [Point], diagonal: f64) {
+    if !(diagonal.is_finite() && diagonal > 0.0) {
+        return;
+    }
+    let step = 2f64.powi(diagonal.log2().floor() as i32 - 80).max(2f64.powi(-1000));
+    // Beyond 2^52 steps a coordinate is a multiple of the step already (and dividing might overflow).
+    let exact = step * 2f64.powi(52);
+    for c in points.iter_mut().flat_map(|p| p.coords.iter_mut()).filter(|c| c.abs() < exact) {
+        *c = (*c / step).round() * step;
     }
 }
 

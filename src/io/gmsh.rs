@@ -87,7 +87,15 @@ pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                 for _ in 0..blocks {
                     let (no, l) = c.need(&b, "a node block header")?;
                     let h = ints(&b, l, no, 4)?;
-                    let (dim, parametric, n) = (h[0], h[2], h[3] as usize);
+                    let (dim, parametric) = (h[0], h[2]);
+                    // Each node takes two lines: a count beyond the file is refused before it
+                    // sizes anything (a mutated count of 2^63 asked for the memory).
+                    let n = usize::try_from(h[3]).ok().filter(|&n| n <= c.remaining()).ok_or_else(|| {
+                        b.syntax(
+                            Loc { file: 0, line: no },
+                            format!("node block of {} nodes: the file has {} lines left", h[3], c.remaining()),
+                        )
+                    })?;
                     let mut tags = Vec::with_capacity(n);
                     for _ in 0..n {
                         let (no, l) = c.need(&b, "a node tag")?;
@@ -121,7 +129,13 @@ pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
                 for _ in 0..blocks {
                     let (no, l) = c.need(&b, "an element block header")?;
                     let h = ints(&b, l, no, 4)?;
-                    let (dim, tag, kind, n) = (h[0], h[1], h[2], h[3] as usize);
+                    let (dim, tag, kind) = (h[0], h[1], h[2]);
+                    let n = usize::try_from(h[3]).ok().filter(|&n| n <= c.remaining()).ok_or_else(|| {
+                        b.syntax(
+                            Loc { file: 0, line: no },
+                            format!("element block of {} elements: the file has {} lines left", h[3], c.remaining()),
+                        )
+                    })?;
                     let corners = match kind {
                         2 => Some(3),
                         3 => Some(4),
@@ -166,6 +180,11 @@ struct Lines<'a> {
 }
 
 impl<'a> Lines<'a> {
+    /// How many lines (blank ones too) are left.
+    fn remaining(&self) -> usize {
+        self.lines.len() - self.next
+    }
+
     /// Next non-blank line, trimmed, with its 1-based number.
     fn next_line(&mut self) -> Option<(usize, &'a str)> {
         while self.next < self.lines.len() {

@@ -160,7 +160,7 @@ struct TimingFile {
 /// The largest coordinate of a net node, m: a thousand kilometres, beyond any part, and far
 /// below where squared distances overflow (a coordinate of 1e308 made every distance NaN or
 /// infinite and the mapping of `drape export` fail or run on without end).
-pub const MAX_NET_COORDINATE: f64 = 1e6;
+pub const MAX_NET_COORDINATE: f64 = crate::kinematic::fishnet::MAX_COORDINATE;
 
 /// Read a net written by [`write_json`] back, checking that its arrays fit its grid and agree with
 /// each other (node null exactly where its code is not "placed", counts, cell nulls). The cell

@@ -27,6 +27,10 @@ const PARALLEL_DIAGONAL: usize = 256;
 /// within a hundred of those is below what the tool resolves: such a net is a dot, and refining
 /// it mechanically runs for hours (every node in contact with the same triangles).
 pub const MIN_SPACING_REL: f64 = 1e-7;
+/// The largest coordinate of an origin or net node, m: a thousand kilometres, beyond any part,
+/// and far below where squared distances overflow (`io::net_json::MAX_NET_COORDINATE` is this).
+pub const MAX_COORDINATE: f64 = 1e6;
+
 /// Bytes of memory per node while a net is being built (positions, triangle, status, quadrant copy).
 pub const BYTES_PER_NODE: usize = 2 * (24 + 4 + 1) + 8;
 
@@ -47,6 +51,18 @@ pub enum DrapeError {
         rel: f64,
         /// The tool's bounding-box diagonal.
         diagonal: f64,
+    },
+    /// The origin lies beyond any part ([`MAX_COORDINATE`] from the coordinate origin).
+    #[error("the origin ({x}, {y}, {z}) lies beyond {max:e} from the coordinate origin: no part is that large. Give the seed point on the tool, in the tool's units")]
+    OriginFar {
+        /// The seed: x,
+        x: f64,
+        /// y
+        y: f64,
+        /// and z.
+        z: f64,
+        /// [`MAX_COORDINATE`].
+        max: f64,
     },
     /// The grid is smaller than 2 x 2.
     #[error("grid must be at least 2 x 2 nodes, got {0} x {1}")]
@@ -364,8 +380,15 @@ pub fn check_settings(s: &KinematicSettings) -> Result<(), DrapeError> {
     if !(s.max_shear > 0.0 && s.max_shear < std::f64::consts::FRAC_PI_2) {
         return Err(DrapeError::MaxShear(s.max_shear.to_degrees()));
     }
-    if s.warp.norm() == 0.0 {
+    // A warp of 1e308 has an infinite norm and normalizes to zero.
+    if !(s.warp.norm() > 0.0 && s.warp.norm().is_finite()) {
         return Err(DrapeError::WarpNormal([s.warp.x, s.warp.y, s.warp.z]));
+    }
+    // Distances to a point at 1e308 overflow: the closest-point search finds nothing (a panic
+    // in parry, found by the mutation harness).
+    if !s.origin.iter().all(|c| c.abs() <= MAX_COORDINATE) {
+        let o = s.origin;
+        return Err(DrapeError::OriginFar { x: o.x, y: o.y, z: o.z, max: MAX_COORDINATE });
     }
     if let Extent::Grid { nu, nv, origin_node } = s.extent {
         if nu < 2 || nv < 2 {

@@ -218,7 +218,7 @@ impl SheetFeatures {
             }
         }
         if let Some(fold) = self.fold {
-            if fold.row == 0 || fold.row + 1 >= nu {
+            if fold.row == 0 || fold.row >= nu.saturating_sub(1) {
                 return Err(SheetError(format!(
                     "a fold at row {} has no row on one side of it: give a row between 1 and {}",
                     fold.row,

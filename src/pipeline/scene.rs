@@ -66,6 +66,7 @@ use super::{parse_generators, unit_scale};
 use crate::geometry::{Point, Vector};
 use crate::io::flow::FlowFormat;
 use crate::io::points::read_points;
+use crate::kinematic::fishnet::check_memory;
 use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
 use crate::layup::{
     locking_angle_deg, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_SOLVER_ITERATIONS,
@@ -415,7 +416,7 @@ impl Scene {
         let v = |a: [f64; 3]| Vector::new(a[0], a[1], a[2]);
         let reference = match file.reference {
             None => Vector::x(),
-            Some(r) if r.iter().all(|x| x.is_finite()) && v(r).norm() > 0.0 => v(r).normalize(),
+            Some(r) if v(r).norm().is_finite() && v(r).norm() > 0.0 => v(r).normalize(),
             Some(r) => {
                 return Err(invalid(format!(
                     "field `reference`: must be a non-zero vector of three finite numbers, got {r:?}"
@@ -517,6 +518,8 @@ impl Scene {
                     if nu < 2 || nv < 2 {
                         return Err(at("grid", format!("needs at least 2 x 2 nodes, got {nu} x {nv}")));
                     }
+                    // Before anything is sized by the grid (sheet features lay out per node).
+                    check_memory(nu, nv).map_err(|e| at("grid", e.to_string()))?;
                     Extent::Grid { nu, nv, origin_node: p.origin_node.map(|[i, j]| (i, j)) }
                 }
                 (None, Some(points), None) => {
