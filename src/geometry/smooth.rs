@@ -348,16 +348,21 @@ impl<'a> SmoothSurface<'a> {
         // A region's implicit surface runs on past its sharp edges (a table's top continues as a
         // plane beyond the rim): where the point found lies across such an edge of the facet under
         // the query, the query is beyond the region and the nearest tool is that edge.
+        // Only a query on the outer side of its facet: one inside the tool next to a convex edge
+        // is off both faces inwards and goes back out through the surface.
+        let (off_n, off_t) = (foot.normal.dot(&off), (off - foot.normal * foot.normal.dot(&off)).norm());
+        let outside = off_n >= -BOUNDARY_TOLERANCE_REL * self.tool.diagonal();
         let lp = self.tool.barycentric(foot.triangle, &p);
-        let beyond_crease = (0..3).any(|k| {
-            lp[k] < -CREASE_OVERSHOOT_BARYCENTRIC
-                && self.tool.neighbour(foot.triangle, k).is_some_and(|n| self.regions[n as usize] != region)
-        });
+        let beyond_crease = outside
+            && (0..3).any(|k| {
+                lp[k] < -CREASE_OVERSHOOT_BARYCENTRIC
+                    && self.tool.neighbour(foot.triangle, k).is_some_and(|n| self.regions[n as usize] != region)
+            });
         // Off a region's smooth part the query lies within the normals of its facets (which
         // differ by less than the crease angle): a query off its facet at a steeper angle is
         // beyond a sharp edge or corner (a sheet's node beside a table's corner).
-        let (off_n, off_t) = (foot.normal.dot(&off), (off - foot.normal * foot.normal.dot(&off)).norm());
-        let beyond_edge_or_corner = off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
+        let beyond_edge_or_corner = outside
+            && off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
             && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
         SmoothPoint {
             point: p,
@@ -541,7 +546,12 @@ mod tests {
             let s = smooth.project(&q);
             assert!(s.beyond_region, "{q} is beyond the rim");
         }
-        for q in [Point::new(0.01, 0.02, 0.004), Point::new(0.058, 0.01, -0.03), Point::new(0.049, 0.0, 1e-12)] {
+        for q in [
+            Point::new(0.01, 0.02, 0.004),
+            Point::new(0.058, 0.01, -0.03),
+            Point::new(0.049, 0.0, 1e-12),
+            Point::new(0.0495, 0.01, -0.0005),
+        ] {
             let s = smooth.project(&q);
             assert!(!s.beyond_region, "{q} is over a face");
             let f = tool.closest_point(&q);
