@@ -49,7 +49,7 @@
 //! Abaqus takes local 1 = a projected onto the shell and local 2 in the plane of a and b, so
 //! local 1 is the warp; b = weft keeps the sheared weft in the file (angle a-b = 90 - shear).
 //! Reference the orientation from your *SHELL SECTION / *SHELL SECTION, COMPOSITE on ELSET `<TAG>`.
-use super::calculix::short;
+use super::calculix::{elset, short};
 use super::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
 use super::{write_atomic, ExportError};
 use crate::mapping::{FlowMesh, LayupMap};
@@ -455,8 +455,6 @@ fn add(
 
 /// Name of the shared distribution table.
 pub const TABLE: &str = "DRAPE_DIRECTIONS";
-/// Abaqus allows at most 16 entries on a data line of *ELSET.
-const PER_LINE: usize = 16;
 
 pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
     write_atomic(out, |w| write_flow_to(mesh, map, w))
@@ -511,11 +509,3 @@ fn write_flow_to<W: Write>(mesh: &FlowMesh, map: &LayupMap, w: &mut W) -> io::Re
     Ok(())
 }
 
-fn elset<W: Write>(w: &mut W, name: &str, ids: &[u64]) -> io::Result<()> {
-    writeln!(w, "*ELSET, ELSET={name}")?;
-    for chunk in ids.chunks(PER_LINE) {
-        let s: Vec<String> = chunk.iter().map(u64::to_string).collect();
-        writeln!(w, "{}", s.join(", "))?;
-    }
-    Ok(())
-}

@@ -150,7 +150,8 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, material: &str, w: &mut W
     Ok(())
 }
 
-fn elset<W: Write>(w: &mut W, name: &str, ids: &[u64]) -> io::Result<()> {
+/// An `*ELSET` of the element ids, [`PER_LINE`] to a data line. Shared with the Abaqus writer.
+pub(crate) fn elset<W: Write>(w: &mut W, name: &str, ids: &[u64]) -> io::Result<()> {
     writeln!(w, "*ELSET, ELSET={name}")?;
     for chunk in ids.chunks(PER_LINE) {
         let s: Vec<String> = chunk.iter().map(u64::to_string).collect();
