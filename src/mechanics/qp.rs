@@ -285,10 +285,6 @@ pub enum QpFailure {
 #[derive(Default)]
 pub struct QpEngine {
     cached: Option<(Vec<u8>, DefaultSolver<f64>)>,
-    /// Solvers built (patterns seen), for the log.
-    pub builds: usize,
-    /// Subproblems solved.
-    pub solves: usize,
     /// Time spent in Clarabel (set-up, updates and solves), ms.
     pub time_ms: f64,
 }
@@ -341,11 +337,9 @@ impl QpEngine {
             let cones: Vec<SupportedConeT<f64>> = Vec::new();
             let solver = DefaultSolver::new(&p, q, &a, &[], &cones, Self::settings(n)).map_err(|_| QpFailure::Setup)?;
             self.cached = Some((red.key().to_vec(), solver));
-            self.builds += 1;
         }
         let (_, solver) = self.cached.as_mut().expect("a solver is cached");
         solver.solve();
-        self.solves += 1;
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
                 let y = solver.solution.x.clone();
