@@ -15,9 +15,24 @@ fn repo(rel: &str) -> PathBuf {
 
 /// Drapes the scene text (tool and cards given relative to the repository) and returns the tool
 /// and the plies.
+/// The text with `@/` standing for the repository's folder.
+fn resolve(text: &str) -> String {
+    text.replace("@/", &format!("{}/", env!("CARGO_MANIFEST_DIR")))
+}
+
+/// The bundled square-table scene's text with its tool and cards given from the repository
+/// (`@/`, which [`drape_text`] resolves) and `replacements` applied.
+fn square_table_text(replacements: &[(&str, &str)]) -> String {
+    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
+        .unwrap()
+        .replace("\"square-table.obj\"", "\"@/geometries/square-table/square-table.obj\"")
+        .replace("../../materials", "@/materials");
+    replacements.iter().fold(text, |t, (from, to)| t.replace(from, to))
+}
+
 fn drape_text(text: &str) -> (ToolSurface, Vec<PlyResult>) {
     let dir = tempfile::tempdir().unwrap();
-    let text = text.replace("@/", &format!("{}/", env!("CARGO_MANIFEST_DIR")));
+    let text = resolve(text);
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, text).unwrap();
     drape_file(&path)
@@ -95,12 +110,7 @@ fn the_square_table_scene_drapes_the_whole_sheet_and_converges_with_the_mesh() {
     // quarter models indistinguishable).
     let (_, fine) = drape_file(&repo("geometries/square-table/scene.toml"));
     assert!(converged(&fine[0]));
-    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
-        .unwrap()
-        .replace("\"square-table.obj\"", "\"@/geometries/square-table/square-table.obj\"")
-        .replace("../../materials", "@/materials")
-        .replace("spacing = 0.005", "spacing = 0.004")
-        .replace("grid = [41, 41]", "grid = [51, 51]");
+    let text = square_table_text(&[("spacing = 0.005", "spacing = 0.004"), ("grid = [41, 41]", "grid = [51, 51]")]);
     let (_, coarse) = drape_text(&text);
     assert!(converged(&coarse[0]));
     for r in [&fine[0], &coarse[0]] {
@@ -204,11 +214,7 @@ mode = "pressed"
 #[test]
 fn a_ply_that_did_not_converge_is_marked_everywhere_and_the_run_exits_1() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
-        .unwrap()
-        .replace("\"square-table.obj\"", &format!("\"{}\"", repo("geometries/square-table/square-table.obj").display()))
-        .replace("../../materials", &repo("materials").display().to_string())
-        .replace("max_iterations = 2000", "max_iterations = 2");
+    let text = resolve(&square_table_text(&[("max_iterations = 2000", "max_iterations = 2")]));
     let scene = dir.path().join("scene.toml");
     std::fs::write(&scene, text).unwrap();
     let out = dir.path().join("out");
@@ -234,12 +240,7 @@ fn a_ply_that_did_not_converge_is_marked_everywhere_and_the_run_exits_1() {
 
 #[test]
 fn a_free_drape_is_the_same_on_one_thread_and_on_two() {
-    let text = std::fs::read_to_string(repo("geometries/square-table/scene.toml"))
-        .unwrap()
-        .replace("\"square-table.obj\"", "\"@/geometries/square-table/square-table.obj\"")
-        .replace("../../materials", "@/materials")
-        .replace("spacing = 0.005", "spacing = 0.01")
-        .replace("grid = [41, 41]", "grid = [21, 21]");
+    let text = square_table_text(&[("spacing = 0.005", "spacing = 0.01"), ("grid = [41, 41]", "grid = [21, 21]")]);
     let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| drape_text(&text).1.remove(0))
