@@ -23,6 +23,7 @@ pub mod mechanics;
 pub mod numeric;
 pub mod pipeline;
 pub mod report;
+pub mod study;
 
 pub use geometry::ToolSurface;
 pub use kinematic::{drape, DrapeNet, KinematicSettings};

@@ -31,3 +31,4 @@ mod net_properties;
 mod offset_bladelike;
 mod report;
 mod sphere_chebyshev;
+mod study;

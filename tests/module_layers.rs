@@ -17,6 +17,7 @@ const LAYERS: &[&str] = &[
     "mapping",
     "io",
     "pipeline",
+    "study",
     "report",
     "cli",
 ];

@@ -7,6 +7,7 @@ mod progress;
 mod refine;
 mod report;
 mod run;
+mod study;
 mod summary;
 mod virtual_test;
 
@@ -96,6 +97,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Draw every ply of a run folder (shear maps, histograms, changes) and write an HTML page.
     Report(report::ReportArgs),
+    /// Studies of one ply: speed against accuracy, where methods fail; sharded, resumable.
+    Study(study::StudyArgs),
 }
 
 /// Run a parsed command line.
@@ -109,6 +112,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Export(a) => export::run(a),
         Command::Report(a) => report::run(a),
+        Command::Study(a) => study::run(a),
     }
 }
 

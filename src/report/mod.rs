@@ -16,6 +16,7 @@
 pub mod change;
 mod html;
 mod render;
+pub mod study;
 mod view;
 
 pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL_TRIANGLE_LIMIT, WIDTH};

@@ -1,0 +1,258 @@
+//! `drape study`: speed against accuracy, stability maps, shards, merging and Slurm arrays. The
+//! studies live in [`crate::study`], their pictures in [`crate::report::study`].
+use super::{compute, input, Failure};
+use crate::pipeline::Scene;
+use crate::study::stability::{self, Parameter};
+use crate::study::{self as st, speed_accuracy, Finished, Plan, Shard, StudyError};
+use clap::{Args, Subcommand};
+use std::path::{Path, PathBuf};
+
+/// Arguments of `drape study`.
+#[derive(Debug, Args)]
+pub struct StudyArgs {
+    #[command(subcommand)]
+    pub command: StudyCommand,
+}
+
+/// The studies.
+#[derive(Debug, Subcommand)]
+pub enum StudyCommand {
+    /// Every method at a range of spacings: error against time, and the Pareto front.
+    SpeedAccuracy(SpeedAccuracyArgs),
+    /// Sweep the conditions that break drape methods and map the outcomes.
+    Stability(StabilityArgs),
+    /// Join shard folders into one study folder.
+    Merge(MergeArgs),
+    /// Run one shard of a study's plan (what a Slurm array task runs).
+    #[command(hide = true)]
+    Shard(ShardArgs),
+}
+
+/// What every study takes.
+#[derive(Debug, Args)]
+pub struct Common {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Study folder: `study.json`, `cases/`, the result file and its charts. Run again into the
+    /// same folder to resume.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The ply studied (default: the scene's first).
+    #[arg(long)]
+    pub ply: Option<String>,
+    /// Further resolutions of the tool, comma-separated files in the scene's units.
+    #[arg(long, value_delimiter = ',')]
+    pub tools: Vec<PathBuf>,
+    /// Cases run at once (default: the machine's cores). Times are per case, so use 1 for
+    /// timings free of other cases.
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Run only shard K of N (K/N); `drape study merge` joins the shards' folders.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// Write `OUT/study.sbatch`, a Slurm job array of this many shards that merges itself, and
+    /// stop (submit it with sbatch).
+    #[arg(long)]
+    pub slurm: Option<usize>,
+}
+
+/// Arguments of `drape study speed-accuracy`.
+#[derive(Debug, Args)]
+pub struct SpeedAccuracyArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Spacings of the kinematic methods, comma-separated, in the scene's units (default: 2, 1,
+    /// 1/2 and 1/4 of the ply's).
+    #[arg(long, value_delimiter = ',')]
+    pub spacings: Vec<f64>,
+    /// Spacings of the mechanical methods (default: 2 and 1 times the ply's).
+    #[arg(long, value_delimiter = ',')]
+    pub mechanical_spacings: Vec<f64>,
+    /// Timed repeats of each kinematic case (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+}
+
+/// Arguments of `drape study stability`.
+#[derive(Debug, Args)]
+pub struct StabilityArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Parameters swept, comma-separated: spacing, angle, seed_u, seed_v, pre_shear, locking,
+    /// tool, stiffness_ratio, load_steps (default: every one that applies to the ply).
+    #[arg(long, value_delimiter = ',')]
+    pub params: Vec<String>,
+    /// The two parameters of the outcome map (swept over their whole product).
+    #[arg(long, default_value = "spacing,angle")]
+    pub axes: String,
+}
+
+/// Arguments of `drape study merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The shard folders.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// The merged study folder.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Arguments of `drape study shard`.
+#[derive(Debug, Args)]
+pub struct ShardArgs {
+    /// A study's `study.json`.
+    pub plan: PathBuf,
+    /// Which shard, K/N.
+    #[arg(long)]
+    pub shard: String,
+    /// The shard's folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Cases run at once.
+    #[arg(long)]
+    pub jobs: Option<usize>,
+}
+
+fn study_failure(e: StudyError) -> Failure {
+    match e {
+        StudyError::Input(_) => input(e),
+        StudyError::Write(_) => compute(e),
+    }
+}
+
+fn jobs(j: Option<usize>) -> usize {
+    j.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1)
+}
+
+/// Run `drape study`.
+pub fn run(a: StudyArgs) -> Result<(), Failure> {
+    match a.command {
+        StudyCommand::SpeedAccuracy(s) => {
+            let scene = Scene::load(&s.common.scene).map_err(input)?;
+            let none_if_empty = |v: Vec<f64>| (!v.is_empty()).then(|| v.iter().map(|d| d * scene.scale).collect());
+            let opts = speed_accuracy::Options {
+                ply: s.common.ply.clone(),
+                spacings: none_if_empty(s.spacings),
+                mechanical_spacings: none_if_empty(s.mechanical_spacings),
+                tools: s.common.tools.clone(),
+                repeats: s.repeats,
+            };
+            let plan = speed_accuracy::plan(&scene, &opts).map_err(study_failure)?;
+            execute(&plan, &s.common)
+        }
+        StudyCommand::Stability(s) => {
+            let scene = Scene::load(&s.common.scene).map_err(input)?;
+            let parse = |n: &str| Parameter::parse(n).map_err(|m| input(anyhow::anyhow!(m)));
+            let parameters = if s.params.is_empty() {
+                None
+            } else {
+                Some(s.params.iter().map(|p| parse(p)).collect::<Result<Vec<_>, _>>()?)
+            };
+            let axes: Vec<&str> = s.axes.split(',').collect();
+            let [a0, a1] = axes[..] else {
+                return Err(input(anyhow::anyhow!("--axes: give two parameters, like spacing,angle")));
+            };
+            let opts = stability::Options {
+                ply: s.common.ply.clone(),
+                parameters,
+                axes: Some([parse(a0)?, parse(a1)?]),
+                tools: s.common.tools.clone(),
+            };
+            let plan = stability::plan_for(&scene, &opts).map_err(study_failure)?;
+            execute(&plan, &s.common)
+        }
+        StudyCommand::Merge(m) => {
+            st::runner::merge(&m.shards, &m.out).map_err(study_failure)?;
+            println!("merged {} shard folders into {}", m.shards.len(), m.out.display());
+            let finished = st::finish(&m.out).map_err(study_failure)?;
+            report(&m.out, finished)
+        }
+        StudyCommand::Shard(s) => {
+            let shard = Shard::parse(&s.shard).map_err(|m| input(anyhow::anyhow!("--shard: {m}")))?;
+            let dir = s.plan.parent().unwrap_or(Path::new("."));
+            let plan = st::runner::read_plan(dir).map_err(study_failure)?;
+            run_shard(&plan, &s.out, shard, jobs(s.jobs))
+        }
+    }
+}
+
+fn execute(plan: &Plan, c: &Common) -> Result<(), Failure> {
+    if let Some(n) = c.slurm {
+        if n == 0 {
+            return Err(input(anyhow::anyhow!("--slurm: give the number of shards, at least 1")));
+        }
+        st::runner::prepare(plan, &c.out).map_err(study_failure)?;
+        let exe = std::env::current_exe().map_err(compute)?;
+        let path = st::runner::write_sbatch(&c.out, n, &exe, jobs(c.jobs)).map_err(study_failure)?;
+        println!("{} cases in {n} shards; submit with: sbatch {}", plan.cases.len(), path.display());
+        return Ok(());
+    }
+    let shard = match &c.shard {
+        Some(s) => Shard::parse(s).map_err(|m| input(anyhow::anyhow!("--shard: {m}")))?,
+        None => Shard::ALL,
+    };
+    run_shard(plan, &c.out, shard, jobs(c.jobs))
+}
+
+fn run_shard(plan: &Plan, out: &Path, shard: Shard, jobs: usize) -> Result<(), Failure> {
+    let mine = plan.cases.iter().filter(|c| shard.holds(c.index)).count();
+    let bar = super::progress::bar(mine as u64, plan.kind.name());
+    let (summary, finished) =
+        st::run_plan(plan, out, shard, jobs, |done, _| bar.set_position(done as u64)).map_err(study_failure)?;
+    bar.finish_and_clear();
+    println!(
+        "{} {}: {} cases ({} from an earlier run) of ply {} in {}",
+        plan.kind.name(),
+        if shard == Shard::ALL { String::new() } else { format!("shard {}/{}", shard.k, shard.n) },
+        summary.cases,
+        summary.resumed,
+        plan.ply,
+        out.display()
+    );
+    report(out, finished)
+}
+
+fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failure> {
+    let Some((finished, path)) = finished else {
+        println!("the study is not complete in {}: run its other shards and merge them", dir.display());
+        return Ok(());
+    };
+    println!("wrote {}", path.display());
+    match &finished {
+        Finished::SpeedAccuracy(s) => {
+            println!("reference: {} ({}, d = {:.4} m)", s.reference.method, s.reference.kind, s.reference.spacing);
+            println!(
+                "{:<22} {:>9} {:>8} {:>10} {:>11} {:>11}  outcome",
+                "method", "d (m)", "surface", "time (s)", "err max", "err rms"
+            );
+            for p in &s.points {
+                let e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.4}"));
+                println!(
+                    "{:<22} {:>9.5} {:>8} {:>10.4} {:>11} {:>11}  {}{}",
+                    p.method,
+                    p.spacing,
+                    p.surface,
+                    p.time_s,
+                    e(p.error_max_deg),
+                    e(p.error_rms_deg),
+                    p.outcome,
+                    if p.pareto { "  (Pareto)" } else { "" }
+                );
+            }
+        }
+        Finished::Stability(s) => {
+            let mut counts = std::collections::BTreeMap::new();
+            for c in &s.cases {
+                *counts.entry(c.outcome.as_str()).or_insert(0) += 1;
+            }
+            let text: Vec<String> = counts.iter().map(|(o, n)| format!("{o}: {n}")).collect();
+            println!("{} cases: {}", s.cases.len(), text.join(", "));
+        }
+    }
+    let files = crate::report::study::draw(dir, &finished).map_err(|m| compute(anyhow::anyhow!(m)))?;
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,83 @@
+//! Studies: many drapes of one ply, to chart speed against accuracy
+//! ([`speed_accuracy`]) and map where methods fail ([`stability`]).
+//!
+//! A study is a [`plan::Plan`] of independent cases, written to `DIR/study.json` first. The
+//! [`runner`] runs them in parallel, each case's result written atomically as it finishes, so an
+//! interrupted study resumes where it stopped; it runs one shard of N, merges shards and writes
+//! a Slurm job array. [`finish`] turns the cases into the study's file once all are in; the
+//! pictures are drawn by [`crate::report::study`].
+pub mod case;
+pub mod plan;
+pub mod runner;
+pub mod speed_accuracy;
+pub mod stability;
+
+pub use plan::{Plan, Shard, StudyKind, StudyMethod};
+
+use runner::{collect, CaseRecord};
+use std::path::{Path, PathBuf};
+
+/// Why a study stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// Bad input: the message says what to change.
+    #[error("{0}")]
+    Input(String),
+    /// A file could not be written.
+    #[error("{0}")]
+    Write(String),
+}
+
+/// A finished study's result.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Finished {
+    /// `speed_accuracy.json`.
+    SpeedAccuracy(speed_accuracy::SpeedAccuracy),
+    /// `stability.json`.
+    Stability(stability::Stability),
+}
+
+/// If every case of the study in `dir` has its result, compute the study's result, write its
+/// file into `dir` and return it with the file's path; else `None`.
+pub fn finish(dir: &Path) -> Result<Option<(Finished, PathBuf)>, StudyError> {
+    let plan = runner::read_plan(dir)?;
+    let Ok(records) = collect(&plan, dir) else { return Ok(None) };
+    Ok(Some(write_result(&plan, &records, dir)?))
+}
+
+fn write_pretty<T: serde::Serialize>(path: &Path, value: &T) -> Result<(), StudyError> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| StudyError::Write(e.to_string()))? + "\n";
+    crate::io::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+        .map_err(|e| StudyError::Write(e.to_string()))
+}
+
+fn write_result(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<(Finished, PathBuf), StudyError> {
+    Ok(match plan.kind {
+        StudyKind::SpeedAccuracy => {
+            let r = speed_accuracy::evaluate(plan, records);
+            let path = dir.join(speed_accuracy::FILE);
+            write_pretty(&path, &r)?;
+            (Finished::SpeedAccuracy(r), path)
+        }
+        StudyKind::Stability => {
+            let r = stability::evaluate(plan, records);
+            let path = dir.join(stability::FILE);
+            write_pretty(&path, &r)?;
+            (Finished::Stability(r), path)
+        }
+    })
+}
+
+/// Run `plan` into `dir`: prepare the folder (or resume the study in it), run the cases of
+/// `shard` `jobs` at a time, and when the folder then holds every case, write the study's file.
+pub fn run_plan(
+    plan: &Plan,
+    dir: &Path,
+    shard: Shard,
+    jobs: usize,
+    on_done: impl Fn(usize, usize) + Sync,
+) -> Result<(runner::RunSummary, Option<(Finished, PathBuf)>), StudyError> {
+    runner::prepare(plan, dir)?;
+    let summary = runner::run(plan, dir, shard, jobs, on_done)?;
+    Ok((summary, finish(dir)?))
+}

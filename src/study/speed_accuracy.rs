@@ -1,0 +1,364 @@
+//! `drape study speed-accuracy`: every method that applies to a ply, at a range of spacings (and
+//! tool resolutions), timed and compared with the best reference the study has, at the same
+//! fabric coordinates.
+//!
+//! The reference is the finest converged mechanical result where mechanics applies; otherwise
+//! each method's own Richardson-extrapolated limit: with the shear `s_m` of the second-finest
+//! spacing and `s_f` of the finest (ratio r, observed order p from three spacings, else 2),
+//! `s* = s_f + (s_f - s_m) / (r^p - 1)`. Errors are measured at the complete cell centres of the
+//! reference's own grid (the second-finest for an extrapolated one): the finer net's value there
+//! is its average of the cells around it, a coarser net's is interpolated from its cell centres,
+//! as a user of that net would.
+use super::plan::{Case, Plan, StudyKind, StudyMethod, Variant};
+use super::runner::CaseRecord;
+use super::StudyError;
+use crate::kinematic::fabric_field::ShearField;
+use crate::kinematic::GeneratorKind;
+use crate::layup::Ply;
+use crate::mechanics::ContactMode;
+use crate::pipeline::Scene;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// The study's result file.
+pub const FILE: &str = "speed_accuracy.json";
+/// Spacings of the kinematic methods when none are given, as multiples of the ply's spacing.
+pub const KINEMATIC_SPACING_FACTORS: [f64; 4] = [2.0, 1.0, 0.5, 0.25];
+/// Spacings of the mechanical methods when none are given, as multiples of the ply's spacing.
+pub const MECHANICAL_SPACING_FACTORS: [f64; 2] = [2.0, 1.0];
+/// Bounds on the observed order of convergence used to extrapolate. The fishnet and the
+/// mechanical net are second order in d; an observed order above 2 comes from a coarse spacing
+/// outside the asymptotic range, and extrapolating with it would understate the error (on the
+/// Chebyshev sphere by a factor 4), so it is capped at the formal order.
+pub const ORDER_RANGE: (f64, f64) = (1.0, 2.0);
+/// The order assumed when only two spacings converge or the differences vanish: the formal one.
+pub const DEFAULT_ORDER: f64 = 2.0;
+/// Differences (rms, degrees) below this are rounding, not convergence: the order is not
+/// measured from them.
+const ORDER_NOISE_DEG: f64 = 1e-9;
+
+/// What the speed-accuracy study runs.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// The ply (default: the scene's first).
+    pub ply: Option<String>,
+    /// Spacings of the kinematic methods, m (default: [`KINEMATIC_SPACING_FACTORS`]).
+    pub spacings: Option<Vec<f64>>,
+    /// Spacings of the mechanical methods, m (default: [`MECHANICAL_SPACING_FACTORS`]).
+    pub mechanical_spacings: Option<Vec<f64>>,
+    /// Further resolutions of the tool (files), run with every kinematic method.
+    pub tools: Vec<PathBuf>,
+    /// Repeats of each kinematic case (the median time is reported); mechanical cases run once.
+    pub repeats: usize,
+}
+
+/// The methods that apply to `ply`.
+pub fn methods_for(ply: &Ply) -> Vec<StudyMethod> {
+    if ply.refinement.as_ref().is_some_and(|r| r.mode == ContactMode::Free) {
+        return vec![StudyMethod::MechanicalFree];
+    }
+    let mut m = vec![StudyMethod::KinematicGeodesic, StudyMethod::KinematicMinShear];
+    if matches!(ply.settings.generators, GeneratorKind::Steer(_)) {
+        m.push(StudyMethod::KinematicSteered);
+    }
+    if ply.material.is_some() || ply.refinement.is_some() {
+        m.push(StudyMethod::MechanicalPressed);
+    }
+    m
+}
+
+/// The ply of `scene` named `name`, or its first.
+pub fn find_ply<'a>(scene: &'a Scene, name: Option<&str>) -> Result<&'a Ply, StudyError> {
+    let plies = &scene.layup.plies;
+    match name {
+        None => plies.first().ok_or_else(|| StudyError::Input("the scene has no ply".into())),
+        Some(n) => plies.iter().find(|p| p.settings.name == n).ok_or_else(|| {
+            let names: Vec<&str> = plies.iter().map(|p| p.settings.name.as_str()).collect();
+            StudyError::Input(format!("the scene has no ply '{n}': its plies are {}", names.join(", ")))
+        }),
+    }
+}
+
+/// The cases of the study of `scene`.
+pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
+    let ply = find_ply(scene, opts.ply.as_deref())?;
+    let d0 = ply.settings.spacing;
+    let spacings = |given: &Option<Vec<f64>>, factors: &[f64]| -> Result<Vec<f64>, StudyError> {
+        let s: Vec<f64> = match given {
+            Some(s) => s.clone(),
+            None => factors.iter().map(|f| f * d0).collect(),
+        };
+        if s.is_empty() || s.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
+            return Err(StudyError::Input(format!("spacings must be positive lengths, got {s:?}")));
+        }
+        Ok(s)
+    };
+    let kin = spacings(&opts.spacings, &KINEMATIC_SPACING_FACTORS)?;
+    let mech = spacings(&opts.mechanical_spacings, &MECHANICAL_SPACING_FACTORS)?;
+    let scene_tool = std::path::absolute(&scene.tool).map_err(|e| StudyError::Input(e.to_string()))?;
+    let mut tools = vec![scene_tool];
+    for t in &opts.tools {
+        if !t.is_file() {
+            return Err(StudyError::Input(format!("--tools: {} is not a file", t.display())));
+        }
+        tools.push(std::path::absolute(t).map_err(|e| StudyError::Input(e.to_string()))?);
+    }
+    let mut cases = Vec::new();
+    for method in methods_for(ply) {
+        let (ds, ts, repeats) =
+            if method.is_mechanical() { (&mech, &tools[..1], 1) } else { (&kin, &tools[..], opts.repeats.max(1)) };
+        for tool in ts {
+            for &spacing in ds {
+                let variant = Variant {
+                    method,
+                    surface: "facets".into(),
+                    tool: tool.clone(),
+                    spacing,
+                    angle_deg: None,
+                    seed_shift: [0.0, 0.0],
+                    pre_shear_deg: None,
+                    max_shear_deg: None,
+                    tension_factor: 1.0,
+                    load_steps: None,
+                };
+                let params = BTreeMap::from([("spacing".to_string(), spacing)]);
+                cases.push(Case { index: cases.len(), variant, params, repeats, keep_field: true });
+            }
+        }
+    }
+    let scene_path = std::path::absolute(&scene.path).map_err(|e| StudyError::Input(e.to_string()))?;
+    Ok(Plan { kind: StudyKind::SpeedAccuracy, scene: scene_path, ply: ply.settings.name.clone(), axes: None, cases })
+}
+
+/// The reference the errors are measured against.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Reference {
+    /// The method of the reference (`own` when each method is measured against its own limit).
+    pub method: String,
+    /// Its spacing (the finest spacing extrapolated from), m.
+    pub spacing: f64,
+    /// `mechanical` or `extrapolated`.
+    pub kind: String,
+}
+
+/// One method's own extrapolated limit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OwnLimit {
+    /// The method.
+    pub method: String,
+    /// Its surface.
+    pub surface: String,
+    /// Triangles of its tool.
+    pub tool_triangles: usize,
+    /// The spacings extrapolated from (the two finest that gave a result), m.
+    pub spacings: [f64; 2],
+    /// The order of convergence used.
+    pub order: f64,
+    /// Whether the order was measured from three spacings (else [`DEFAULT_ORDER`]).
+    pub order_measured: bool,
+}
+
+/// One run of the study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedPoint {
+    /// The method.
+    pub method: String,
+    /// Fibre spacing d, m.
+    pub spacing: f64,
+    /// `facets` or `smooth`.
+    pub surface: String,
+    /// Triangles of the tool.
+    pub tool_triangles: usize,
+    /// Median time of the repeats, s.
+    pub time_s: f64,
+    /// Repeats timed.
+    pub repeats: usize,
+    /// Largest |shear - reference| over the compared points, degrees (absent without any).
+    pub error_max_deg: Option<f64>,
+    /// Root mean square of the same, degrees.
+    pub error_rms_deg: Option<f64>,
+    /// Points compared.
+    pub compared: usize,
+    /// `ok` or why not.
+    pub outcome: String,
+    /// On the Pareto front: no other successful run is both faster and more accurate.
+    pub pareto: bool,
+}
+
+/// `speed_accuracy.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedAccuracy {
+    /// The ply.
+    pub ply: String,
+    /// What the errors are measured against.
+    pub reference: Reference,
+    /// For an extrapolated reference: each method's own limit.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub limits: Vec<OwnLimit>,
+    /// Every run.
+    pub points: Vec<SpeedPoint>,
+}
+
+/// Cell centres of `f` and the values of the other fields there, where all have one.
+fn common(points: &[(f64, f64)], fields: &[&ShearField]) -> Vec<Vec<f64>> {
+    points.iter().filter_map(|&(u, v)| fields.iter().map(|f| f.at(u, v)).collect::<Option<Vec<f64>>>()).collect()
+}
+
+fn rms(x: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = x.fold((0.0, 0usize), |(s, n), e| (s + e * e, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        (s / n as f64).sqrt()
+    }
+}
+
+/// A reference field: values at the complete cell centres of `grid`.
+struct RefField {
+    grid: ShearField,
+}
+
+impl RefField {
+    /// Max and rms of |field - reference| at the reference's points, and how many.
+    fn compare(&self, field: &ShearField) -> (Option<f64>, Option<f64>, usize) {
+        let pts = self.grid.complete_cell_centres();
+        let errs: Vec<f64> =
+            pts.iter().filter_map(|&(u, v)| Some((field.at(u, v)? - self.grid.at(u, v)?).abs())).collect();
+        if errs.is_empty() {
+            return (None, None, 0);
+        }
+        (errs.iter().copied().reduce(f64::max), Some(rms(errs.iter().copied())), errs.len())
+    }
+}
+
+/// The Richardson limit of one method's runs, finest last: `None` with fewer than two fields.
+fn extrapolate(runs: &[(f64, &ShearField)]) -> Option<(RefField, [f64; 2], f64, bool)> {
+    let n = runs.len();
+    if n < 2 {
+        return None;
+    }
+    let (dm, fm) = runs[n - 2];
+    let (df, ff) = runs[n - 1];
+    let r = dm / df;
+    let pts = fm.complete_cell_centres();
+    // Observed order from three spacings, measured at the medium grid's points.
+    let mut order = (DEFAULT_ORDER, false);
+    if n >= 3 {
+        let (dc, fc) = runs[n - 3];
+        let vals = common(&pts, &[fc, fm, ff]);
+        let (e1, e2) = (rms(vals.iter().map(|v| v[0] - v[1])), rms(vals.iter().map(|v| v[1] - v[2])));
+        if e1 > ORDER_NOISE_DEG && e2 > ORDER_NOISE_DEG {
+            // Unequal ratios: solve e1/e2 = (dc^p - dm^p)/(dm^p - df^p) is not closed-form; the
+            // studies use equal ratios, and for unequal ones the mean ratio is close enough.
+            let ratio = ((dc / dm) * (dm / df)).sqrt();
+            let p = (e1 / e2).ln() / ratio.ln();
+            if p.is_finite() {
+                order = (p.clamp(ORDER_RANGE.0, ORDER_RANGE.1), true);
+            }
+        }
+    }
+    let factor = 1.0 / (r.powf(order.0) - 1.0);
+    let mut grid = fm.clone();
+    for (k, s) in grid.shear_deg.iter_mut().enumerate() {
+        let (i, j) = (k / fm.cv, k % fm.cv);
+        let (u, v) = fm.cell_centre(i, j);
+        *s = match (*s, ff.at(u, v)) {
+            (Some(sm), Some(sf)) => Some(sf + (sf - sm) * factor),
+            _ => None,
+        };
+    }
+    Some((RefField { grid }, [dm, df], order.0, order.1))
+}
+
+/// The study's result from every case's record.
+pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
+    // A net with failed nodes is compared where it has cells; its outcome says what failed.
+    fn field(r: &CaseRecord) -> Option<&ShearField> {
+        r.result.field.as_ref()
+    }
+    // The finest converged mechanical run on the scene's own tool.
+    let scene_tool = plan.cases.first().map(|c| c.variant.tool.clone());
+    let mech = records
+        .iter()
+        .filter(|r| r.case.variant.method.is_mechanical() && Some(&r.case.variant.tool) == scene_tool.as_ref())
+        .filter(|r| r.result.converged == Some(true) && field(r).is_some())
+        .min_by(|a, b| a.case.variant.spacing.total_cmp(&b.case.variant.spacing));
+    let mut limits = Vec::new();
+    let mut points: Vec<SpeedPoint> = records
+        .iter()
+        .map(|r| SpeedPoint {
+            method: r.case.variant.method.name().into(),
+            spacing: r.case.variant.spacing,
+            surface: r.case.variant.surface.clone(),
+            tool_triangles: r.result.tool_triangles,
+            time_s: r.result.time_s,
+            repeats: r.result.times_s.len(),
+            error_max_deg: None,
+            error_rms_deg: None,
+            compared: 0,
+            outcome: r.result.outcome.clone(),
+            pareto: false,
+        })
+        .collect();
+    let reference = if let Some(m) = mech {
+        let reference =
+            RefField { grid: m.result.field.clone().unwrap_or_else(|| unreachable!("filtered on a field")) };
+        for (p, r) in points.iter_mut().zip(records) {
+            if let Some(f) = field(r) {
+                (p.error_max_deg, p.error_rms_deg, p.compared) = reference.compare(f);
+            }
+        }
+        Reference {
+            method: m.case.variant.method.name().into(),
+            spacing: m.case.variant.spacing,
+            kind: "mechanical".into(),
+        }
+    } else {
+        // Each method (on each surface and tool) against its own limit.
+        let mut groups: BTreeMap<(StudyMethod, String, PathBuf), Vec<usize>> = BTreeMap::new();
+        for (k, r) in records.iter().enumerate() {
+            let v = &r.case.variant;
+            groups.entry((v.method, v.surface.clone(), v.tool.clone())).or_default().push(k);
+        }
+        let mut finest = f64::INFINITY;
+        for ((method, surface, _), ks) in &groups {
+            let mut runs: Vec<(f64, &ShearField)> =
+                ks.iter().filter_map(|&k| Some((records[k].case.variant.spacing, field(&records[k])?))).collect();
+            runs.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let Some((reference, spacings, order, measured)) = extrapolate(&runs) else { continue };
+            finest = finest.min(spacings[1]);
+            limits.push(OwnLimit {
+                method: method.name().into(),
+                surface: surface.clone(),
+                tool_triangles: records[ks[0]].result.tool_triangles,
+                spacings,
+                order,
+                order_measured: measured,
+            });
+            for &k in ks {
+                if let Some(f) = field(&records[k]) {
+                    let p = &mut points[k];
+                    (p.error_max_deg, p.error_rms_deg, p.compared) = reference.compare(f);
+                }
+            }
+        }
+        Reference {
+            method: "own".into(),
+            spacing: if finest.is_finite() { finest } else { 0.0 },
+            kind: "extrapolated".into(),
+        }
+    };
+    mark_pareto(&mut points);
+    SpeedAccuracy { ply: plan.ply.clone(), reference, limits, points }
+}
+
+/// Mark the runs no other successful run beats on both time and error.
+fn mark_pareto(points: &mut [SpeedPoint]) {
+    let scored: Vec<(usize, f64, f64)> =
+        points.iter().enumerate().filter_map(|(k, p)| Some((k, p.time_s, p.error_max_deg?))).collect();
+    for &(k, t, e) in &scored {
+        let beaten = scored.iter().any(|&(j, t2, e2)| j != k && t2 <= t && e2 <= e && (t2 < t || e2 < e));
+        points[k].pareto = !beaten;
+    }
+}
