@@ -57,7 +57,14 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
     let spacing = std::f64::consts::FRAC_PI_2 / half.max(1) as f64 * 0.999;
     let settings = KinematicSettings {
         surface,
-        ..KinematicSettings::grid("bench", Point::new(0.0, 0.0, 1.0), Vector::new(1.0, 0.0, 0.0), spacing, a.nodes, a.nodes)
+        ..KinematicSettings::grid(
+            "bench",
+            Point::new(0.0, 0.0, 1.0),
+            Vector::new(1.0, 0.0, 0.0),
+            spacing,
+            a.nodes,
+            a.nodes,
+        )
     };
     let mut best = f64::INFINITY;
     let mut total = 0.0;

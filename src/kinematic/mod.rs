@@ -11,9 +11,9 @@ pub mod sampler;
 pub mod surface;
 
 pub use fishnet::{drape, drape_on, DrapeError};
-pub use surface::DrapeSurface;
 pub use net::{DrapeNet, Method, NodeStatus};
 pub use provenance::{CellChanges, Provenance, SolverRecord, UnbalancedRecord};
+pub use surface::DrapeSurface;
 
 use crate::geometry::{Point, Vector};
 

@@ -429,12 +429,12 @@ impl Scene {
                 )))
             }
         };
-        let surface_at = |spanned: &toml::Spanned<String>| -> Result<SurfaceKind, String> {
-            spanned.get_ref().parse::<SurfaceKind>().map_err(|m| format!("line {}, field `surface`: {m}", line_of(spanned.span().start)))
-        };
         let scene_surface = match &file.surface {
             None => SurfaceKind::Facets,
-            Some(spanned) => surface_at(spanned).map_err(invalid)?,
+            Some(spanned) => spanned
+                .get_ref()
+                .parse::<SurfaceKind>()
+                .map_err(|m| invalid(format!("field `surface` (line {}): {m}", line_of(spanned.span().start))))?,
         };
         let stack_side = match file.stack_side.as_deref().unwrap_or("normal") {
             "normal" => StackSide::Normal,
@@ -618,10 +618,7 @@ impl Scene {
             }
             let surface = match &p.surface {
                 None => scene_surface,
-                Some(spanned) => spanned
-                    .get_ref()
-                    .parse::<SurfaceKind>()
-                    .map_err(|m| invalid(format!("ply '{}' (line {}), field `surface`: {m}", p.name, line_of(spanned.span().start))))?,
+                Some(spanned) => spanned.get_ref().parse::<SurfaceKind>().map_err(|m| at("surface", m))?,
             };
             let settings = KinematicSettings {
                 name: p.name.clone(),
