@@ -20,6 +20,9 @@ const CIRCLE_NEWTON_MAX_ITERATIONS: usize = 12;
 /// The Newton iteration stops when |f| (about the distance to the surface) or the step along the
 /// circle falls below this fraction of the tool's bounding-box diagonal.
 const CIRCLE_NEWTON_TOLERANCE_REL: f64 = 1e-13;
+/// Once |f| is below this fraction of the diagonal, one more Newton step brings it (quadratic
+/// convergence) far below [`CIRCLE_NEWTON_TOLERANCE_REL`]: that step is taken without checking.
+const CIRCLE_NEWTON_LAST_STEP_REL: f64 = 1e-9;
 /// A Newton step along the circle longer than this (radians) means the smooth surface has no
 /// crossing near the facet one (the circle grazes it): the root is dropped.
 const CIRCLE_NEWTON_MAX_STEP: f64 = 0.5;
@@ -115,6 +118,7 @@ impl SmoothSurface<'_> {
     /// Newton on the circle parameter from the facet crossing `root`, on region `region`.
     fn circle_newton(&self, circle: &Circle, root: &CircleRoot, region: u32) -> Option<Point> {
         let tol = CIRCLE_NEWTON_TOLERANCE_REL * self.tool().diagonal();
+        let last = CIRCLE_NEWTON_LAST_STEP_REL * self.tool().diagonal();
         let rel = root.point - circle.center;
         let mut theta = rel.dot(&circle.e2).atan2(rel.dot(&circle.e1));
         for _ in 0..CIRCLE_NEWTON_MAX_ITERATIONS {
@@ -133,7 +137,7 @@ impl SmoothSurface<'_> {
                 return None;
             }
             theta -= step;
-            if step.abs() * circle.radius <= tol {
+            if f.abs() <= last || step.abs() * circle.radius <= tol {
                 let (s, c) = theta.sin_cos();
                 return Some(circle.center + (circle.e1 * c + circle.e2 * s) * circle.radius);
             }
