@@ -310,3 +310,62 @@ fn coverage_is_the_share_of_the_tool_or_the_outline_covered() {
     assert!(s.coverage.share() > (inner / r).powi(2) && s.coverage.share() < 1.0, "{:?}", s.coverage);
     assert!((s.coverage.covered_area / s.draped_area - 1.0).abs() < 0.01, "{:?} vs {}", s.coverage, s.draped_area);
 }
+
+/// `surface = "smooth"` for the whole scene, and per ply: every ply, the ones stacked on the
+/// offset tool too, lies on the smooth surface its tool stands for, and its net says so.
+#[test]
+fn the_smooth_surface_in_a_scene_for_every_ply_and_per_ply() {
+    let dir = tempfile::tempdir().unwrap();
+    let tool = root().join("geometries/hemisphere/hemisphere-2k.obj");
+    let ply = |name: &str, extra: &str| {
+        format!("[[ply]]\nname = \"{name}\"\norigin = [0.0, 0.0, 0.1]\nspacing = 0.01\ngrid = [11, 11]\nthickness = 0.001\n{extra}")
+    };
+    let run = |text: &str, out: &str| -> Vec<Value> {
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, text.replace("TOOL", tool.to_str().unwrap())).unwrap();
+        let out = dir.path().join(out);
+        drape()
+            .args(["run", path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"])
+            .assert()
+            .success();
+        ["a", "b", "c"].iter().map(|n| read_json(&out.join(format!("{n}.drape.json")))).collect()
+    };
+    let nets = run(
+        &format!(
+            "tool = \"TOOL\"\nsurface = \"smooth\"\n{}{}{}",
+            ply("a", ""),
+            ply("b", ""),
+            ply("c", "surface = \"facets\"\n")
+        ),
+        "scene-wide",
+    );
+    let surfaces: Vec<&str> = nets.iter().map(|n| n["meta"]["surface"].as_str().unwrap()).collect();
+    assert_eq!(surfaces, ["smooth", "smooth", "facets"]);
+    // Ply b lies on the smooth surface over the tool offset by ply a: one thickness above the
+    // sphere at its seed, to the smooth surface's third-order error on the coarse tool.
+    let o = origin_node(&nets[1]);
+    assert!((o[2] - 0.101).abs() < SMOOTH_SEED_TOL, "ply b's seed at {o:?}");
+    let nets = run(
+        &format!("tool = \"TOOL\"\n{}{}{}", ply("a", ""), ply("b", "surface = \"smooth\"\n"), ply("c", "")),
+        "per-ply",
+    );
+    let surfaces: Vec<&str> = nets.iter().map(|n| n["meta"]["surface"].as_str().unwrap()).collect();
+    assert_eq!(surfaces, ["facets", "smooth", "facets"]);
+}
+
+/// The smooth surface over the 2k-triangle hemisphere lies within this of the sphere at the pole
+/// (m; its facets are about 8 mm, (h/R)^3 R is 5e-5 m).
+const SMOOTH_SEED_TOL: f64 = 1e-5;
+
+#[test]
+fn an_unknown_surface_in_a_scene_names_the_line_and_the_choices() {
+    let head = "tool = \"TOOL\"\n";
+    scene_refused(
+        &format!("{head}surface = \"curved\"\n{PLY}"),
+        "field `surface` (line 2): unknown surface 'curved': use \"facets\"",
+    );
+    scene_refused(
+        &format!("{head}{PLY}surface = \"bumpy\"\n"),
+        "ply 'a' (line 2), field `surface`: unknown surface 'bumpy': use \"facets\"",
+    );
+}

@@ -4,7 +4,7 @@
 #![allow(clippy::approx_constant)]
 use drape::geometry::shapes;
 use drape::geometry::{Point, ToolSurface, Vector};
-use drape::kinematic::{drape, DrapeNet, GeneratorKind, KinematicSettings, NodeStatus};
+use drape::kinematic::{drape, DrapeNet, GeneratorKind, KinematicSettings, NodeStatus, SurfaceKind};
 use proptest::prelude::*;
 use std::sync::OnceLock;
 
@@ -307,4 +307,70 @@ fn a_closed_sphere_is_draped_past_its_equator_into_the_undercut() {
     assert!(below > 8, "{below} nodes below the equator");
     let (e, _) = segment_error(&net);
     assert!(e < LENGTH_TOLERANCE);
+}
+
+/// Nodes on the smooth surface satisfy its implicit equation to this (m, on a unit hemisphere).
+const ON_SMOOTH_TOLERANCE: f64 = 1e-12;
+
+#[test]
+fn on_the_smooth_surface_segments_have_length_d_and_nodes_lie_on_it_for_every_generator() {
+    let tool = hemisphere();
+    let smooth = drape::geometry::SmoothSurface::new(tool);
+    let origin = Point::from(Vector::new(0.1, 0.2, 1.0).normalize());
+    // A steering curve through the seed: a small circle tilted off the great circle along x.
+    let curve: Vec<Point> = (0..=80)
+        .map(|k| {
+            let a = -1.0 + 2.0 * k as f64 / 80.0;
+            let p = Vector::new(a.sin(), 0.05 * a, a.cos()).normalize();
+            Point::from(nalgebra::Rotation3::rotation_between(&Vector::z(), &origin.coords).unwrap() * p)
+        })
+        .collect();
+    for generators in [GeneratorKind::Geodesic, GeneratorKind::MinShear, GeneratorKind::Steer(curve)] {
+        let mut s = KinematicSettings::grid("h", origin, Vector::new(1.0, 0.4, 0.0), 0.05, 31, 31);
+        s.surface = SurfaceKind::Smooth;
+        s.generators = generators.clone();
+        let net = drape(tool, &s).unwrap();
+        assert_eq!(net.meta.surface, SurfaceKind::Smooth);
+        assert!(!net.status.contains(&NodeStatus::Pending));
+        let (e, n) = segment_error(&net);
+        assert!(n > 1500, "{generators:?}: only {n} segments");
+        assert!(e < LENGTH_TOLERANCE, "{generators:?}: segment error {e}");
+        for k in 0..net.positions.len() {
+            if net.status[k] == NodeStatus::Placed {
+                let p = net.positions[k];
+                let (f, _) = smooth.value_and_gradient(smooth.region_of(net.triangles[k]), &p).unwrap();
+                assert!(f.abs() < ON_SMOOTH_TOLERANCE, "{generators:?}: node {k} is {f:e} off the smooth surface");
+                // Its facet is the one under it.
+                let l = tool.barycentric(net.triangles[k], &p);
+                assert!(l.iter().all(|&x| x > -1e-9), "{generators:?}: node {k} not over its facet: {l:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn on_the_smooth_surface_results_do_not_depend_on_the_thread_count() {
+    let mut s = KinematicSettings::grid(
+        "h",
+        Point::from(Vector::new(0.1, 0.2, 1.0).normalize()),
+        Vector::new(1.0, 0.4, 0.0),
+        0.004,
+        601,
+        601,
+    );
+    s.surface = SurfaceKind::Smooth;
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| drape(hemisphere(), &s).unwrap())
+    };
+    let one = run(1);
+    for threads in [2, 3] {
+        let other = run(threads);
+        assert_eq!(one.status, other.status);
+        assert!(one.positions.iter().zip(&other.positions).all(|(a, b)| a == b), "{threads} threads differ");
+        assert_eq!(one.triangles, other.triangles);
+    }
 }

@@ -4,14 +4,28 @@ use crate::common;
 use common::chebyshev::SphereChebyshev;
 use drape::geometry::shapes;
 use drape::geometry::{Point, ToolSurface, Vector};
-use drape::kinematic::{drape, KinematicSettings};
+use drape::kinematic::{drape, KinematicSettings, SurfaceKind};
 
 /// Largest |cell shear - Chebyshev shear| (radians) over cells whose centres have |u|, |v| <= reach,
-/// for a net from the pole with spacing `d` and warp along x.
+/// for a net from the pole with spacing `d` and warp along x, on the facets.
 fn max_error(tool: &ToolSurface, reference: &SphereChebyshev, d: f64, reach: f64) -> (f64, usize) {
+    max_error_on(tool, SurfaceKind::Facets, reference, d, reach)
+}
+
+/// As [`max_error`], on the given surface.
+fn max_error_on(
+    tool: &ToolSurface,
+    surface: SurfaceKind,
+    reference: &SphereChebyshev,
+    d: f64,
+    reach: f64,
+) -> (f64, usize) {
     let half = (reach / d).round() as usize + 1;
     let n = 2 * half + 1;
-    let settings = KinematicSettings::grid("s", Point::new(0.0, 0.0, 1.0), Vector::new(1.0, 0.0, 0.0), d, n, n);
+    let settings = KinematicSettings {
+        surface,
+        ..KinematicSettings::grid("s", Point::new(0.0, 0.0, 1.0), Vector::new(1.0, 0.0, 0.0), d, n, n)
+    };
     let net = drape(tool, &settings).unwrap();
     let (i0, j0) = net.origin_node;
     let mut worst = 0.0f64;
@@ -92,4 +106,47 @@ fn quadrants_carry_the_signs_of_the_chebyshev_solution() {
     assert!(g(5, 5) > 0.0);
     assert!(g(-6, 5) < 0.0 && g(5, -6) < 0.0 && g(-6, -6) > 0.0);
     assert!((g(5, 5) + g(-6, 5)).abs() < 0.05 * g(5, 5).abs());
+}
+
+/// Triangles of the coarse sphere cap of the smooth-surface tests (issue 13): about 13k.
+const COARSE_CAP_TRIANGLES: usize = 13_000;
+/// At d = R/27 the smooth surface's largest cell-shear error against the Chebyshev net stays
+/// under this (degrees); the facets of the same tool give about 0.1 deg.
+const SMOOTH_ERROR_R27_DEG: f64 = 0.01;
+
+#[test]
+fn smooth_surface_gives_a_coarse_cap_the_accuracy_of_a_fine_one() {
+    let reference = SphereChebyshev::new(1.0, 1.0);
+    let tool = shapes::hemisphere_with_triangles(1.0, COARSE_CAP_TRIANGLES).into_surface().unwrap();
+    let (facets, n_f) = max_error_on(&tool, SurfaceKind::Facets, &reference, 1.0 / FINE, REACH);
+    let (smooth, n_s) = max_error_on(&tool, SurfaceKind::Smooth, &reference, 1.0 / FINE, REACH);
+    println!(
+        "cap of {} triangles, d = R/27: max |shear error| facets {:.5} deg, smooth {:.5} deg",
+        tool.num_triangles(),
+        facets.to_degrees(),
+        smooth.to_degrees()
+    );
+    assert_eq!((n_f, n_s), (48 * 48, 48 * 48));
+    assert!(smooth.to_degrees() < SMOOTH_ERROR_R27_DEG, "smooth: {:.5} deg", smooth.to_degrees());
+    assert!(facets.to_degrees() > 0.03, "facets: {:.5} deg (0.055 measured)", facets.to_degrees());
+    assert!(smooth < facets / 5.0, "smooth {smooth:e} vs facets {facets:e} rad");
+}
+
+#[test]
+fn smooth_surface_converges_at_second_order_in_d() {
+    let reference = SphereChebyshev::new(1.0, 1.0);
+    let tool = shapes::hemisphere_with_triangles(1.0, COARSE_CAP_TRIANGLES).into_surface().unwrap();
+    let errors: Vec<f64> = [COARSE, MEDIUM, 2.0 * MEDIUM]
+        .iter()
+        .map(|k| max_error_on(&tool, SurfaceKind::Smooth, &reference, 1.0 / k, REACH).0)
+        .collect();
+    let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    println!(
+        "smooth surface on {} triangles: max |shear error| {:?} deg at d = R/9, R/18, R/36; observed orders {orders:.2?}",
+        tool.num_triangles(),
+        errors.iter().map(|e| e.to_degrees()).collect::<Vec<_>>()
+    );
+    for w in errors.windows(2) {
+        assert!(w[0] / w[1] >= 3.0, "halving d must divide the error by about 4: {errors:?}");
+    }
 }

@@ -2,7 +2,7 @@
 use super::{input, Failure};
 use crate::geometry::hemisphere::hemisphere_with_triangles;
 use crate::geometry::{Point, Vector};
-use crate::kinematic::{drape, KinematicSettings};
+use crate::kinematic::{drape, KinematicSettings, SurfaceKind};
 use crate::material::MaterialCard;
 use crate::mechanics::refine::{refine, RefineSettings};
 use crate::mechanics::SolverSettings;
@@ -28,6 +28,9 @@ pub struct BenchArgs {
     /// iterations and time per iteration.
     #[arg(long)]
     pub refine: Option<std::path::PathBuf>,
+    /// The surface the net lies on: facets or smooth.
+    #[arg(long, default_value = "facets")]
+    pub surface: String,
     /// Iteration limit of the refinement.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
@@ -41,6 +44,7 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         .num_threads(a.threads.unwrap_or(0))
         .build()
         .map_err(|e| input(anyhow::anyhow!("cannot start {} threads: {e}", a.threads.unwrap_or(0))))?;
+    let surface: SurfaceKind = a.surface.parse().map_err(|m| input(anyhow::anyhow!("--surface: {m}")))?;
     let t = Instant::now();
     let tool = hemisphere_with_triangles(1.0, a.triangles).into_surface().map_err(input)?;
     println!(
@@ -51,14 +55,17 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
     // Spacing so the generators reach from the pole to the rim: quarter circumference / half-size.
     let half = (a.nodes - 1) / 2;
     let spacing = std::f64::consts::FRAC_PI_2 / half.max(1) as f64 * 0.999;
-    let settings = KinematicSettings::grid(
-        "bench",
-        Point::new(0.0, 0.0, 1.0),
-        Vector::new(1.0, 0.0, 0.0),
-        spacing,
-        a.nodes,
-        a.nodes,
-    );
+    let settings = KinematicSettings {
+        surface,
+        ..KinematicSettings::grid(
+            "bench",
+            Point::new(0.0, 0.0, 1.0),
+            Vector::new(1.0, 0.0, 0.0),
+            spacing,
+            a.nodes,
+            a.nodes,
+        )
+    };
     let mut best = f64::INFINITY;
     let mut total = 0.0;
     let mut placed_cells = 0;
@@ -72,7 +79,7 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
     }
     let grid_cells = (a.nodes - 1) * (a.nodes - 1);
     println!(
-        "net {n} x {n} nodes, spacing {spacing:.6} m, {threads} thread(s): {placed_cells} of the grid's {grid_cells} cells placed on the tool",
+        "net {n} x {n} nodes on the {surface}, spacing {spacing:.6} m, {threads} thread(s): {placed_cells} of the grid's {grid_cells} cells placed on the tool",
         n = a.nodes,
         threads = pool.current_num_threads()
     );

@@ -5,7 +5,7 @@ use crate::geometry::{Point, ToolSurface, Vector};
 use crate::io::points::read_points;
 use crate::io::{write_net, Format};
 use crate::kinematic::fishnet::check_settings;
-use crate::kinematic::{drape, Extent, KinematicSettings};
+use crate::kinematic::{drape, Extent, KinematicSettings, SurfaceKind};
 use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::pipeline::{parse_generators, unit_scale};
 use clap::Args;
@@ -45,6 +45,10 @@ pub struct KinematicArgs {
     /// Shear (degrees) at which a node is refused as a collapsing cell.
     #[arg(long, default_value_t = crate::kinematic::DEFAULT_MAX_SHEAR_DEG)]
     pub max_shear: f64,
+    /// The surface the net lies on: facets (the tool's facets as given) or smooth (the smooth
+    /// surface over them, the one the pressed contact slides on).
+    #[arg(long, default_value = "facets")]
+    pub surface: String,
     /// Locking angle (degrees) for the summary's count of cells over it.
     #[arg(long, default_value_t = DEFAULT_LOCKING_ANGLE_DEG)]
     pub locking_angle: f64,
@@ -74,6 +78,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     let base = std::env::current_dir().unwrap_or_default();
     let generators =
         parse_generators(&a.generators, &base, scale).map_err(|m| input(anyhow::anyhow!("--generators: {m}")))?;
+    let surface: SurfaceKind = a.surface.parse().map_err(|m| input(anyhow::anyhow!("--surface: {m}")))?;
     let extent = match (&a.grid, &a.outline) {
         (Some([nu, nv]), _) => Extent::Grid { nu: *nu, nv: *nv, origin_node: a.origin_node.map(|[i, j]| (i, j)) },
         (None, Some(f)) => {
@@ -90,6 +95,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
         pre_shear: a.pre_shear.to_radians(),
         generators,
         max_shear: a.max_shear.to_radians(),
+        surface,
     };
     // Cheap argument checks come before the (possibly slow) tool load.
     check_settings(&settings).map_err(input)?;

@@ -338,6 +338,22 @@ mod tests {
     }
 
     #[test]
+    fn the_surface_is_recorded_and_older_files_without_it_read_as_facets() {
+        let mut net = sample();
+        net.meta.surface = crate::kinematic::SurfaceKind::Smooth;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.drape.json");
+        write_json(&net, &path).unwrap();
+        let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+        assert_eq!(v["meta"]["surface"], "smooth");
+        assert_eq!(read_net(&path).unwrap().meta.surface, crate::kinematic::SurfaceKind::Smooth);
+        // A file written before the surface was recorded: draped on the facets.
+        v["meta"].as_object_mut().unwrap().remove("surface");
+        std::fs::write(&path, serde_json::to_vec(&v).unwrap()).unwrap();
+        assert_eq!(read_net(&path).unwrap().meta.surface, crate::kinematic::SurfaceKind::Facets);
+    }
+
+    #[test]
     fn round_trip() {
         let net = sample();
         let dir = tempfile::tempdir().unwrap();

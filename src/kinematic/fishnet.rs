@@ -5,9 +5,10 @@
 //! on the number of threads.
 use super::generators::{lay_generators, Generators};
 use super::net::{corner_shear, DrapeNet, Method, NodeStatus};
-use super::{Extent, KinematicSettings};
+use super::surface::DrapeSurface;
+use super::{Extent, KinematicSettings, SurfaceKind};
 use crate::geometry::surface::{Circle, CircleRoot};
-use crate::geometry::{Point, ToolSurface, Vector};
+use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::time::Instant;
@@ -157,8 +158,8 @@ thread_local! {
 // The step's inputs, as the fill and the min-shear generators have them: no struct to build per
 // node in the hot loop.
 #[allow(clippy::too_many_arguments)]
-pub fn place_node(
-    tool: &ToolSurface,
+pub fn place_node<S: DrapeSurface>(
+    surface: &S,
     d: f64,
     max_shear: f64,
     a: &Placed,
@@ -181,12 +182,13 @@ pub fn place_node(
     let circle = Circle { center, e1, e2, radius };
     let reach = radius.max(0.5 * gap);
 
-    let root = circle_root(tool, &circle, reach, [a.triangle, b.triangle])?;
+    let root = circle_root(surface, &circle, reach, [a.triangle, b.triangle])?;
     let x = root.point;
-    // Fold: the new cell must keep the net's orientation (warp x weft along the tool normal).
+    // Fold: the new cell must keep the net's orientation (warp x weft along the tool normal; the
+    // facet's normal on either surface: a sign test, and the same test on both).
     let warp_x = (x - a.point) * si;
     let weft_x = (x - b.point) * sj;
-    if warp_x.cross(&weft_x).dot(&tool.normal(root.triangle)) <= 0.0 {
+    if warp_x.cross(&weft_x).dot(&surface.tool().normal(root.triangle)) <= 0.0 {
         return Err(NodeStatus::Fold);
     }
     let warp_c = (b.point - c) * si;
@@ -200,33 +202,59 @@ pub fn place_node(
     Ok(Placed { point: x, triangle: root.triangle })
 }
 
-/// The acceptable crossing of `circle` with the tool farthest along `e1` (largest cos of the circle
-/// parameter): first on the patch of triangles connected to `seeds` within `reach` of the circle's
-/// centre, then, if that patch has none, among all triangles near the circle (BVH). A root found
-/// only by the BVH whose triangle faces away from the first seed's is on another sheet.
-pub fn circle_root(tool: &ToolSurface, circle: &Circle, reach: f64, seeds: [u32; 2]) -> Result<CircleRoot, NodeStatus> {
-    SCRATCH.with(|s| {
-        let s = &mut *s.borrow_mut();
-        if let Some(r) = local_roots(tool, circle, reach, seeds, s) {
-            return Ok(r);
-        }
-        let r = all_roots_near(tool, circle, reach, s)?;
-        if tool.normal(r.triangle).dot(&tool.normal(seeds[0])) < 0.0 {
-            return Err(NodeStatus::SheetJump);
-        }
-        Ok(r)
-    })
-}
-
-/// Best acceptable root among triangles connected to `seeds` that may meet the ball around the
-/// circle, by flood fill over edge neighbours.
-fn local_roots(
-    tool: &ToolSurface,
+/// The acceptable crossing of `circle` with the surface farthest along `e1` (largest cos of the
+/// circle parameter): first on the patch of facets connected to `seeds` within `reach` of the
+/// circle's centre, then, if that patch has none, among all facets near the circle (BVH). A root
+/// found only by the BVH whose facet faces away from the first seed's is on another sheet. The
+/// crossings are found on the facets and moved onto `surface` ([`DrapeSurface::on_surface`]).
+pub fn circle_root<S: DrapeSurface>(
+    surface: &S,
     circle: &Circle,
     reach: f64,
     seeds: [u32; 2],
-    s: &mut Scratch,
-) -> Option<CircleRoot> {
+) -> Result<CircleRoot, NodeStatus> {
+    let tool = surface.tool();
+    SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        local_roots(tool, circle, reach, seeds, s);
+        if let Some(r) = best_on_surface(surface, circle, &mut s.roots) {
+            return Ok(r);
+        }
+        all_roots_near(tool, circle, reach, s);
+        if let Some(r) = best_on_surface(surface, circle, &mut s.roots.clone()) {
+            if tool.normal(r.triangle).dot(&tool.normal(seeds[0])) < 0.0 {
+                return Err(NodeStatus::SheetJump);
+            }
+            return Ok(r);
+        }
+        // Roots between "ahead" and "back at the diagonal node" mean the fabric would fold back
+        // (roots ahead that the smooth surface does not cross are no roots).
+        if s.roots.iter().any(|r| r.cos_t > COS_DIAGONAL && r.cos_t < COS_FOLD) {
+            Err(NodeStatus::Fold)
+        } else {
+            Err(NodeStatus::NoRoot)
+        }
+    })
+}
+
+/// The best acceptable facet root moved onto `surface`; roots the surface has no crossing near
+/// are dropped and the next best tried (on the facets the first is taken as it is).
+#[inline]
+fn best_on_surface<S: DrapeSurface>(surface: &S, circle: &Circle, roots: &mut Vec<CircleRoot>) -> Option<CircleRoot> {
+    loop {
+        let k = best_root(roots)?;
+        match surface.on_surface(circle, &roots[k]) {
+            Some(r) if r.cos_t >= COS_FOLD => return Some(r),
+            _ => {
+                roots.swap_remove(k);
+            }
+        }
+    }
+}
+
+/// The roots of `circle` on the facets connected to `seeds` that may meet the ball around the
+/// circle, by flood fill over edge neighbours, into `s.roots`.
+fn local_roots(tool: &ToolSurface, circle: &Circle, reach: f64, seeds: [u32; 2], s: &mut Scratch) {
     let stamp = s.next_stamp(tool.num_triangles());
     s.stack.clear();
     s.roots.clear();
@@ -248,34 +276,26 @@ fn local_roots(
             }
         }
     }
-    best_root(&s.roots)
 }
 
-/// Best acceptable root among all triangles near the circle (BVH query), or why there is none.
-fn all_roots_near(tool: &ToolSurface, circle: &Circle, reach: f64, s: &mut Scratch) -> Result<CircleRoot, NodeStatus> {
+/// All roots of `circle` on the facets near it (BVH query), into `s.roots`.
+fn all_roots_near(tool: &ToolSurface, circle: &Circle, reach: f64, s: &mut Scratch) {
     s.roots.clear();
     for t in tool.triangles_near(&circle.center, reach) {
         tool.circle_roots(t, circle, &mut s.roots);
     }
-    if let Some(r) = best_root(&s.roots) {
-        return Ok(r);
-    }
-    // Roots between "ahead" and "back at the diagonal node" mean the fabric would fold back.
-    if s.roots.iter().any(|r| r.cos_t > COS_DIAGONAL) {
-        Err(NodeStatus::Fold)
-    } else {
-        Err(NodeStatus::NoRoot)
-    }
 }
 
-/// The root farthest from the diagonal node (largest cos of the circle parameter), if it is ahead
-/// enough not to fold the cell. Ties are broken by triangle index so results are deterministic.
-fn best_root(roots: &[CircleRoot]) -> Option<CircleRoot> {
+/// Index of the root farthest from the diagonal node (largest cos of the circle parameter), if it
+/// is ahead enough not to fold the cell. Ties are broken by triangle index so results are
+/// deterministic whatever the order of the roots.
+fn best_root(roots: &[CircleRoot]) -> Option<usize> {
     roots
         .iter()
-        .filter(|r| r.cos_t >= COS_FOLD)
-        .max_by(|p, q| p.cos_t.total_cmp(&q.cos_t).then(q.triangle.cmp(&p.triangle)))
-        .copied()
+        .enumerate()
+        .filter(|(_, r)| r.cos_t >= COS_FOLD)
+        .max_by(|(_, p), (_, q)| p.cos_t.total_cmp(&q.cos_t).then(q.triangle.cmp(&p.triangle)))
+        .map(|(k, _)| k)
 }
 
 /// One quadrant of the grid seen from the origin node: i = i0 + si * a, j = j0 + sj * b.
@@ -293,13 +313,33 @@ struct QuadrantNodes {
     status: Vec<NodeStatus>,
 }
 
-/// Drape one ply on the tool with the kinematic (fishnet) method.
+/// Drape one ply on the tool with the kinematic (fishnet) method, on the surface the settings
+/// name: the facets as given or the smooth surface over them ([`SurfaceKind`]).
 pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNet, DrapeError> {
+    match settings.surface {
+        SurfaceKind::Facets => drape_on(tool, settings),
+        SurfaceKind::Smooth => {
+            check_settings(settings)?;
+            check_spacing_on_tool(tool, settings.spacing)?;
+            let start = Instant::now();
+            let smooth = SmoothSurface::new(tool);
+            let build_ms = ms(start);
+            let mut net = drape_on(&smooth, settings)?;
+            net.timing.total_ms += build_ms;
+            Ok(net)
+        }
+    }
+}
+
+/// Drape one ply on `surface` (whatever `settings.surface` says; the net's provenance records
+/// the surface used).
+pub fn drape_on<S: DrapeSurface>(surface: &S, settings: &KinematicSettings) -> Result<DrapeNet, DrapeError> {
     let start = Instant::now();
+    let tool = surface.tool();
     check_settings(settings)?;
     let d = settings.spacing;
     check_spacing_on_tool(tool, settings.spacing)?;
-    let seed = tool.closest_point(&settings.origin);
+    let seed = surface.seed(&settings.origin);
     if !(seed.distance <= d) {
         let o = settings.origin;
         return Err(DrapeError::OriginOffTool { x: o.x, y: o.y, z: o.z, distance: seed.distance, spacing: d });
@@ -321,7 +361,7 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
     }
 
     let t_gen = Instant::now();
-    let generators = lay_generators(tool, settings, &seed, (nu, nv), (i0, j0))?;
+    let generators = lay_generators(surface, settings, &seed, (nu, nv), (i0, j0))?;
     let generators_ms = ms(t_gen);
 
     let t_fill = Instant::now();
@@ -337,7 +377,7 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
             nb: if sj > 0 { nv - j0 } else { j0 + 1 },
         })
         .collect();
-    let filled: Vec<QuadrantNodes> = quadrants.par_iter().map(|q| fill_quadrant(tool, settings, &net, q)).collect();
+    let filled: Vec<QuadrantNodes> = quadrants.par_iter().map(|q| fill_quadrant(surface, settings, &net, q)).collect();
     for (q, nodes) in quadrants.iter().zip(&filled) {
         for a in 1..q.na {
             for b in 1..q.nb {
@@ -365,6 +405,7 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
     net.meta.pre_shear_deg = Some(settings.pre_shear.to_degrees());
     net.meta.generators = Some(generators.kind.clone());
     net.meta.max_shear_deg = Some(settings.max_shear.to_degrees());
+    net.meta.surface = surface.kind();
     Ok(net)
 }
 
@@ -465,7 +506,12 @@ fn write_generators(net: &mut DrapeNet, g: &Generators) {
 }
 
 /// Fill one quadrant, anti-diagonal by anti-diagonal.
-fn fill_quadrant(tool: &ToolSurface, settings: &KinematicSettings, net: &DrapeNet, q: &Quadrant) -> QuadrantNodes {
+fn fill_quadrant<S: DrapeSurface>(
+    surface: &S,
+    settings: &KinematicSettings,
+    net: &DrapeNet,
+    q: &Quadrant,
+) -> QuadrantNodes {
     let (na, nb) = (q.na, q.nb);
     let (i0, j0) = net.origin_node;
     let mut nodes = QuadrantNodes { placed: vec![None; na * nb], status: vec![NodeStatus::Pending; na * nb] };
@@ -489,7 +535,7 @@ fn fill_quadrant(tool: &ToolSurface, settings: &KinematicSettings, net: &DrapeNe
         let pb = nodes.placed[a * nb + b - 1];
         let pc = nodes.placed[(a - 1) * nb + b - 1];
         match (pa, pb, pc) {
-            (Some(pa), Some(pb), Some(pc)) => place_node(tool, d, max_shear, &pa, &pb, &pc.point, si, sj),
+            (Some(pa), Some(pb), Some(pc)) => place_node(surface, d, max_shear, &pa, &pb, &pc.point, si, sj),
             _ => Err(NodeStatus::ParentMissing),
         }
     };

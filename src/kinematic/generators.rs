@@ -3,10 +3,10 @@
 //! segment turned to minimise the shear of the two cells beside it).
 use super::fishnet::{cell_shear_of, circle_root, place_node, DrapeError, Placed};
 use super::net::NodeStatus;
+use super::surface::DrapeSurface;
 use super::{GeneratorKind, KinematicSettings};
-use crate::geometry::geodesic::TraceState;
 use crate::geometry::surface::Circle;
-use crate::geometry::{Point, SurfacePoint, ToolSurface, Vector};
+use crate::geometry::{Point, SurfacePoint, Vector};
 use crate::numeric::golden_section_min;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -37,8 +37,8 @@ pub struct Generators {
 }
 
 /// Lay the generators for a grid of `grid` nodes with the origin at `origin_node`.
-pub fn lay_generators(
-    tool: &ToolSurface,
+pub fn lay_generators<S: DrapeSurface>(
+    surface: &S,
     settings: &KinematicSettings,
     seed: &SurfacePoint,
     grid: (usize, usize),
@@ -57,15 +57,19 @@ pub fn lay_generators(
     match &settings.generators {
         GeneratorKind::Geodesic | GeneratorKind::MinShear => {
             let origin = Placed { point: seed.point, triangle: seed.triangle };
-            let start = TraceState::new(tool, seed.point, seed.triangle, &settings.warp).ok_or_else(warp_err)?;
-            let states =
-                [Some(start), start.turned(tool, PI), start.turned(tool, omega), start.turned(tool, PI + omega)];
+            let start = surface.start_trace(&origin, &settings.warp).ok_or_else(warp_err)?;
+            let states = [
+                Some(start),
+                surface.turned(&start, PI),
+                surface.turned(&start, omega),
+                surface.turned(&start, PI + omega),
+            ];
             let min_shear = settings.generators == GeneratorKind::MinShear;
             let mut halves: Vec<Vec<Result<Placed, NodeStatus>>> = Vec::with_capacity(4);
             if !min_shear {
                 for (state, n) in states.iter().zip(counts) {
                     halves.push(match state {
-                        Some(s) => trace_half(tool, *s, origin.point, n, d),
+                        Some(s) => trace_half(surface, *s, origin.point, n, d),
                         None => vec![Err(NodeStatus::OffTool); n],
                     });
                 }
@@ -74,7 +78,7 @@ pub fn lay_generators(
                 // that steer the following segments.
                 let first: Vec<Option<Placed>> = states
                     .iter()
-                    .map(|s| s.and_then(|s| trace_half(tool, s, origin.point, 1, d).pop()?.ok()))
+                    .map(|s| s.and_then(|s| trace_half(surface, s, origin.point, 1, d).pop()?.ok()))
                     .collect();
                 // (is_warp, sign, the two neighbouring halves' first nodes with their side signs)
                 let specs = [
@@ -85,7 +89,7 @@ pub fn lay_generators(
                 ];
                 for ((state, n), (is_warp, sign, sides)) in states.iter().zip(counts).zip(specs) {
                     halves.push(match state {
-                        Some(s) => min_shear_half(tool, settings, *s, origin, n, is_warp, sign, sides),
+                        Some(s) => min_shear_half(surface, settings, *s, origin, n, is_warp, sign, sides),
                         None => vec![Err(NodeStatus::OffTool); n],
                     });
                 }
@@ -93,7 +97,7 @@ pub fn lay_generators(
             let mut it = halves.into_iter();
             Ok(Generators {
                 origin,
-                warp_dir: start.dir,
+                warp_dir: surface.trace_dir(&start),
                 kind: if min_shear { "min-shear".into() } else { "geodesic".into() },
                 warp_pos: it.next().unwrap_or_default(),
                 warp_neg: it.next().unwrap_or_default(),
@@ -101,14 +105,14 @@ pub fn lay_generators(
                 weft_neg: it.next().unwrap_or_default(),
             })
         }
-        GeneratorKind::Steer(curve) => steered(tool, settings, seed, curve, counts, omega),
+        GeneratorKind::Steer(curve) => steered(surface, settings, seed, curve, counts, omega),
     }
 }
 
 /// Follow a geodesic from `from`, placing `n` nodes at straight-line distance d from each other.
-fn trace_half(
-    tool: &ToolSurface,
-    mut state: TraceState,
+fn trace_half<S: DrapeSurface>(
+    surface: &S,
+    mut state: S::Trace,
     from: Point,
     n: usize,
     d: f64,
@@ -116,12 +120,12 @@ fn trace_half(
     let mut out = Vec::with_capacity(n);
     let mut prev = from;
     while out.len() < n {
-        match state.advance_chord(tool, &prev, d) {
-            Ok(p) => {
-                out.push(Ok(Placed { point: p, triangle: state.triangle }));
-                prev = p;
+        match surface.advance_chord(&mut state, &prev, d) {
+            Some(p) => {
+                out.push(Ok(p));
+                prev = p.point;
             }
-            Err(_) => break,
+            None => break,
         }
     }
     out.resize(n, Err(NodeStatus::OffTool));
@@ -132,10 +136,10 @@ fn trace_half(
 /// the geodesic continuation turned by the angle (within +-MAX_STEER_TURN) that minimises the
 /// summed squared shear of the two cells beside it.
 #[allow(clippy::too_many_arguments)]
-fn min_shear_half(
-    tool: &ToolSurface,
+fn min_shear_half<S: DrapeSurface>(
+    surface: &S,
     settings: &KinematicSettings,
-    start: TraceState,
+    start: S::Trace,
     origin: Placed,
     n: usize,
     is_warp: bool,
@@ -156,7 +160,7 @@ fn min_shear_half(
             let Some(s) = strip[k] else { continue };
             // Roles: the warp parent differs from the new strip node in i, the weft parent in j.
             let (a, b, si, sj) = if is_warp { (s, *x, sign, *side) } else { (*x, s, *side, sign) };
-            if let Ok(p) = place_node(tool, d, settings.max_shear, &a, &b, &prev.point, si, sj) {
+            if let Ok(p) = place_node(surface, d, settings.max_shear, &a, &b, &prev.point, si, sj) {
                 let g = cell_shear_of(&a.point, &b.point, &prev.point, &p.point, si, sj);
                 cost += g * g;
                 used += 1;
@@ -166,10 +170,10 @@ fn min_shear_half(
         (if used == 0 { f64::NAN } else { cost }, next)
     };
     while out.len() < n {
-        let shoot = |turn: f64| -> Option<(TraceState, Placed)> {
-            let mut s = if turn == 0.0 { state } else { state.turned(tool, turn)? };
-            let p = s.advance_chord(tool, &prev.point, d).ok()?;
-            Some((s, Placed { point: p, triangle: s.triangle }))
+        let shoot = |turn: f64| -> Option<(S::Trace, Placed)> {
+            let mut s = if turn == 0.0 { state } else { surface.turned(&state, turn)? };
+            let p = surface.advance_chord(&mut s, &prev.point, d)?;
+            Some((s, p))
         };
         let cost = |turn: f64| -> f64 {
             match shoot(turn) {
@@ -202,8 +206,8 @@ fn min_shear_half(
 }
 
 /// Warp generator along a user curve; weft generator geodesic.
-fn steered(
-    tool: &ToolSurface,
+fn steered<S: DrapeSurface>(
+    surface: &S,
     settings: &KinematicSettings,
     seed: &SurfacePoint,
     curve: &[Point],
@@ -223,7 +227,7 @@ fn steered(
         let pieces = (((w[1] - w[0]).norm() / (STEER_REFINE * d)).ceil() as usize).max(1);
         for m in 0..pieces + usize::from(k + 2 == curve.len()) {
             let q = w[0] + (w[1] - w[0]) * (m as f64 / pieces as f64);
-            let sp = tool.closest_point(&q);
+            let sp = surface.seed(&q);
             if sp.distance > d {
                 return Err(DrapeError::Steering(format!(
                     "steering curve point near ({:.6}, {:.6}, {:.6}) (segment {}) is {:.4} from the tool, more than one spacing: give a curve that lies on the tool",
@@ -245,28 +249,29 @@ fn steered(
         )));
     }
     let on_curve = refined[seg] + (refined[seg + 1] - refined[seg]) * t;
-    let origin_sp = tool.closest_point(&on_curve);
+    let origin_sp = surface.seed(&on_curve);
     let origin = Placed { point: origin_sp.point, triangle: origin_sp.triangle };
     let tangent = refined[seg + 1] - refined[seg];
     let forward = tangent.dot(&settings.warp) >= 0.0;
     let warp_dir = if forward { tangent } else { -tangent };
-    let start = TraceState::new(tool, origin.point, origin.triangle, &warp_dir)
-        .ok_or(DrapeError::WarpNormal([warp_dir.x, warp_dir.y, warp_dir.z]))?;
+    let start =
+        surface.start_trace(&origin, &warp_dir).ok_or(DrapeError::WarpNormal([warp_dir.x, warp_dir.y, warp_dir.z]))?;
     // Walk the refined curve both ways from the origin.
     let ahead: Vec<Point> = std::iter::once(on_curve).chain(refined[seg + 1..].iter().copied()).collect();
     let behind: Vec<Point> = std::iter::once(on_curve).chain(refined[..=seg].iter().rev().copied()).collect();
     let (pos_path, neg_path) = if forward { (ahead, behind) } else { (behind, ahead) };
-    let warp_pos = follow_curve(tool, &pos_path, origin, counts[0], d);
-    let warp_neg = follow_curve(tool, &neg_path, origin, counts[1], d);
-    let weft_pos = match start.turned(tool, omega) {
-        Some(s) => trace_half(tool, s, origin.point, counts[2], d),
+    let warp_pos = follow_curve(surface, &pos_path, origin, counts[0], d);
+    let warp_neg = follow_curve(surface, &neg_path, origin, counts[1], d);
+    let weft_pos = match surface.turned(&start, omega) {
+        Some(s) => trace_half(surface, s, origin.point, counts[2], d),
         None => vec![Err(NodeStatus::OffTool); counts[2]],
     };
-    let weft_neg = match start.turned(tool, PI + omega) {
-        Some(s) => trace_half(tool, s, origin.point, counts[3], d),
+    let weft_neg = match surface.turned(&start, PI + omega) {
+        Some(s) => trace_half(surface, s, origin.point, counts[3], d),
         None => vec![Err(NodeStatus::OffTool); counts[3]],
     };
-    Ok(Generators { origin, warp_dir: start.dir, kind: "steer".into(), warp_pos, warp_neg, weft_pos, weft_neg })
+    let warp_dir = surface.trace_dir(&start);
+    Ok(Generators { origin, warp_dir, kind: "steer".into(), warp_pos, warp_neg, weft_pos, weft_neg })
 }
 
 /// Closest point of a polyline to `p`: (segment, parameter in [0, 1], distance).
@@ -286,8 +291,8 @@ fn closest_on_polyline(line: &[Point], p: &Point) -> (usize, f64, f64) {
 
 /// Nodes at straight-line distance d along a path on the tool, each the point of the tool at
 /// distance d from the previous node nearest to where the path crosses that distance.
-fn follow_curve(
-    tool: &ToolSurface,
+fn follow_curve<S: DrapeSurface>(
+    surface: &S,
     path: &[Point],
     origin: Placed,
     n: usize,
@@ -314,7 +319,7 @@ fn follow_curve(
                 let s = -bq + disc.sqrt();
                 if s >= 0.0 && s <= len {
                     let target = a + dir * s;
-                    match node_towards(tool, &prev, &target, d) {
+                    match node_towards(surface, &prev, &target, d) {
                         Some(p) => {
                             out.push(Ok(p));
                             prev = p;
@@ -334,13 +339,13 @@ fn follow_curve(
 
 /// The point of the tool at distance d from `from` closest to `target`: the tool crossed by the
 /// circle of radius d about `from` in the plane of `target - from` and the tool normal.
-fn node_towards(tool: &ToolSurface, from: &Placed, target: &Point, d: f64) -> Option<Placed> {
-    let n = tool.normal(from.triangle);
+fn node_towards<S: DrapeSurface>(surface: &S, from: &Placed, target: &Point, d: f64) -> Option<Placed> {
+    let n = surface.normal(from);
     let e1 = (target - from.point).try_normalize(1e-14 * d)?;
     let e2 = (n - e1 * e1.dot(&n)).try_normalize(1e-12)?;
     let circle = Circle { center: from.point, e1, e2, radius: d };
-    let near = tool.closest_point(target);
-    circle_root(tool, &circle, d, [from.triangle, near.triangle])
+    let near = surface.tool().closest_point(target);
+    circle_root(surface, &circle, d, [from.triangle, near.triangle])
         .ok()
         .map(|r| Placed { point: r.point, triangle: r.triangle })
 }

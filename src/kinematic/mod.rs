@@ -9,10 +9,12 @@ pub mod net;
 pub mod outline;
 pub mod provenance;
 pub mod sampler;
+pub mod surface;
 
-pub use fishnet::{drape, DrapeError};
+pub use fishnet::{drape, drape_on, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};
 pub use provenance::{CellChanges, Provenance, SolverRecord, UnbalancedRecord};
+pub use surface::DrapeSurface;
 
 use crate::geometry::{Point, Vector};
 
@@ -26,6 +28,49 @@ pub enum GeneratorKind {
     /// The warp generator follows this curve (projected onto the tool, resampled at d); the weft
     /// generator is a geodesic.
     Steer(Vec<Point>),
+}
+
+/// Which surface the fishnet lies on.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SurfaceKind {
+    /// The tool's facets as given: every node exactly on the mesh.
+    #[default]
+    Facets,
+    /// The smooth surface the facets stand for ([`crate::geometry::SmoothSurface`], the one the
+    /// pressed contact slides on): a coarse tool drapes with the accuracy of a fine one.
+    Smooth,
+}
+
+impl SurfaceKind {
+    /// Every kind, in the order the choices are listed.
+    pub const ALL: [SurfaceKind; 2] = [SurfaceKind::Facets, SurfaceKind::Smooth];
+
+    /// Its name in files and on the command line: `facets` or `smooth`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceKind::Facets => "facets",
+            SurfaceKind::Smooth => "smooth",
+        }
+    }
+}
+
+impl std::str::FromStr for SurfaceKind {
+    type Err = String;
+
+    /// `facets` or `smooth`; anything else is refused with a message naming the choices.
+    fn from_str(s: &str) -> Result<Self, String> {
+        SurfaceKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown surface '{s}': use \"facets\" (the tool's facets, the default) or \"smooth\" (the smooth surface over them)"))
+    }
+}
+
+impl std::fmt::Display for SurfaceKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// How far the net extends.
@@ -63,6 +108,8 @@ pub struct KinematicSettings {
     pub generators: GeneratorKind,
     /// Nodes whose corner shear would reach this are not placed (radians, < pi/2).
     pub max_shear: f64,
+    /// The surface the net lies on: the facets (default) or the smooth surface over them.
+    pub surface: SurfaceKind,
 }
 
 /// Default shear at which a node is refused as a collapsing cell (degrees).
@@ -80,6 +127,7 @@ impl KinematicSettings {
             pre_shear: 0.0,
             generators: GeneratorKind::Geodesic,
             max_shear: DEFAULT_MAX_SHEAR_DEG.to_radians(),
+            surface: SurfaceKind::Facets,
         }
     }
 }

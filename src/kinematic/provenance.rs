@@ -20,6 +20,10 @@ pub struct Provenance {
     /// How the generators were laid: `geodesic`, `min-shear` or `steer`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub generators: Option<String>,
+    /// The surface the fishnet lay on: `facets` or `smooth` (files written before it was
+    /// recorded were draped on the facets, and read so).
+    #[serde(default)]
+    pub surface: super::SurfaceKind,
     /// Shear past which nodes were refused, degrees.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_shear_deg: Option<f64>,

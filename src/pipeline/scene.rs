@@ -5,6 +5,9 @@
 //! units = "m"                 # "m" (default) or "mm": lengths here and in the OBJ
 //! tool = "hemisphere-20k.obj" # relative to this file: OBJ, STL, or a shell mesh (.inp .bdf .msh)
 //! reference = [1.0, 0.0, 0.0] # optional: the 0 deg direction of ply angles (default +x)
+//! surface = "facets"          # optional: what the fishnet lies on, for every ply without its
+//!                             # own: "facets" (the tool's facets, default) or "smooth" (the
+//!                             # smooth surface over them: a coarse tool drapes like a fine one)
 //! stack_side = "normal"       # optional: plies stack on the side the tool normals point to
 //!                             # ("normal", default) or the other ("opposite")
 //! roll_width = 1.27           # optional: fabric roll width, for nesting the flat patterns
@@ -34,6 +37,7 @@
 //! locking_angle_deg = 45.0    # optional, for reporting (default: the card's two-slope
 //!                             # locking angle, else 45)
 //! max_shear_deg = 75.0        # optional: nodes shearing past this are not placed
+//! surface = "smooth"          # optional: this ply's surface (default: the scene's)
 //! method = "kinematic"       # or "mechanical": kinematic, then refinement with the
 //!                             # ply's material card
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
@@ -67,7 +71,7 @@ use crate::geometry::{Point, Vector};
 use crate::io::flow::FlowFormat;
 use crate::io::points::read_points;
 use crate::kinematic::fishnet::check_memory;
-use crate::kinematic::{Extent, KinematicSettings, DEFAULT_MAX_SHEAR_DEG};
+use crate::kinematic::{Extent, KinematicSettings, SurfaceKind, DEFAULT_MAX_SHEAR_DEG};
 use crate::layup::{
     locking_angle_deg, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_SOLVER_ITERATIONS,
     MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
@@ -108,6 +112,7 @@ struct SceneFile {
     units: String,
     tool: String,
     reference: Option<[f64; 3]>,
+    surface: Option<toml::Spanned<String>>,
     stack_side: Option<String>,
     roll_width: Option<f64>,
     nesting_gap: Option<f64>,
@@ -161,6 +166,7 @@ struct PlyFile {
     generators: String,
     locking_angle_deg: Option<f64>,
     max_shear_deg: Option<f64>,
+    surface: Option<toml::Spanned<String>>,
     #[serde(default = "default_method")]
     method: String,
     material: Option<String>,
@@ -423,6 +429,13 @@ impl Scene {
                 )))
             }
         };
+        let scene_surface = match &file.surface {
+            None => SurfaceKind::Facets,
+            Some(spanned) => spanned
+                .get_ref()
+                .parse::<SurfaceKind>()
+                .map_err(|m| invalid(format!("field `surface` (line {}): {m}", line_of(spanned.span().start))))?,
+        };
         let stack_side = match file.stack_side.as_deref().unwrap_or("normal") {
             "normal" => StackSide::Normal,
             "opposite" => StackSide::Opposite,
@@ -603,6 +616,10 @@ impl Scene {
             if !(locking > 0.0 && locking < 90.0) {
                 return Err(at("locking_angle_deg", format!("must lie strictly between 0 and 90, got {locking}")));
             }
+            let surface = match &p.surface {
+                None => scene_surface,
+                Some(spanned) => spanned.get_ref().parse::<SurfaceKind>().map_err(|m| at("surface", m))?,
+            };
             let settings = KinematicSettings {
                 name: p.name.clone(),
                 origin: Point::from(v(p.origin) * scale),
@@ -615,6 +632,7 @@ impl Scene {
                 pre_shear: p.pre_shear_deg.to_radians(),
                 generators,
                 max_shear: max_shear.to_radians(),
+                surface,
             };
             plies.push(Ply {
                 settings,
