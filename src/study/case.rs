@@ -110,6 +110,7 @@ pub fn case_ply(base: &Ply, layup: &Layup, v: &Variant, tool: &ToolSurface) -> R
         return Err("refused: a seed shift needs a ply given by its grid".into());
     }
     s.spacing = v.spacing;
+    s.surface = v.surface;
     if let Some(a) = v.angle_deg {
         ply.orientation = Orientation::Angle(a.to_radians());
     }

@@ -1,6 +1,7 @@
 //! What a study is: the scene, the ply, and the list of independent [`Case`]s it runs. A plan is
 //! written to `DIR/study.json` before any case runs; shards and resumed runs read it back, so
 //! every process of one study agrees on what case `k` is.
+use crate::kinematic::SurfaceKind;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -66,8 +67,8 @@ impl StudyMethod {
 pub struct Variant {
     /// The method.
     pub method: StudyMethod,
-    /// The surface the kinematic drape steps on: `facets` (the tool's triangles).
-    pub surface: String,
+    /// The surface the kinematic drape steps on: the tool's facets or the smooth surface over them.
+    pub surface: SurfaceKind,
     /// The tool file (the scene's, or one of the study's tool resolutions).
     pub tool: PathBuf,
     /// Fibre segment length d, m. The grid keeps the scene's extent in fabric length.

@@ -13,7 +13,7 @@ use super::plan::{Case, Plan, StudyKind, StudyMethod, Variant};
 use super::runner::CaseRecord;
 use super::StudyError;
 use crate::kinematic::fabric_field::ShearField;
-use crate::kinematic::GeneratorKind;
+use crate::kinematic::{GeneratorKind, SurfaceKind};
 use crate::layup::Ply;
 use crate::mechanics::ContactMode;
 use crate::pipeline::Scene;
@@ -108,11 +108,13 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
     for method in methods_for(ply) {
         let (ds, ts, repeats) =
             if method.is_mechanical() { (&mech, &tools[..1], 1) } else { (&kin, &tools[..], opts.repeats.max(1)) };
-        for tool in ts {
+        // The kinematic methods step on the facets and on the smooth surface over them.
+        let surfaces: &[SurfaceKind] = if method.is_mechanical() { &[SurfaceKind::Facets] } else { &SurfaceKind::ALL };
+        for (tool, &surface) in ts.iter().flat_map(|t| surfaces.iter().map(move |s| (t, s))) {
             for &spacing in ds {
                 let variant = Variant {
                     method,
-                    surface: "facets".into(),
+                    surface,
                     tool: tool.clone(),
                     spacing,
                     angle_deg: None,
@@ -290,7 +292,7 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
         .map(|r| SpeedPoint {
             method: r.case.variant.method.name().into(),
             spacing: r.case.variant.spacing,
-            surface: r.case.variant.surface.clone(),
+            surface: r.case.variant.surface.name().into(),
             tool_triangles: r.result.tool_triangles,
             time_s: r.result.time_s,
             repeats: r.result.times_s.len(),
@@ -316,10 +318,10 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
         }
     } else {
         // Each method (on each surface and tool) against its own limit.
-        let mut groups: BTreeMap<(StudyMethod, String, PathBuf), Vec<usize>> = BTreeMap::new();
+        let mut groups: BTreeMap<(StudyMethod, &str, PathBuf), Vec<usize>> = BTreeMap::new();
         for (k, r) in records.iter().enumerate() {
             let v = &r.case.variant;
-            groups.entry((v.method, v.surface.clone(), v.tool.clone())).or_default().push(k);
+            groups.entry((v.method, v.surface.name(), v.tool.clone())).or_default().push(k);
         }
         let mut finest = f64::INFINITY;
         for ((method, surface, _), ks) in &groups {
@@ -330,7 +332,7 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
             finest = finest.min(spacings[1]);
             limits.push(OwnLimit {
                 method: method.name().into(),
-                surface: surface.clone(),
+                surface: surface.to_string(),
                 tool_triangles: records[ks[0]].result.tool_triangles,
                 spacings,
                 order,

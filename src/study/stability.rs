@@ -6,6 +6,7 @@ use super::runner::CaseRecord;
 use super::speed_accuracy::find_ply;
 use super::StudyError;
 use crate::geometry::ToolSurface;
+use crate::kinematic::SurfaceKind;
 use crate::mechanics::ContactMode;
 use crate::pipeline::Scene;
 use serde::{Deserialize, Serialize};
@@ -220,7 +221,7 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
     };
     let base = |method| Variant {
         method,
-        surface: "facets".into(),
+        surface: SurfaceKind::Facets,
         tool: tools[0].clone(),
         spacing: d0,
         angle_deg: None,
