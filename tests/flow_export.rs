@@ -297,14 +297,30 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
     }
     assert_eq!(checked, covered);
 
-    // RTMsim (its read_nastran_mesh layout and 14-line input file): the covered elements, sets
-    // of the laminate, porosity 1 - Vf within what the ply's shear makes of Vf0.
+    // RTMsim (its read_nastran_mesh layout and 14-line input file): every element, sets of the
+    // laminate and one of the elements no ply covers, porosity 1 - Vf within what the ply's shear
+    // makes of Vf0.
     let mesh = export(&case, "rtmsim", "flow-rtmsim.bdf", &["--permeability"]);
     let input = case.dir.join("flow-rtmsim_input.txt");
     let rtm = readback("rtmsim", &[&mesh, &input]);
     let uncovered = rtm["uncovered"].as_array().unwrap().len();
-    assert_eq!(uncovered, elements.len() - covered, "RTMsim leaves out exactly the uncovered elements");
-    assert_eq!(rtm["tris"].as_object().unwrap().len(), covered, "the 2k mesh is all triangles: none split");
+    assert_eq!(uncovered, elements.len() - covered, "RTMsim lists exactly the uncovered elements");
+    assert!(uncovered > 0, "the case leaves elements uncovered");
+    assert_eq!(rtm["tris"].as_object().unwrap().len(), elements.len(), "every element, none split (all triangles)");
+    // The uncovered elements are the last SET used, alone, a preform region of their own.
+    let sets: Vec<Vec<u64>> = rtm["sets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect())
+        .collect();
+    let last = sets.iter().rposition(|s| !s.is_empty()).expect("a SET is written");
+    let mut want: Vec<u64> = rtm["uncovered"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+    let mut got = sets[last].clone();
+    want.sort();
+    got.sort();
+    assert_eq!(got, want, "SET {} holds the uncovered elements", last + 1);
+    assert_eq!(rtm["patchtypes"][last], 2);
     for p in rtm["params"].as_array().unwrap() {
         let porosity = p[1].as_f64().unwrap();
         assert!(

@@ -479,6 +479,11 @@ fn rtmsim_mesh_sets_and_parameters() {
         assert!(report.regions.len() <= MAX_RTMSIM_SETS + 1 && report.regions.len() <= report.groups_found);
         let uncovered: Vec<u64> = if layup { vec![] } else { vec![16] };
         assert_eq!(report.uncovered, uncovered);
+        // The uncovered elements get the SET after the covered regions' SETs.
+        let uncovered_set = (!layup).then_some(report.regions.len());
+        assert_eq!(report.uncovered_set, uncovered_set);
+        let sets_used = report.regions.len() - 1 + usize::from(uncovered_set.is_some());
+        assert!(sets_used <= MAX_RTMSIM_SETS);
         if !python_ready() {
             continue;
         }
@@ -491,10 +496,6 @@ fn rtmsim_mesh_sets_and_parameters() {
         let splits: Vec<Vec<u64>> = s["splits"].as_array().unwrap().iter().map(ids_of).collect();
         let mut tri_of = std::collections::BTreeMap::new(); // tri id -> element index
         for (e, el) in mesh.elements.iter().enumerate() {
-            if uncovered.contains(&el.id) {
-                assert!(!tris.contains_key(&el.id.to_string()));
-                continue;
-            }
             let mine: Vec<u64> = match el.shape {
                 ElementShape::Tria3 => vec![el.id],
                 ElementShape::Quad4 => {
@@ -514,6 +515,9 @@ fn rtmsim_mesh_sets_and_parameters() {
         }
         assert_eq!(tris.len(), tri_of.len());
         assert_eq!(s["meshio_triangles"].as_u64().unwrap() as usize, tri_of.len());
+        // Element count in = element count out: every element (covered or not) is written.
+        let written: std::collections::BTreeSet<usize> = tri_of.values().copied().collect();
+        assert_eq!(written.len(), mesh.elements.len());
         for (id, p) in s["grids"].as_object().unwrap() {
             let k = mesh.node_ids.iter().position(|n| n.to_string() == *id).unwrap();
             assert!((vec3(&f64s(p)) - mesh.nodes[k].coords).norm() < SHORT_FIELD_TOL, "grid {id}");
@@ -535,14 +539,31 @@ fn rtmsim_mesh_sets_and_parameters() {
                 }
             }
         }
-        for s_unused in report.regions.len()..=MAX_RTMSIM_SETS {
+        if let Some(u) = uncovered_set {
+            // Their own preform region: the main preform's values, for the user to edit.
+            assert_eq!(types[u - 1], 2);
+            assert_eq!(params[u], params[0]);
+            for t in &sets[u - 1] {
+                region_of_tri.insert(*t, usize::MAX);
+            }
+        }
+        for s_unused in sets_used + 1..=MAX_RTMSIM_SETS {
             assert_eq!(types[s_unused - 1], 0);
             assert!(sets[s_unused - 1].is_empty());
         }
-        assert_eq!(s["i_interactive"].as_u64().unwrap(), if report.regions.len() > 1 { 2 } else { 1 });
+        assert_eq!(s["i_interactive"].as_u64().unwrap(), if sets_used > 0 { 2 } else { 1 });
         let mut max_err: f64 = 0.0;
         for (t, &e) in &tri_of {
             let r = *region_of_tri.get(t).unwrap_or(&0);
+            let id = mesh.elements[e].id;
+            assert_eq!(
+                r == usize::MAX,
+                uncovered.contains(&id),
+                "tri {t} of element {id}: in the uncovered SET or not"
+            );
+            if r == usize::MAX {
+                continue;
+            }
             assert!(report.regions[r].elements.contains(&mesh.elements[e].id), "tri {t} in the wrong region");
             // The reference direction projected onto the element vs the element's own K1 axis.
             let n = mesh.normal(e).unwrap();

@@ -141,8 +141,10 @@ pub struct RtmsimReport {
     pub regions: Vec<RtmsimRegion>,
     /// Elements whose group was merged into a written region because of RTMsim's limit.
     pub merged_elements: usize,
-    /// Ids of elements no ply covers: left out of the RTMsim mesh.
+    /// Ids of elements no ply covers: in the RTMsim mesh as SET `uncovered_set` of their own.
     pub uncovered: Vec<u64>,
+    /// The SET (1..=4) of the elements no ply covers, `None` when every element is covered.
+    pub uncovered_set: Option<usize>,
     /// Largest angle (degrees) between an element's own first principal permeability direction
     /// and its region's reference direction projected into the element.
     pub max_direction_error_deg: f64,
