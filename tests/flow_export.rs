@@ -329,3 +329,44 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
         );
     }
 }
+
+/// `drape export --vtu binary` writes the compressed binary VTU; VTK's reader finds in it the
+/// arrays of the ASCII file bit for bit (NaN on the uncovered elements), and a bad `--vtu` is
+/// refused.
+#[test]
+fn export_vtu_binary_option_reads_in_vtk_as_the_ascii() {
+    use crate::common::vtk_reader::{read_with_vtk, vtk_ready};
+    let case = drape_ply();
+    let bin = export(&case, "vtu", "flow-bin.vtu", &["--vtu", "binary"]);
+    let ascii = export(&case, "vtu", "flow-ascii.vtu", &["--vtu", "ascii"]);
+    let auto = export(&case, "vtu", "flow-auto.vtu", &[]);
+    assert_eq!(std::fs::read(&auto).unwrap(), std::fs::read(&ascii).unwrap(), "2k elements: ASCII by default");
+    let text = String::from_utf8_lossy(&std::fs::read(&bin).unwrap()[..400]).into_owned();
+    assert!(text.contains("compressor=\"vtkZLibDataCompressor\""), "{text}");
+    let refused = Command::cargo_bin("drape")
+        .unwrap()
+        .args(["export", "--net", case.dir.join("p45.drape.json").to_str().unwrap()])
+        .args(["--mesh", root().join("geometries/hemisphere/hemisphere-2k.obj").to_str().unwrap()])
+        .args(["--format", "vtu", "--out", case.dir.join("x.vtu").to_str().unwrap(), "--vtu", "zip"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success() && stderr.contains("--vtu: unknown VTU encoding 'zip'"), "{stderr}");
+    assert!(!case.dir.join("x.vtu").exists());
+    if skip_python() || !vtk_ready() {
+        return;
+    }
+    let (b, a) = (read_with_vtk(&bin), read_with_vtk(&ascii));
+    assert_eq!(b.arrays.keys().collect::<Vec<_>>(), a.arrays.keys().collect::<Vec<_>>());
+    for (key, values) in &b.arrays {
+        let same = values.len() == a.arrays[key].len()
+            && values.iter().zip(&a.arrays[key]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+        assert!(same, "{key} differs between the binary and the ASCII file");
+    }
+    let covered = &b.arrays["cell.covered"];
+    let vf = &b.arrays["cell.vf"];
+    assert!(covered.contains(&0.0), "some elements uncovered");
+    for (c, v) in covered.iter().zip(vf) {
+        assert_eq!(*c == 0.0, v.is_nan(), "NaN exactly on the uncovered elements");
+    }
+}

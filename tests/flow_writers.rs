@@ -735,3 +735,62 @@ fn nastran_deck_cross_references_the_users_properties() {
         }
     }
 }
+
+/// The flow VTU as compressed binary: VTK's own reader gets the same arrays as from the ASCII
+/// file, bit for bit, NaN where a ply does not cover an element included (and NaN stays NaN).
+#[test]
+fn flow_vtu_binary_reads_in_vtk_as_the_ascii_does() {
+    use crate::common::vtk_reader::{read_with_vtk, vtk_ready};
+    use drape::io::flow::{write_flow_with, FlowOptions};
+    use drape::io::vtk::VtuEncoding;
+    let mesh = mesh();
+    let map = layup_map(&mesh, true);
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, ascii) = (dir.path().join("flow.vtu"), dir.path().join("flow-ascii.vtu"));
+    let opts = |vtu| FlowOptions { vtu, ..FlowOptions::default() };
+    write_flow_with(&mesh, &map, FlowFormat::Vtu, &bin, &opts(VtuEncoding::Binary)).unwrap();
+    write_flow_with(&mesh, &map, FlowFormat::Vtu, &ascii, &opts(VtuEncoding::Ascii)).unwrap();
+    // The default for a small mesh is ASCII.
+    let auto = dir.path().join("flow-auto.vtu");
+    write_flow(&mesh, &map, FlowFormat::Vtu, &auto).unwrap();
+    assert_eq!(std::fs::read(&auto).unwrap(), std::fs::read(&ascii).unwrap());
+    assert!(!std::fs::read(&bin).unwrap().windows(14).any(|w| w == b"format=\"ascii\""));
+    if !vtk_ready() {
+        return;
+    }
+    let (b, a) = (read_with_vtk(&bin), read_with_vtk(&ascii));
+    assert_eq!(b.summary["encoding"]["compressor"], "vtkZLibDataCompressor");
+    assert_eq!(b.summary["cells"].as_u64().unwrap() as usize, mesh.elements.len());
+    assert_eq!(b.arrays.keys().collect::<Vec<_>>(), a.arrays.keys().collect::<Vec<_>>());
+    for (key, values) in &b.arrays {
+        let same = values.len() == a.arrays[key].len()
+            && values.iter().zip(&a.arrays[key]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+        assert!(same, "{key} differs between the binary and the ASCII file");
+    }
+    // Against the map itself: ids, and NaN exactly where a ply does not cover an element.
+    let ids: Vec<f64> = mesh.elements.iter().map(|e| e.id as f64).collect();
+    assert_eq!(b.arrays["cell.element_id"], ids);
+    let mut uncovered = 0;
+    for ply in &map.plies {
+        let warp = &b.arrays[&format!("cell.{}_warp", ply.ply)];
+        let covered = &b.arrays[&format!("cell.{}_covered", ply.ply)];
+        for (e, f) in ply.elements.iter().enumerate() {
+            match f {
+                Some(f) => {
+                    assert_eq!(covered[e], 1.0);
+                    assert_eq!(warp[3 * e..3 * e + 3], [f.warp.x, f.warp.y, f.warp.z]);
+                }
+                None => {
+                    uncovered += 1;
+                    assert_eq!(covered[e], 0.0);
+                    assert!(
+                        warp[3 * e..3 * e + 3].iter().all(|v| v.is_nan()),
+                        "element {e}: {:?}",
+                        &warp[3 * e..3 * e + 3]
+                    );
+                }
+            }
+        }
+    }
+    assert!(uncovered > 0, "the layup leaves elements uncovered");
+}

@@ -91,11 +91,13 @@ impl std::str::FromStr for FlowFormat {
 pub struct FlowOptions {
     /// The material name CalculiX sections refer to (the user defines the material).
     pub material_name: String,
+    /// ASCII or binary VTU (by default by size).
+    pub vtu: vtk::VtuEncoding,
 }
 
 impl Default for FlowOptions {
     fn default() -> Self {
-        FlowOptions { material_name: calculix::DEFAULT_MATERIAL.to_string() }
+        FlowOptions { material_name: calculix::DEFAULT_MATERIAL.to_string(), vtu: vtk::VtuEncoding::Auto }
     }
 }
 
@@ -120,7 +122,7 @@ pub fn write_flow_with(
 ) -> Result<Vec<PathBuf>, ExportError> {
     check(mesh, map, format.name())?;
     match format {
-        FlowFormat::Vtu => vtk::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::Vtu => vtk::write_flow(mesh, map, out, options.vtu).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Nastran => nastran::write_flow(mesh, map, out),
         FlowFormat::Abaqus => abaqus::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Calculix => calculix::write_flow(mesh, map, out, &options.material_name),

@@ -13,7 +13,7 @@ use super::folder::{prepare, FolderError};
 use super::scene::{Scene, SceneExport};
 use crate::geometry::ToolSurface;
 use crate::io::drawing::{write_cutting_plan, PatternError};
-use crate::io::flow::write_flow;
+use crate::io::flow::{write_flow_with, FlowOptions};
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::{read_flow_mesh, read_tool, write_net, ExportError, Format, ReadToolError};
 use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeError};
@@ -367,7 +367,8 @@ fn export_flow(
     let ms = flow.read_ms + t.elapsed().as_secs_f64() * 1e3;
     on(Event::FlowMapped { path: &export.mesh, mesh, map: &map, ms });
     for &format in &export.formats {
-        let files = write_flow(mesh, &map, format, &out.join(format.scene_file()))?;
+        let options = FlowOptions { vtu: export.vtu, ..FlowOptions::default() };
+        let files = write_flow_with(mesh, &map, format, &out.join(format.scene_file()), &options)?;
         on(Event::FlowWritten { files: &files });
         written.extend(files);
     }
