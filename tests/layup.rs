@@ -270,6 +270,10 @@ fn scene_errors_name_the_field_and_the_line() {
         &format!("{head}[export]\nmesh = \"x.bdf\"\n{PLY}"),
         "[export] (line 2), field `mesh`: no flow mesh at",
     );
+    scene_refused(
+        &format!("{head}[export]\nmesh = \"x.bdf\"\nvtu = \"zip\"\n{PLY}"),
+        "[export] (line 2), field `vtu`: unknown VTU encoding 'zip': use auto, ascii or binary",
+    );
     // A reference along the normal at the seed (the pole) has no direction on the tool there.
     scene_refused(&format!("{head}reference = [0.0, 0.0, 1.0]\n{PLY}"), "normal to the tool at the seed");
 }
