@@ -203,3 +203,85 @@ fn csv_frame_matches_geometry() {
         assert!((vec(12) - normal).norm() < 1e-12, "{line}");
     }
 }
+
+/// A net larger than `BINARY_FROM_CELLS` is written as compressed binary VTU, and VTK's own
+/// reader gets every point and every cell value of the net back bit for bit.
+#[test]
+fn export_large_net_as_binary_vtu_read_by_vtk() {
+    use crate::common::vtk_reader::{read_with_vtk, vtk_ready};
+    use drape::io::vtk::{write_vtu_as, VtuEncoding, BINARY_FROM_CELLS};
+    let n = 241;
+    let d = 0.005;
+    let mut net = DrapeNet::new("big", d, n, n, (n / 2, n / 2));
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = (i as f64 * d, j as f64 * d);
+            let k = net.index(i, j);
+            net.positions[k] = Point::new(x, y, 0.05 * (3.0 * x).sin() * (2.0 * y).cos());
+            net.status[k] = NodeStatus::Placed;
+        }
+    }
+    // Failed nodes: a corner block and a scattered few, so points are renumbered.
+    for i in 0..n {
+        for j in 0..n {
+            if (i < 20 && j < 30) || (i * 7 + j * 13) % 997 == 0 {
+                let k = net.index(i, j);
+                net.status[k] = NodeStatus::NoRoot;
+            }
+        }
+    }
+    let complete: Vec<(usize, usize)> = (0..n - 1)
+        .flat_map(|i| (0..n - 1).map(move |j| (i, j)))
+        .filter(|&(i, j)| net.cell_corners(i, j).is_some())
+        .collect();
+    assert!(complete.len() >= BINARY_FROM_CELLS, "{} cells", complete.len());
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, ascii) = (dir.path().join("big.vtu"), dir.path().join("big-ascii.vtu"));
+    drape::io::write_vtu(&net, &bin).unwrap();
+    write_vtu_as(&net, &ascii, VtuEncoding::Ascii).unwrap();
+    let bytes = std::fs::read(&bin).unwrap();
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4000)]).into_owned();
+    assert!(head.contains("compressor=\"vtkZLibDataCompressor\"") && head.contains("header_type=\"UInt64\""));
+    assert!(!head.contains("format=\"ascii\"") && head.contains("format=\"appended\""));
+    let ascii_len = std::fs::metadata(&ascii).unwrap().len();
+    println!("{} cells: binary {} bytes, ascii {ascii_len} bytes", complete.len(), bytes.len());
+    assert!((bytes.len() as u64) < ascii_len / 2, "binary is not smaller");
+    // A small net stays ASCII.
+    let small = sheared_net();
+    let small_path = dir.path().join("small.vtu");
+    drape::io::write_vtu(&small, &small_path).unwrap();
+    assert!(std::fs::read_to_string(&small_path).unwrap().contains("format=\"ascii\""));
+
+    if !vtk_ready() {
+        return;
+    }
+    let r = read_with_vtk(&bin);
+    assert_eq!(r.summary["encoding"]["compressor"], "vtkZLibDataCompressor");
+    let placed: Vec<usize> = (0..n * n).filter(|&k| net.status[k] == NodeStatus::Placed).collect();
+    assert_eq!(r.summary["points"].as_u64().unwrap() as usize, placed.len());
+    assert_eq!(r.summary["cells"].as_u64().unwrap() as usize, complete.len());
+    let a = &r.arrays;
+    for (p, &k) in placed.iter().enumerate() {
+        let q = net.positions[k];
+        assert_eq!(a["points.Points"][3 * p..3 * p + 3], [q.x, q.y, q.z], "point {p}");
+        assert_eq!([a["point.node_i"][p], a["point.node_j"][p]], [(k / n) as f64, (k % n) as f64]);
+    }
+    assert!(a["cells.types"].iter().all(|&t| t == 9.0));
+    for (c, &(i, j)) in complete.iter().enumerate() {
+        assert_eq!([a["cell.cell_i"][c], a["cell.cell_j"][c]], [i as f64, j as f64]);
+        assert_eq!(a["cell.shear_deg"][c], net.cell_shear(i, j).unwrap().to_degrees(), "cell ({i}, {j})");
+        let f = net.cell_frame(i, j).unwrap();
+        for (name, v) in [("warp", f.warp), ("weft", f.weft), ("normal", f.normal)] {
+            assert_eq!(a[&format!("cell.{name}")][3 * c..3 * c + 3], [v.x, v.y, v.z], "{name} of ({i}, {j})");
+        }
+        // Corners (i, j), (i+1, j), (i+1, j+1), (i, j+1) by the points' node numbers.
+        assert_eq!(a["cells.offsets"][c], 4.0 * (c + 1) as f64);
+        let corners: Vec<(f64, f64)> = a["cells.connectivity"][4 * c..4 * c + 4]
+            .iter()
+            .map(|&p| (a["point.node_i"][p as usize], a["point.node_j"][p as usize]))
+            .collect();
+        let want: Vec<(f64, f64)> =
+            [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].iter().map(|&(x, y)| (x as f64, y as f64)).collect();
+        assert_eq!(corners, want, "cell ({i}, {j})");
+    }
+}

@@ -1,8 +1,9 @@
 //! Flat patterns, nesting and their drawings, on real drapes of generated tools.
 //!
-//! Known answers: on a plate the pattern is the plate (to the staircase of one spacing), on a
-//! cylinder the unrolled patch (axis length by arc length); on a hemisphere the pattern area is
-//! exactly the number of complete cells times d^2. The DXF and SVG are read back by
+//! Known answers: on a plate the pattern is the plate (to within one spacing), on a cylinder
+//! the unrolled patch (axis length by arc length); cut through the boundary nodes the pattern
+//! area is exactly (complete cells + half cells / 2) d^2; a ply with an outline is cut along the
+//! outline carried into the flat frame (on a plate: the outline itself). The DXF and SVG are read back by
 //! tools/pattern_readback.py (ezdxf and xml.etree; `python3 -m pip install -r
 //! tools/requirements.txt`); DRAPE_SKIP_PYTHON=1 skips that part.
 use drape::geometry::{shapes, Point, ToolSurface, Vector};
@@ -10,7 +11,10 @@ use drape::io::drawing::{write_cutting_plan, PatternError};
 use drape::io::dxf::{dxf_layer_names, write_dxf};
 use drape::io::svg::{svg_ids, write_pattern_svg, write_svg};
 use drape::kinematic::{drape, DrapeNet, Extent, KinematicSettings, NodeStatus};
-use drape::layup::flat::{flat_pattern, flat_pattern_with_margin, shoelace_area, FlatError, FlatPattern, Region};
+use drape::layup::flat::{
+    flat_pattern, flat_pattern_in_outline, flat_pattern_with_margin, ply_pattern, shoelace_area, CutLine, FlatError,
+    FlatPattern, Region,
+};
 use drape::layup::nest::{nest, Nesting, Rotation};
 use proptest::prelude::*;
 use serde_json::Value;
@@ -38,19 +42,48 @@ fn complete_cells(net: &DrapeNet) -> usize {
         .count()
 }
 
-/// Loops of a pattern are closed, axis-aligned, on the grid of spacing d, simple (no repeated
+/// Cells of a net with exactly three placed corners, counted directly.
+fn half_cells(net: &DrapeNet) -> usize {
+    (0..net.nu - 1)
+        .flat_map(|i| (0..net.nv - 1).map(move |j| (i, j)))
+        .filter(|&(i, j)| {
+            [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)].iter().filter(|&&(a, b)| net.node(a, b).is_some()).count()
+                == 3
+        })
+        .count()
+}
+
+/// Largest turn between consecutive edges of the loops of a pattern, degrees.
+fn max_turn_deg(p: &FlatPattern) -> f64 {
+    let mut worst = 0.0f64;
+    for l in p.loops() {
+        let n = l.len();
+        for k in 0..n {
+            let (a, b, c) = (l[(k + n - 1) % n], l[k], l[(k + 1) % n]);
+            let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+            worst = worst.max((u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1]).abs().to_degrees());
+        }
+    }
+    worst
+}
+
+/// Loops of a pattern cut through the boundary nodes are closed polygons through nodes (on the
+/// grid of spacing d), each edge along a fibre or along cell diagonals, simple (no repeated
 /// vertex, no collinear vertex), outer counter-clockwise first then holes clockwise, and the
-/// signed areas add up to the pattern area.
+/// signed areas add up to the pattern area, (cells + half cells / 2) d^2.
 fn check_pattern(p: &FlatPattern) {
     let d = p.spacing;
+    assert_eq!(p.cut, CutLine::Nodes, "{}", p.ply);
     let mut total = 0.0;
     for r in &p.regions {
         let areas: Vec<f64> = r.loops.iter().map(|l| shoelace_area(l)).collect();
         assert!(areas[0] > 0.0, "{}: the outer loop must be counter-clockwise: {areas:?}", p.ply);
         assert!(areas[1..].iter().all(|&a| a < 0.0), "{}: holes must be clockwise: {areas:?}", p.ply);
         let sum: f64 = areas.iter().sum();
-        assert!((sum - r.area).abs() <= AREA_REL * r.area, "{}: loops {sum} vs cells {}", p.ply, r.area);
-        assert_eq!(r.area, r.cells as f64 * d * d);
+        assert!((sum - r.area).abs() <= AREA_REL * r.area, "{}: loops {sum} vs triangles {}", p.ply, r.area);
+        // Whole cells and half cells: a multiple of d^2 / 2.
+        let halves = r.area / (0.5 * d * d);
+        assert!((halves - halves.round()).abs() < 1e-9 && halves.round() >= 2.0 * r.cells as f64, "{}", p.ply);
         total += sum;
         for l in &r.loops {
             let n = l.len();
@@ -67,14 +100,25 @@ fn check_pattern(p: &FlatPattern) {
                     p.ply
                 );
                 let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
-                assert!(u[0].abs() < LEN_EPS || u[1].abs() < LEN_EPS, "{}: edge not along a fibre", p.ply);
-                assert!((u[0] * w[1] - u[1] * w[0]).abs() > 0.5 * d * d, "{}: vertex {b:?} is not a corner", p.ply);
+                assert!(
+                    u[0].abs() < LEN_EPS || u[1].abs() < LEN_EPS || (u[0].abs() - u[1].abs()).abs() < LEN_EPS,
+                    "{}: edge {a:?} -> {b:?} neither along a fibre nor along cell diagonals",
+                    p.ply
+                );
+                assert!((u[0] * w[1] - u[1] * w[0]).abs() > 0.25 * d * d, "{}: vertex {b:?} is not a corner", p.ply);
             }
         }
     }
     assert!((total - p.area).abs() <= AREA_REL * p.area);
     assert_eq!(p.cells, p.regions.iter().map(|r| r.cells).sum::<usize>());
-    assert_eq!(p.area, p.cells as f64 * d * d);
+    let want = (2 * p.cells + p.half_cells) as f64 * 0.5 * d * d;
+    assert!((p.area - want).abs() <= AREA_REL * want, "{}: area {} vs {want}", p.ply, p.area);
+}
+
+/// `check_pattern`, and the cell counts are the net's own.
+fn check_net_pattern(p: &FlatPattern, net: &DrapeNet) {
+    check_pattern(p);
+    assert_eq!((p.cells, p.half_cells), (complete_cells(net), half_cells(net)), "{}", p.ply);
 }
 
 #[test]
@@ -85,7 +129,7 @@ fn plate_ply_fully_on_the_tool_is_one_rectangle() {
     let net =
         drape(&tool, &KinematicSettings::grid("rect", Point::new(0.05, -0.03, 0.01), Vector::x(), d, nu, nv)).unwrap();
     let p = flat_pattern(&net).unwrap();
-    check_pattern(&p);
+    check_net_pattern(&p, &net);
     assert_eq!(p.regions.len(), 1);
     assert_eq!(p.regions[0].loops.len(), 1);
     assert_eq!(p.regions[0].loops[0].len(), 4, "a rectangle: {:?}", p.regions[0].loops[0]);
@@ -108,7 +152,7 @@ fn plate_ply_larger_than_the_plate_is_the_plate_outline_to_within_d() {
     let net = drape(&tool, &KinematicSettings::grid("big", seed, Vector::x(), d, 41, 31)).unwrap();
     assert!(net.status.iter().any(|s| *s != NodeStatus::Placed), "the ply must overhang the plate");
     let p = flat_pattern(&net).unwrap();
-    check_pattern(&p);
+    check_net_pattern(&p, &net);
     assert_eq!((p.regions.len(), p.regions[0].loops.len(), p.regions[0].loops[0].len()), (1, 1, 4));
     // On a plane the flat pattern is the drape itself: flat point + seed = draped node.
     let (i0, j0) = net.origin_node;
@@ -147,10 +191,10 @@ fn ply_trimmed_to_a_circular_outline() {
     s.extent = Extent::Outline(outline);
     let net = drape(&tool, &s).unwrap();
     let p = flat_pattern(&net).unwrap();
-    check_pattern(&p);
+    check_net_pattern(&p, &net);
     assert_eq!(p.regions.len(), 1);
-    // Cells with all corners inside the polygon lie inside the circle; every point of the
-    // disc of radius r - sqrt(2) d (less the polygon's sagitta) is in such a cell.
+    // The nodes inside the polygon span a convex region inside the circle; every point of the
+    // disc of radius r - sqrt(2) d (less the polygon's sagitta) is in a complete cell.
     let sagitta = r * (1.0 - (std::f64::consts::PI / 180.0).cos());
     let inner = r - sagitta - std::f64::consts::SQRT_2 * d;
     let pi = std::f64::consts::PI;
@@ -182,7 +226,7 @@ fn cylinder_pattern_is_the_unrolled_patch() {
     let net =
         drape(&tool, &KinematicSettings::grid("cyl", Point::new(0.0, 0.007, radius), Vector::y(), d, 61, 91)).unwrap();
     let p = flat_pattern(&net).unwrap();
-    check_pattern(&p);
+    check_net_pattern(&p, &net);
     // Arc length of the faceted section: the sum of its chords. Nodes d apart fit in a length L
     // over at least L - d (the staircase).
     let arc = n_around as f64 * 2.0 * radius * (std::f64::consts::PI / (2.0 * n_around as f64)).sin();
@@ -197,16 +241,15 @@ fn cylinder_pattern_is_the_unrolled_patch() {
 }
 
 #[test]
-fn hemisphere_pattern_area_is_the_cell_count_exactly() {
+fn hemisphere_pattern_area_is_the_cell_and_half_cell_count_exactly() {
     for (name, warp, n) in [("h0", Vector::x(), 61), ("h45", Vector::new(1.0, 1.0, 0.0), 71)] {
         let net =
             drape(hemisphere(), &KinematicSettings::grid(name, Point::new(0.0, 0.0, 1.0), warp, 0.05, n, n)).unwrap();
         let p = flat_pattern(&net).unwrap();
-        check_pattern(&p);
-        let cells = complete_cells(&net);
-        assert_eq!(p.cells, cells);
-        // A woven cell keeps its fibre lengths: each draped cell is d x d undeformed.
-        assert_eq!(p.area, cells as f64 * 0.05 * 0.05);
+        // A woven cell keeps its fibre lengths: each draped cell is d x d undeformed, each half
+        // cell (three corners on the tool) half of that.
+        check_net_pattern(&p, &net);
+        assert!(p.half_cells > 0, "{name}: the rim of a hemisphere drape has half cells");
         let holes: usize = p.regions.iter().map(|r| r.loops.len() - 1).sum();
         println!(
             "{name}: {} cells, {} region(s), {holes} hole(s), area {:.4} m2, bbox {:?}",
@@ -259,9 +302,30 @@ fn shape_net(name: &str, d: f64, nu: usize, nv: usize, cells: impl Fn(usize, usi
     net
 }
 
+/// The box of a net's complete cells in the flat frame: [min, max].
+fn cell_box(net: &DrapeNet) -> [[f64; 2]; 2] {
+    let (d, (i0, j0)) = (net.spacing, net.origin_node);
+    let mut b = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+    for i in 0..net.nu - 1 {
+        for j in 0..net.nv - 1 {
+            if net.cell_corners(i, j).is_some() {
+                let lo = [(i as f64 - i0 as f64) * d, (j as f64 - j0 as f64) * d];
+                for k in 0..2 {
+                    b[0][k] = b[0][k].min(lo[k]);
+                    b[1][k] = b[1][k].max(lo[k] + d);
+                }
+            }
+        }
+    }
+    b
+}
+
 /// Loops of a pattern with a margin: outer counter-clockwise first, holes clockwise, region
-/// areas are their shoelace sums, and the box is the plain pattern's grown by the margin.
-fn check_margin(p: &FlatPattern, plain: &FlatPattern, margin: f64) {
+/// areas are their shoelace sums, and the box is the complete cells' box grown by the margin.
+fn check_margin(p: &FlatPattern, net: &DrapeNet, margin: f64) {
+    let plain = flat_pattern(net).unwrap();
+    let [lo, hi] = cell_box(net);
+    assert_eq!(p.cut, CutLine::GrownCells);
     let mut total = 0.0;
     for r in &p.regions {
         let areas: Vec<f64> = r.loops.iter().map(|l| shoelace_area(l)).collect();
@@ -273,12 +337,9 @@ fn check_margin(p: &FlatPattern, plain: &FlatPattern, margin: f64) {
     assert_eq!(p.cells, plain.cells);
     assert_eq!(p.regions.iter().map(|r| r.cells).sum::<usize>(), p.cells);
     for k in 0..2 {
-        assert!(
-            (p.min[k] - (plain.min[k] - margin)).abs() < LEN_EPS
-                && (p.max[k] - (plain.max[k] + margin)).abs() < LEN_EPS
-        );
+        assert!((p.min[k] - (lo[k] - margin)).abs() < LEN_EPS && (p.max[k] - (hi[k] + margin)).abs() < LEN_EPS);
     }
-    assert!(p.area > plain.area);
+    assert!(p.area > p.cells as f64 * net.spacing * net.spacing);
 }
 
 #[test]
@@ -288,22 +349,21 @@ fn cutting_margin_grows_the_outline_with_square_corners() {
     let rect = shape_net("rect", d, 21, 11, |_, _| true);
     let m = 0.003;
     let p = flat_pattern_with_margin(&rect, m).unwrap();
-    check_margin(&p, &flat_pattern(&rect).unwrap(), m);
+    check_margin(&p, &rect, m);
     assert_eq!((p.regions.len(), p.regions[0].loops.len(), p.regions[0].loops[0].len()), (1, 1, 4));
     assert!((p.area - (0.2 + 2.0 * m) * (0.1 + 2.0 * m)).abs() < 1e-15, "{}", p.area);
     // Two squares touching at a corner merge into one piece: the grown squares overlap by (2m)^2.
     let pinch = shape_net("pinch", d, 21, 21, |i, j| (i < 10) == (j < 10));
     let p = flat_pattern_with_margin(&pinch, m).unwrap();
-    check_margin(&p, &flat_pattern(&pinch).unwrap(), m);
+    check_margin(&p, &pinch, m);
     assert_eq!((p.regions.len(), p.regions[0].cells), (1, 200));
     let want = 2.0 * (0.1 + 2.0 * m) * (0.1 + 2.0 * m) - 4.0 * m * m;
     assert!((p.area - want).abs() < 1e-15, "{} vs {want}", p.area);
     // A ring keeps a smaller hole, until the margin closes it (hole 0.1 wide).
     let ring = shape_net("ring", d, 21, 21, |i, j| !(5..15).contains(&i) || !(5..15).contains(&j));
-    let plain = flat_pattern(&ring).unwrap();
     for (m, holes) in [(0.004, 1), (0.03, 1), (0.05, 0), (0.07, 0)] {
         let p = flat_pattern_with_margin(&ring, m).unwrap();
-        check_margin(&p, &plain, m);
+        check_margin(&p, &ring, m);
         assert_eq!(p.regions[0].loops.len() - 1, holes, "margin {m}");
         let hole = (0.1 - 2.0 * m).max(0.0);
         let want = (0.2 + 2.0 * m).powi(2) - hole * hole;
@@ -317,7 +377,7 @@ fn cutting_margin_grows_the_outline_with_square_corners() {
     .unwrap();
     let plain = flat_pattern(&net).unwrap();
     for m in [0.0123, 0.025, 0.075] {
-        check_margin(&flat_pattern_with_margin(&net, m).unwrap(), &plain, m);
+        check_margin(&flat_pattern_with_margin(&net, m).unwrap(), &net, m);
     }
     assert_eq!(flat_pattern_with_margin(&net, 0.0).unwrap(), plain);
     assert!(matches!(flat_pattern_with_margin(&net, -0.01), Err(FlatError::BadMargin { .. })));
@@ -408,7 +468,9 @@ fn rect_pattern(name: &str, a: f64, b: f64, at: [f64; 2]) -> FlatPattern {
         origin_node: (0, 0),
         regions: vec![Region { loops: vec![vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]], cells: 1, area: a * b }],
         cells: 1,
+        half_cells: 0,
         area: a * b,
+        cut: CutLine::Nodes,
         min: [x0, y0],
         max: [x1, y1],
         anchor: [x0 + a / 2.0, y0 + b / 2.0],
@@ -619,4 +681,122 @@ fn drawings_read_back_independently() {
         let g = &r[path.to_str().unwrap()]["groups"][id.as_str()];
         assert!(close(num(&g["signed_area_mm2"]) * 1e-6, p.area, FILE_AREA_REL), "{id}");
     }
+}
+
+/// Largest turn (degrees) between consecutive edges of a pattern cut along a smooth outline of
+/// N points: a polygon of N points round a convex curve turns by 360/N on average; the flat
+/// image of a circle on the hemisphere is not a circle (the fabric shears), so some vertices
+/// turn several times that, but nowhere near the 90 degree steps of a staircase of cells.
+const MAX_OUTLINE_TURN_DEG: f64 = 10.0;
+
+/// A circle of `n` points round the z axis at `z`, radius `r`, counter-clockwise seen from +z.
+fn circle(r: f64, z: f64, n: usize) -> Vec<Point> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 * std::f64::consts::TAU / n as f64;
+            Point::new(r * t.cos(), r * t.sin(), z)
+        })
+        .collect()
+}
+
+#[test]
+fn outline_ply_on_a_plate_is_cut_along_the_outline_itself() {
+    let tool = shapes::plate(1.0, 1.0, 20, 20).into_surface().unwrap();
+    let (r, d, n) = (0.2, 0.01, 180);
+    let outline = circle(r, 0.0, n);
+    let mut s = KinematicSettings::grid("disc", Point::origin(), Vector::x(), d, 3, 3);
+    s.extent = Extent::Outline(outline.clone());
+    let net = drape(&tool, &s).unwrap();
+    let q = flat_pattern_in_outline(&net, &outline).unwrap();
+    assert_eq!(q.cut, CutLine::Outline);
+    assert_eq!((q.regions.len(), q.regions[0].loops.len(), q.regions[0].loops[0].len()), (1, 1, n));
+    // On a plane the flat frame is the tool moved by the seed (here the origin): every vertex is
+    // its outline point, in order.
+    for (v, o) in q.regions[0].loops[0].iter().zip(&outline) {
+        assert!((v[0] - o.x).abs() < LEN_EPS && (v[1] - o.y).abs() < LEN_EPS, "{v:?} vs {o:?}");
+    }
+    let want = shoelace_area(&outline.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>());
+    assert!((q.area - want).abs() <= 1e-9 * want, "area {} vs the outline's {want}", q.area);
+    assert!((max_turn_deg(&q) - 360.0 / n as f64).abs() < 1e-6, "turn {}", max_turn_deg(&q));
+    // Through the boundary nodes instead: chords inside the outline, less area.
+    let p = flat_pattern(&net).unwrap();
+    check_net_pattern(&p, &net);
+    assert!(p.area < q.area && q.area - p.area < 2.0 * std::f64::consts::PI * r * d, "{} vs {}", p.area, q.area);
+    // What the run cuts: the outline without a margin, the grown cells with one.
+    assert_eq!(ply_pattern(&net, Some(&outline), 0.0).unwrap(), q);
+    assert_eq!(ply_pattern(&net, None, 0.0).unwrap(), p);
+    assert_eq!(ply_pattern(&net, Some(&outline), 0.003).unwrap().cut, CutLine::GrownCells);
+    // An outline the net does not reach (twice as large) falls back to the boundary nodes.
+    assert_eq!(flat_pattern_in_outline(&net, &circle(2.0 * r, 0.0, n)).unwrap(), p);
+}
+
+/// The chords through the boundary nodes follow a circle without the staircase of whole cells:
+/// the cut turns by at most 45 degrees at a node (the staircase by 90 at every step), and leaves
+/// out of the disc exactly the half cells' area less than the staircase does.
+#[test]
+fn boundary_nodes_cut_chords_not_a_staircase() {
+    let tool = shapes::plate(1.0, 1.0, 20, 20).into_surface().unwrap();
+    let (r, d) = (0.2, 0.01);
+    let mut s = KinematicSettings::grid("disc", Point::origin(), Vector::x(), d, 3, 3);
+    s.extent = Extent::Outline(circle(r, 0.0, 360));
+    let net = drape(&tool, &s).unwrap();
+    let p = flat_pattern(&net).unwrap();
+    check_net_pattern(&p, &net);
+    let disc = shoelace_area(&circle(r, 0.0, 360).iter().map(|p| [p.x, p.y]).collect::<Vec<_>>());
+    let staircase = complete_cells(&net) as f64 * d * d;
+    let (left_out, stairs_left_out) = (disc - p.area, disc - staircase);
+    println!(
+        "disc {disc}: chords leave out {left_out}, the staircase {stairs_left_out}, max turn {}",
+        max_turn_deg(&p)
+    );
+    assert!(p.half_cells > 0);
+    let halves = p.half_cells as f64 * 0.5 * d * d;
+    assert!(left_out > 0.0 && (stairs_left_out - left_out - halves).abs() < 1e-12, "{left_out} vs {stairs_left_out}");
+    assert!(max_turn_deg(&p) <= 45.0 + 1e-9, "turns by {} deg", max_turn_deg(&p));
+    // Every vertex is a node inside the outline.
+    assert!(p.loops().flatten().all(|v| v[0].hypot(v[1]) < r), "a vertex outside the disc");
+}
+
+#[test]
+fn hemisphere_disc_outline_is_cut_along_its_flattened_outline() {
+    let (theta, d, n) = (0.5f64, 0.02, 240);
+    let outline = circle(theta.sin(), theta.cos(), n);
+    let mut s = KinematicSettings::grid("cap", Point::new(0.0, 0.0, 1.0), Vector::x(), d, 3, 3);
+    s.extent = Extent::Outline(outline.clone());
+    let net = drape(hemisphere(), &s).unwrap();
+    let q = flat_pattern_in_outline(&net, &outline).unwrap();
+    assert_eq!(q.cut, CutLine::Outline);
+    assert_eq!((q.regions.len(), q.regions[0].loops.len(), q.regions[0].loops[0].len()), (1, 1, n));
+    let turn = max_turn_deg(&q);
+    let l = &q.regions[0].loops[0];
+    let perimeter: f64 = (0..n).map(|k| (l[(k + 1) % n][0] - l[k][0]).hypot(l[(k + 1) % n][1] - l[k][1])).sum();
+    let p = flat_pattern(&net).unwrap();
+    check_net_pattern(&p, &net);
+    println!("cap: outline cut {} m2 (max turn {turn} deg, perimeter {perimeter}), nodes {} m2", q.area, p.area);
+    assert!(turn < MAX_OUTLINE_TURN_DEG, "largest turn {turn} deg");
+    // The outline runs through the band of cells whose outer corners were refused: it encloses
+    // the cut through the boundary nodes and lies within a cell's diagonal of it.
+    assert!(q.area > p.area && q.area - p.area < perimeter * std::f64::consts::SQRT_2 * d, "{} vs {}", q.area, p.area);
+    // The fabric the layup table counts is this cut.
+    let tool_outline = drape::kinematic::outline::Outline::new(hemisphere(), &outline, d).unwrap();
+    let stats = drape::layup::stack::ply_stats(&net, hemisphere(), Some(&tool_outline), 0.5, None);
+    assert_eq!(stats.fabric_area, q.area);
+    assert!(!q.loops().flatten().flatten().any(|v| v.is_nan()));
+
+    // The drawing: the ply's layer holds one closed loop, of that area, turning smoothly.
+    let nesting = nest(std::slice::from_ref(&q), 2.0, 0.01, Rotation::WarpAlongRoll).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let dxf = dir.path().join("cap.dxf");
+    write_dxf(std::slice::from_ref(&q), &nesting, &dxf).unwrap();
+    if !python_ready() {
+        return;
+    }
+    let r = readback(&[&dxf]);
+    let layer = &r[dxf.to_str().unwrap()]["by_layer"]["cap"];
+    assert_eq!((layer["closed_polylines"].as_u64(), layer["open_polylines"].as_u64()), (Some(1), Some(0)));
+    assert_eq!((layer["vertices"].as_u64(), layer["self_intersecting"].as_u64()), (Some(n as u64), Some(0)));
+    let area = num(&layer["signed_area_mm2"]) * 1e-6;
+    assert!(close(area, q.area, FILE_AREA_REL), "DXF area {area} vs {}", q.area);
+    let dxf_turn = num(&layer["max_turn_deg"]);
+    assert!(dxf_turn < MAX_OUTLINE_TURN_DEG, "DXF turns by {dxf_turn} deg");
 }

@@ -297,19 +297,76 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
     }
     assert_eq!(checked, covered);
 
-    // RTMsim (its read_nastran_mesh layout and 14-line input file): the covered elements, sets
-    // of the laminate, porosity 1 - Vf within what the ply's shear makes of Vf0.
+    // RTMsim (its read_nastran_mesh layout and 14-line input file): every element, sets of the
+    // laminate and one of the elements no ply covers, porosity 1 - Vf within what the ply's shear
+    // makes of Vf0.
     let mesh = export(&case, "rtmsim", "flow-rtmsim.bdf", &["--permeability"]);
     let input = case.dir.join("flow-rtmsim_input.txt");
     let rtm = readback("rtmsim", &[&mesh, &input]);
     let uncovered = rtm["uncovered"].as_array().unwrap().len();
-    assert_eq!(uncovered, elements.len() - covered, "RTMsim leaves out exactly the uncovered elements");
-    assert_eq!(rtm["tris"].as_object().unwrap().len(), covered, "the 2k mesh is all triangles: none split");
+    assert_eq!(uncovered, elements.len() - covered, "RTMsim lists exactly the uncovered elements");
+    assert!(uncovered > 0, "the case leaves elements uncovered");
+    assert_eq!(rtm["tris"].as_object().unwrap().len(), elements.len(), "every element, none split (all triangles)");
+    // The uncovered elements are the last SET used, alone, a preform region of their own.
+    let sets: Vec<Vec<u64>> = rtm["sets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect())
+        .collect();
+    let last = sets.iter().rposition(|s| !s.is_empty()).expect("a SET is written");
+    let mut want: Vec<u64> = rtm["uncovered"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+    let mut got = sets[last].clone();
+    want.sort();
+    got.sort();
+    assert_eq!(got, want, "SET {} holds the uncovered elements", last + 1);
+    assert_eq!(rtm["patchtypes"][last], 2);
     for p in rtm["params"].as_array().unwrap() {
         let porosity = p[1].as_f64().unwrap();
         assert!(
             porosity > 1.0 - 0.429 / 50f64.to_radians().cos() && porosity <= 1.0 - 0.429 + 1e-9,
             "porosity {porosity}"
         );
+    }
+}
+
+/// `drape export --vtu binary` writes the compressed binary VTU; VTK's reader finds in it the
+/// arrays of the ASCII file bit for bit (NaN on the uncovered elements), and a bad `--vtu` is
+/// refused.
+#[test]
+fn export_vtu_binary_option_reads_in_vtk_as_the_ascii() {
+    use crate::common::vtk_reader::{read_with_vtk, vtk_ready};
+    let case = drape_ply();
+    let bin = export(&case, "vtu", "flow-bin.vtu", &["--vtu", "binary"]);
+    let ascii = export(&case, "vtu", "flow-ascii.vtu", &["--vtu", "ascii"]);
+    let auto = export(&case, "vtu", "flow-auto.vtu", &[]);
+    assert_eq!(std::fs::read(&auto).unwrap(), std::fs::read(&ascii).unwrap(), "2k elements: ASCII by default");
+    let text = String::from_utf8_lossy(&std::fs::read(&bin).unwrap()[..400]).into_owned();
+    assert!(text.contains("compressor=\"vtkZLibDataCompressor\""), "{text}");
+    let refused = Command::cargo_bin("drape")
+        .unwrap()
+        .args(["export", "--net", case.dir.join("p45.drape.json").to_str().unwrap()])
+        .args(["--mesh", root().join("geometries/hemisphere/hemisphere-2k.obj").to_str().unwrap()])
+        .args(["--format", "vtu", "--out", case.dir.join("x.vtu").to_str().unwrap(), "--vtu", "zip"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success() && stderr.contains("--vtu: unknown VTU encoding 'zip'"), "{stderr}");
+    assert!(!case.dir.join("x.vtu").exists());
+    if skip_python() || !vtk_ready() {
+        return;
+    }
+    let (b, a) = (read_with_vtk(&bin), read_with_vtk(&ascii));
+    assert_eq!(b.arrays.keys().collect::<Vec<_>>(), a.arrays.keys().collect::<Vec<_>>());
+    for (key, values) in &b.arrays {
+        let same = values.len() == a.arrays[key].len()
+            && values.iter().zip(&a.arrays[key]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+        assert!(same, "{key} differs between the binary and the ASCII file");
+    }
+    let covered = &b.arrays["cell.covered"];
+    let vf = &b.arrays["cell.vf"];
+    assert!(covered.contains(&0.0), "some elements uncovered");
+    for (c, v) in covered.iter().zip(vf) {
+        assert_eq!(*c == 0.0, v.is_nan(), "NaN exactly on the uncovered elements");
     }
 }

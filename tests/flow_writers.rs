@@ -479,6 +479,11 @@ fn rtmsim_mesh_sets_and_parameters() {
         assert!(report.regions.len() <= MAX_RTMSIM_SETS + 1 && report.regions.len() <= report.groups_found);
         let uncovered: Vec<u64> = if layup { vec![] } else { vec![16] };
         assert_eq!(report.uncovered, uncovered);
+        // The uncovered elements get the SET after the covered regions' SETs.
+        let uncovered_set = (!layup).then_some(report.regions.len());
+        assert_eq!(report.uncovered_set, uncovered_set);
+        let sets_used = report.regions.len() - 1 + usize::from(uncovered_set.is_some());
+        assert!(sets_used <= MAX_RTMSIM_SETS);
         if !python_ready() {
             continue;
         }
@@ -491,10 +496,6 @@ fn rtmsim_mesh_sets_and_parameters() {
         let splits: Vec<Vec<u64>> = s["splits"].as_array().unwrap().iter().map(ids_of).collect();
         let mut tri_of = std::collections::BTreeMap::new(); // tri id -> element index
         for (e, el) in mesh.elements.iter().enumerate() {
-            if uncovered.contains(&el.id) {
-                assert!(!tris.contains_key(&el.id.to_string()));
-                continue;
-            }
             let mine: Vec<u64> = match el.shape {
                 ElementShape::Tria3 => vec![el.id],
                 ElementShape::Quad4 => {
@@ -514,6 +515,9 @@ fn rtmsim_mesh_sets_and_parameters() {
         }
         assert_eq!(tris.len(), tri_of.len());
         assert_eq!(s["meshio_triangles"].as_u64().unwrap() as usize, tri_of.len());
+        // Element count in = element count out: every element (covered or not) is written.
+        let written: std::collections::BTreeSet<usize> = tri_of.values().copied().collect();
+        assert_eq!(written.len(), mesh.elements.len());
         for (id, p) in s["grids"].as_object().unwrap() {
             let k = mesh.node_ids.iter().position(|n| n.to_string() == *id).unwrap();
             assert!((vec3(&f64s(p)) - mesh.nodes[k].coords).norm() < SHORT_FIELD_TOL, "grid {id}");
@@ -535,14 +539,31 @@ fn rtmsim_mesh_sets_and_parameters() {
                 }
             }
         }
-        for s_unused in report.regions.len()..=MAX_RTMSIM_SETS {
+        if let Some(u) = uncovered_set {
+            // Their own preform region: the main preform's values, for the user to edit.
+            assert_eq!(types[u - 1], 2);
+            assert_eq!(params[u], params[0]);
+            for t in &sets[u - 1] {
+                region_of_tri.insert(*t, usize::MAX);
+            }
+        }
+        for s_unused in sets_used + 1..=MAX_RTMSIM_SETS {
             assert_eq!(types[s_unused - 1], 0);
             assert!(sets[s_unused - 1].is_empty());
         }
-        assert_eq!(s["i_interactive"].as_u64().unwrap(), if report.regions.len() > 1 { 2 } else { 1 });
+        assert_eq!(s["i_interactive"].as_u64().unwrap(), if sets_used > 0 { 2 } else { 1 });
         let mut max_err: f64 = 0.0;
         for (t, &e) in &tri_of {
             let r = *region_of_tri.get(t).unwrap_or(&0);
+            let id = mesh.elements[e].id;
+            assert_eq!(
+                r == usize::MAX,
+                uncovered.contains(&id),
+                "tri {t} of element {id}: in the uncovered SET or not"
+            );
+            if r == usize::MAX {
+                continue;
+            }
             assert!(report.regions[r].elements.contains(&mesh.elements[e].id), "tri {t} in the wrong region");
             // The reference direction projected onto the element vs the element's own K1 axis.
             let n = mesh.normal(e).unwrap();
@@ -713,4 +734,63 @@ fn nastran_deck_cross_references_the_users_properties() {
             None => assert!(r["theta"].is_null() || r["theta"].as_f64() == Some(0.0), "{r}"),
         }
     }
+}
+
+/// The flow VTU as compressed binary: VTK's own reader gets the same arrays as from the ASCII
+/// file, bit for bit, NaN where a ply does not cover an element included (and NaN stays NaN).
+#[test]
+fn flow_vtu_binary_reads_in_vtk_as_the_ascii_does() {
+    use crate::common::vtk_reader::{read_with_vtk, vtk_ready};
+    use drape::io::flow::{write_flow_with, FlowOptions};
+    use drape::io::vtk::VtuEncoding;
+    let mesh = mesh();
+    let map = layup_map(&mesh, true);
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, ascii) = (dir.path().join("flow.vtu"), dir.path().join("flow-ascii.vtu"));
+    let opts = |vtu| FlowOptions { vtu, ..FlowOptions::default() };
+    write_flow_with(&mesh, &map, FlowFormat::Vtu, &bin, &opts(VtuEncoding::Binary)).unwrap();
+    write_flow_with(&mesh, &map, FlowFormat::Vtu, &ascii, &opts(VtuEncoding::Ascii)).unwrap();
+    // The default for a small mesh is ASCII.
+    let auto = dir.path().join("flow-auto.vtu");
+    write_flow(&mesh, &map, FlowFormat::Vtu, &auto).unwrap();
+    assert_eq!(std::fs::read(&auto).unwrap(), std::fs::read(&ascii).unwrap());
+    assert!(!std::fs::read(&bin).unwrap().windows(14).any(|w| w == b"format=\"ascii\""));
+    if !vtk_ready() {
+        return;
+    }
+    let (b, a) = (read_with_vtk(&bin), read_with_vtk(&ascii));
+    assert_eq!(b.summary["encoding"]["compressor"], "vtkZLibDataCompressor");
+    assert_eq!(b.summary["cells"].as_u64().unwrap() as usize, mesh.elements.len());
+    assert_eq!(b.arrays.keys().collect::<Vec<_>>(), a.arrays.keys().collect::<Vec<_>>());
+    for (key, values) in &b.arrays {
+        let same = values.len() == a.arrays[key].len()
+            && values.iter().zip(&a.arrays[key]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+        assert!(same, "{key} differs between the binary and the ASCII file");
+    }
+    // Against the map itself: ids, and NaN exactly where a ply does not cover an element.
+    let ids: Vec<f64> = mesh.elements.iter().map(|e| e.id as f64).collect();
+    assert_eq!(b.arrays["cell.element_id"], ids);
+    let mut uncovered = 0;
+    for ply in &map.plies {
+        let warp = &b.arrays[&format!("cell.{}_warp", ply.ply)];
+        let covered = &b.arrays[&format!("cell.{}_covered", ply.ply)];
+        for (e, f) in ply.elements.iter().enumerate() {
+            match f {
+                Some(f) => {
+                    assert_eq!(covered[e], 1.0);
+                    assert_eq!(warp[3 * e..3 * e + 3], [f.warp.x, f.warp.y, f.warp.z]);
+                }
+                None => {
+                    uncovered += 1;
+                    assert_eq!(covered[e], 0.0);
+                    assert!(
+                        warp[3 * e..3 * e + 3].iter().all(|v| v.is_nan()),
+                        "element {e}: {:?}",
+                        &warp[3 * e..3 * e + 3]
+                    );
+                }
+            }
+        }
+    }
+    assert!(uncovered > 0, "the layup leaves elements uncovered");
 }

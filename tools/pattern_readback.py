@@ -11,7 +11,8 @@ Prints one JSON object to stdout, {path: summary}, where a DXF summary has
              signed_area_mm2, abs_area_mm2, vertices, bbox_mm [xmin, ymin, xmax, ymax] of the
              polylines, text_bbox_mm the same of the texts as ezdxf measures them,
              self_intersecting (loops that cross or repeat a vertex),
-             loops_ccw, loops_cw}}
+             loops_ccw, loops_cw, max_turn_deg (the largest turn between consecutive edges of
+             the closed polylines, degrees), max_edge_mm (their longest edge)}}
 and an SVG summary has
   width, height (attribute strings), viewbox [x, y, w, h]
   groups: {id: {data_ply, cut_paths, subpaths, signed_area_mm2 (with y flipped back up),
@@ -20,6 +21,7 @@ and an SVG summary has
 Exit status 2 on bad arguments or an unreadable file.
 """
 import json
+import math
 import re
 import sys
 import xml.etree.ElementTree as ET
@@ -65,6 +67,17 @@ def self_intersecting(pts):
     return False
 
 
+def max_turn_deg(pts):
+    """Largest turn between consecutive edges of a closed loop, degrees (0 to 180)."""
+    n = len(pts)
+    worst = 0.0
+    for k in range(n):
+        a, b, c = pts[k - 1], pts[k], pts[(k + 1) % n]
+        u, w = (b[0] - a[0], b[1] - a[1]), (c[0] - b[0], c[1] - b[1])
+        worst = max(worst, abs(math.degrees(math.atan2(u[0] * w[1] - u[1] * w[0], u[0] * w[0] + u[1] * w[1]))))
+    return worst
+
+
 def bbox_update(box, pts):
     for x, y in pts:
         box[0], box[1] = min(box[0], x), min(box[1], y)
@@ -85,6 +98,7 @@ def read_dxf(path):
             "closed_polylines": 0, "open_polylines": 0, "lines": 0, "texts": 0, "text": [],
             "signed_area_mm2": 0.0, "abs_area_mm2": 0.0, "vertices": 0,
             "bbox_mm": [inf, inf, -inf, -inf], "text_bbox_mm": [inf, inf, -inf, -inf], "self_intersecting": 0, "loops_ccw": 0, "loops_cw": 0,
+            "max_turn_deg": 0.0, "max_edge_mm": 0.0,
         })
         kind = e.dxftype()
         if kind in ("POLYLINE", "LWPOLYLINE"):
@@ -102,6 +116,8 @@ def read_dxf(path):
             s["loops_ccw" if a > 0 else "loops_cw"] += 1
             s["vertices"] += len(pts)
             s["self_intersecting"] += int(self_intersecting(pts))
+            s["max_turn_deg"] = max(s["max_turn_deg"], max_turn_deg(pts))
+            s["max_edge_mm"] = max(s["max_edge_mm"], max(math.dist(pts[k - 1], pts[k]) for k in range(len(pts))))
             bbox_update(s["bbox_mm"], pts)
         elif kind == "LINE":
             s["lines"] += 1

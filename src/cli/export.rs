@@ -2,6 +2,7 @@
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
 use super::{input, Failure};
 use crate::io::flow::{write_flow_with, FlowFormat, FlowOptions};
+use crate::io::vtk::VtuEncoding;
 use crate::io::{read_flow_mesh, read_net};
 use crate::mapping::{map_plies, PlyMap, PlyToMap};
 use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP};
@@ -58,10 +59,15 @@ pub struct ExportArgs {
     /// The material the CalculiX deck's shell sections refer to (you define it).
     #[arg(long, default_value = crate::io::calculix::DEFAULT_MATERIAL)]
     pub material_name: String,
+    /// VTU encoding: auto (binary from 50k elements on), ascii, or binary (zlib-compressed,
+    /// appended).
+    #[arg(long, default_value = "auto")]
+    pub vtu: String,
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Failure> {
     let format: FlowFormat = a.format.parse().map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
+    let vtu: VtuEncoding = a.vtu.parse().map_err(|m| input(anyhow::anyhow!("--vtu: {m}")))?;
     let scale = unit_scale(&a.mesh_units).map_err(|m| input(anyhow::anyhow!("--mesh-units: {m}")))?;
     if let Some(t) = a.thickness {
         if !(t.is_finite() && t > 0.0) {
@@ -114,8 +120,9 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     );
     println!("{}", coverage_line(&map.plies[0]));
     println!("  mapped in {map_ms:.1} ms");
-    let written = write_flow_with(&mesh, &map, format, &a.out, &FlowOptions { material_name: a.material_name.clone() })
-        .map_err(super::write_failure)?;
+    let written =
+        write_flow_with(&mesh, &map, format, &a.out, &FlowOptions { material_name: a.material_name.clone(), vtu })
+            .map_err(super::write_failure)?;
     for p in written {
         println!("  wrote {}", p.display());
     }

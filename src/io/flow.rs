@@ -91,11 +91,13 @@ impl std::str::FromStr for FlowFormat {
 pub struct FlowOptions {
     /// The material name CalculiX sections refer to (the user defines the material).
     pub material_name: String,
+    /// ASCII or binary VTU (by default by size).
+    pub vtu: vtk::VtuEncoding,
 }
 
 impl Default for FlowOptions {
     fn default() -> Self {
-        FlowOptions { material_name: calculix::DEFAULT_MATERIAL.to_string() }
+        FlowOptions { material_name: calculix::DEFAULT_MATERIAL.to_string(), vtu: vtk::VtuEncoding::Auto }
     }
 }
 
@@ -120,7 +122,7 @@ pub fn write_flow_with(
 ) -> Result<Vec<PathBuf>, ExportError> {
     check(mesh, map, format.name())?;
     match format {
-        FlowFormat::Vtu => vtk::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
+        FlowFormat::Vtu => vtk::write_flow(mesh, map, out, options.vtu).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Nastran => nastran::write_flow(mesh, map, out),
         FlowFormat::Abaqus => abaqus::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Calculix => calculix::write_flow(mesh, map, out, &options.material_name),
@@ -141,8 +143,10 @@ pub struct RtmsimReport {
     pub regions: Vec<RtmsimRegion>,
     /// Elements whose group was merged into a written region because of RTMsim's limit.
     pub merged_elements: usize,
-    /// Ids of elements no ply covers: left out of the RTMsim mesh.
+    /// Ids of elements no ply covers: in the RTMsim mesh as SET `uncovered_set` of their own.
     pub uncovered: Vec<u64>,
+    /// The SET (1..=4) of the elements no ply covers, `None` when every element is covered.
+    pub uncovered_set: Option<usize>,
     /// Largest angle (degrees) between an element's own first principal permeability direction
     /// and its region's reference direction projected into the element.
     pub max_direction_error_deg: f64,

@@ -19,8 +19,11 @@
 //! the groups with the largest area become those regions and the elements of any further group
 //! go to the region nearest to their group (counted in the report). Region values are
 //! area-weighted means of their elements; the reference direction is the mean K1 axis.
-//! Elements no ply covers are left out of the mesh (RTMsim has no empty-cavity cells; a comment
-//! lists them). Inlets are left to RTMsim's interactive selection (`i_interactive` 2, or 1 when
+//! Elements no ply covers stay in the mesh as a SET of their own, the last one written (so the
+//! covered elements then get the main preform and at most three SETs): its parameter line
+//! repeats the main preform's values, marked for the user to replace with what fills that part
+//! of the cavity (a resin channel, a core, an insert); comment lines `$$ UNCOVERED id ...` list
+//! them. Inlets are left to RTMsim's interactive selection (`i_interactive` 2, or 1 when
 //! there is no set); the process values (pressures, viscosity, tmax) are RTMsim's documented
 //! example values: edit them. Run RTMsim in the output directory (the mesh name is relative).
 use super::flow::{sibling, RtmsimReport};
@@ -209,7 +212,8 @@ pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<
     let mut stats: Vec<(RtmsimRegion, Vec<Cell>)> = groups.into_iter().map(|(_, _, m)| (region(&m, mesh), m)).collect();
     // Largest area first (stable: ties keep mesh order).
     stats.sort_by(|a, b| b.0.area.total_cmp(&a.0.area));
-    let keep = stats.len().min(MAX_RTMSIM_SETS + 1);
+    // One SET is kept for the elements no ply covers, if there are any.
+    let keep = stats.len().min(MAX_RTMSIM_SETS + usize::from(uncovered.is_empty()));
     let dropped = stats.split_off(keep);
     let mut merged_elements = 0;
     for (g, members) in dropped {
@@ -249,14 +253,17 @@ pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<
     if mesh_name.contains(char::is_whitespace) {
         return Err(invalid(format!("RTMsim reads the mesh file name up to the first blank: '{mesh_name}' has one; choose an output name without blanks")));
     }
-    write_atomic(&mesh_path, |w| write_mesh(mesh, &cells, &regions, &region_of, &uncovered, w))?;
-    write_atomic(&input_path, |w| write_input(&mesh_name, &regions, w))?;
+    // The elements no ply covers: a SET after the covered regions' SETs.
+    let uncovered_set = (!uncovered.is_empty()).then_some(regions.len());
+    write_atomic(&mesh_path, |w| write_mesh(mesh, &regions, &region_of, &uncovered, uncovered_set, w))?;
+    write_atomic(&input_path, |w| write_input(&mesh_name, &regions, uncovered_set, w))?;
     Ok(RtmsimReport {
         files: vec![mesh_path, input_path],
         groups_found,
         regions,
         merged_elements,
         uncovered,
+        uncovered_set,
         max_direction_error_deg,
     })
 }
@@ -265,12 +272,14 @@ fn short(x: f64) -> String {
     fit_real(x, 8).expect("coordinates are checked finite")
 }
 
+/// The RTMsim mesh: every element of the flow mesh, covered ones in their region's SET (none for
+/// the main preform), the uncovered ones (`region_of` is `usize::MAX`) in `uncovered_set`.
 fn write_mesh<W: Write>(
     mesh: &FlowMesh,
-    cells: &[Cell],
     regions: &[RtmsimRegion],
     region_of: &[usize],
     uncovered: &[u64],
+    uncovered_set: Option<usize>,
     w: &mut W,
 ) -> io::Result<()> {
     writeln!(w, "$$ drape: RTMsim mesh of flow mesh {}", mesh.path.display())?;
@@ -280,19 +289,25 @@ fn write_mesh<W: Write>(
         regions.len(),
         regions.len() - 1
     )?;
+    if let Some(set) = uncovered_set {
+        writeln!(w, "$$ SET {set}: the {} element(s) no ply covers (give them their own values)", uncovered.len())?;
+    }
     for id in uncovered.chunks(10) {
         let s: Vec<String> = id.iter().map(u64::to_string).collect();
         writeln!(w, "$$ UNCOVERED {}", s.join(" "))?;
     }
-    // Triangles: (id, region, [node index; 3]).
+    // Triangles: (id, SET (0: the main preform), [node index; 3]).
     let mut next_id = mesh.elements.iter().map(|e| e.id).max().unwrap_or(0);
     let mut tris: Vec<(u64, usize, [usize; 3])> = Vec::new();
     let mut splits = Vec::new();
-    for c in cells {
-        let el = &mesh.elements[c.e];
+    for (e, el) in mesh.elements.iter().enumerate() {
+        let set = match region_of[e] {
+            usize::MAX => uncovered_set.expect("an uncovered element has its SET"),
+            r => r,
+        };
         let g = &el.nodes;
         match el.shape {
-            ElementShape::Tria3 => tris.push((el.id, region_of[c.e], [g[0], g[1], g[2]])),
+            ElementShape::Tria3 => tris.push((el.id, set, [g[0], g[1], g[2]])),
             ElementShape::Quad4 => {
                 let d13 = (mesh.nodes[g[2]] - mesh.nodes[g[0]]).norm();
                 let d24 = (mesh.nodes[g[3]] - mesh.nodes[g[1]]).norm();
@@ -302,8 +317,8 @@ fn write_mesh<W: Write>(
                     ([g[0], g[1], g[3]], [g[1], g[2], g[3]])
                 };
                 next_id += 1;
-                tris.push((el.id, region_of[c.e], a));
-                tris.push((next_id, region_of[c.e], b));
+                tris.push((el.id, set, a));
+                tris.push((next_id, set, b));
                 splits.push((el.id, next_id));
             }
         }
@@ -312,7 +327,7 @@ fn write_mesh<W: Write>(
         writeln!(w, "$$ SPLIT {q} {q} {t}")?;
     }
     writeln!(w, "CEND")?;
-    for r in 1..regions.len() {
+    for r in 1..regions.len() + usize::from(uncovered_set.is_some()) {
         let ids: Vec<String> = tris.iter().filter(|t| t.1 == r).map(|t| t.0.to_string()).collect();
         let lines: Vec<String> = ids.chunks(6).map(|c| c.join(",")).collect();
         for (k, line) in lines.iter().enumerate() {
@@ -338,7 +353,12 @@ fn write_mesh<W: Write>(
     writeln!(w, "ENDDATA")
 }
 
-fn write_input<W: Write>(mesh_name: &str, regions: &[RtmsimRegion], w: &mut W) -> io::Result<()> {
+fn write_input<W: Write>(
+    mesh_name: &str,
+    regions: &[RtmsimRegion],
+    uncovered_set: Option<usize>,
+    w: &mut W,
+) -> io::Result<()> {
     let line = |r: &RtmsimRegion| {
         format!(
             "{:?} {:?} {:?} {:?} {:?} {:?} {:?}",
@@ -355,13 +375,15 @@ fn write_input<W: Write>(mesh_name: &str, regions: &[RtmsimRegion], w: &mut W) -
     for s in 1..=MAX_RTMSIM_SETS {
         match regions.get(s) {
             Some(r) => writeln!(w, "{}    #t{s}_val porosity{s}_val K{s}_val alpha{s}_val refdir1{s}_val refdir2{s}_val refdir3{s}_val (SET {s})", line(r))?,
+            None if uncovered_set == Some(s) => writeln!(w, "{main}    #t{s}_val porosity{s}_val K{s}_val alpha{s}_val refdir1{s}_val refdir2{s}_val refdir3{s}_val (SET {s}: elements no ply covers; the main preform's values: EDIT)")?,
             None => writeln!(w, "{main}    #t{s}_val porosity{s}_val K{s}_val alpha{s}_val refdir1{s}_val refdir2{s}_val refdir3{s}_val (no SET {s}: unused)")?,
         }
     }
-    let types: Vec<&str> = (1..=MAX_RTMSIM_SETS).map(|s| if s < regions.len() { "2" } else { "0" }).collect();
+    let sets = regions.len() - 1 + usize::from(uncovered_set.is_some());
+    let types: Vec<&str> = (1..=MAX_RTMSIM_SETS).map(|s| if s <= sets { "2" } else { "0" }).collect();
     writeln!(w, "{}    #patchtype1val patchtype2val patchtype3val patchtype4val", types.join(" "))?;
     writeln!(w, "0 results.jld2    #i_restart restartfilename")?;
-    let interactive = if regions.len() > 1 { 2 } else { 1 };
+    let interactive = if sets > 0 { 2 } else { 1 };
     writeln!(w, "{interactive} 0.01    #i_interactive r_p (select the inlet ports in RTMsim)")?;
     writeln!(w, "16    #n_pics")
 }

@@ -67,6 +67,11 @@ impl Outline {
         Ok(Outline { points: pts, centroid, u, v, polygon })
     }
 
+    /// The outline's points as given (a repeated closing point dropped).
+    pub fn points(&self) -> &[Point] {
+        &self.points
+    }
+
     /// Nodes from the origin to the grid's edge so that the grid covers the outline.
     pub fn half_size(&self, origin: &Point, spacing: f64) -> usize {
         let reach = self.points.iter().map(|p| (p - origin).norm()).fold(0.0, f64::max);

@@ -2,16 +2,26 @@
 //!
 //! A woven ply is cut unsheared, so node (i, j) of a [`DrapeNet`] lies flat at
 //! `((i - i0) d, (j - j0) d)`: warp along +x, weft along +y, `d` the net spacing and `(i0, j0)`
-//! the origin (seed) node, which sits at (0, 0). A cell belongs to the pattern when its four
-//! corners were placed; the pattern is the union of those unit squares and its outline is the
-//! exact boundary of that union, traced on the integer grid.
+//! the origin (seed) node, which sits at (0, 0). A point of the draped net with fabric
+//! coordinates (i + s, j + t) in cell (i, j) lies flat at `((i + s - i0) d, (j + t - j0) d)`: the
+//! bilinear interpolation of the cell's flat corners.
 //!
-//! Trimming: a ply draped with an outline (`Extent::Outline`) has every node outside the outline
-//! already refused (`outside_outline`), so the union of complete cells *is* the ply trimmed to its
-//! outline, at the resolution of the net (a staircase within one spacing d of the true outline).
-//! Nodes lost for other reasons (off the tool, shear limit, folds) are trimmed the same way: the
-//! pattern is the fabric that actually lies on the tool. A cutting allowance can be added all
-//! round with [`flat_pattern_with_margin`].
+//! The cut line ([`CutLine`]):
+//! - **the ply's outline** ([`flat_pattern_in_outline`]): a ply draped with an outline is cut
+//!   along that outline, each of its points located on the draped net (its cell and the
+//!   bilinear parameters there, extended up to [`OUTLINE_REACH`] cells beyond the placed cells,
+//!   where the nodes outside the outline were refused) and carried into the flat frame;
+//! - **the boundary nodes** ([`flat_pattern`]): otherwise the polygon through the net's placed
+//!   boundary nodes, the boundary of the cells with four placed corners and of the half cells
+//!   (triangles) whose three corners were placed. Its edges run along a fibre or across one
+//!   cell's diagonal, so a curved edge is followed by chords, not by a staircase of whole cells;
+//! - **the cells grown by a margin** ([`flat_pattern_with_margin`] with a margin): the union of
+//!   the complete cells, each grown by the margin (a staircase with square corners).
+//!
+//! Nodes lost for other reasons than an outline (off the tool, shear limit, folds) are trimmed
+//! the same way: the pattern is the fabric that actually lies on the tool.
+use crate::geometry::Point;
+use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
 use std::collections::HashMap;
 
@@ -73,13 +83,24 @@ pub struct Region {
     /// Closed loops (last vertex joins the first, not repeated), in metres in the pattern frame:
     /// the outer boundary first, counter-clockwise, then the holes, clockwise. No loop visits a
     /// point twice; loops of one pattern may touch at a corner (a pinch point) but never cross.
-    /// Collinear vertices are merged, so every vertex is a corner.
+    /// On the grid lines (boundary nodes, cells), collinear vertices are merged.
     pub loops: Vec<Vec<[f64; 2]>>,
-    /// Number of the ply's cells in the region.
+    /// Number of the ply's complete cells in the region.
     pub cells: usize,
-    /// Area inside the loops (m^2), their signed shoelace area: `cells * d^2` exactly when there
-    /// is no cutting margin.
+    /// Area inside the loops (m^2), their signed shoelace area. Cut through the boundary nodes it
+    /// is `(cells + half_cells / 2) d^2` exactly.
     pub area: f64,
+}
+
+/// The line a pattern is cut along (see the module comment).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CutLine {
+    /// The ply's outline, carried through the draped net into the flat frame.
+    Outline,
+    /// The polygon through the net's placed boundary nodes (complete cells and half cells).
+    Nodes,
+    /// The complete cells, each grown by the cutting margin.
+    GrownCells,
 }
 
 /// The flat cutting pattern of one ply, in its own frame: metres, warp along +x, weft along +y,
@@ -94,16 +115,23 @@ pub struct FlatPattern {
     pub origin_node: (usize, usize),
     /// The connected pieces, largest first (ties in grid order).
     pub regions: Vec<Region>,
-    /// Total number of complete cells; `cells * d^2` is the ply's area.
+    /// Total number of complete cells.
     pub cells: usize,
-    /// Area to cut (m^2), inside the loops: `cells * d^2` exactly when there is no margin.
+    /// Number of half cells: cells with exactly three placed corners, whose triangle is part of
+    /// the pattern cut through the boundary nodes.
+    pub half_cells: usize,
+    /// Area to cut (m^2), inside the loops: `(cells + half_cells / 2) d^2` cut through the
+    /// boundary nodes.
     pub area: f64,
+    /// The line the pattern is cut along.
+    pub cut: CutLine,
     /// Lower-left corner of the bounding box (m).
     pub min: [f64; 2],
     /// Upper-right corner of the bounding box (m).
     pub max: [f64; 2],
-    /// A point inside the pattern to hang the warp arrow and label on: the centre of the cell
-    /// of the largest region nearest to that region's centroid.
+    /// A point inside the pattern to hang the warp arrow and label on: the centroid of the
+    /// triangle (half of a complete cell, or a half cell) of the largest region nearest to that
+    /// region's centroid.
     pub anchor: [f64; 2],
 }
 
@@ -119,11 +147,384 @@ impl FlatPattern {
     }
 }
 
-/// The flat pattern of a draped net: its complete cells unfolded onto the unsheared grid and the
-/// outline of their union (see the module comment for the frame and the trimming).
+/// The flat pattern of a draped net cut through its boundary nodes (see the module comment).
 /// Error when the net has no complete cell, or a spacing that is not a positive length.
 pub fn flat_pattern(net: &DrapeNet) -> Result<FlatPattern, FlatError> {
-    flat_pattern_with_margin(net, 0.0)
+    check_spacing(net)?;
+    let tri = triangles_of(net);
+    if tri.cells == 0 {
+        return Err(FlatError::NoCells { ply: net.name.clone() });
+    }
+    let d = net.spacing;
+    let (i0, j0) = (net.origin_node.0 as f64, net.origin_node.1 as f64);
+    let to_flat = |[x, y]: [f64; 2]| [(x - i0) * d, (y - j0) * d];
+    let traced = trace_triangles(&tri);
+    let regions: Vec<Region> = traced
+        .iter()
+        .map(|r| Region {
+            loops: r.loops.iter().map(|l| l.iter().map(|&[i, j]| to_flat([i as f64, j as f64])).collect()).collect(),
+            cells: r.cells,
+            area: r.triangles as f64 * 0.5 * d * d,
+        })
+        .collect();
+    let anchor = to_flat(traced[0].anchor);
+    let area = (2 * tri.cells + tri.half_cells) as f64 * 0.5 * d * d;
+    Ok(pattern_of(net, regions, tri.cells, tri.half_cells, area, CutLine::Nodes, anchor))
+}
+
+/// How far (in cells, along the warp or the weft) beyond the cell it lands in an outline point
+/// may lie and still be carried into the flat frame by that cell's bilinear patch: the nodes
+/// just outside an outline are refused, so the outline runs through the band of cells with
+/// refused corners, within one cell (along its diagonal, up to sqrt 2 of one fibre) of the
+/// complete cells.
+pub const OUTLINE_REACH: f64 = 1.5;
+
+/// Gauss-Newton steps that locate a point on a cell's bilinear patch (it converges in two or
+/// three on the cells of a net; the step size is checked after).
+const PATCH_STEPS: usize = 12;
+/// A located point whose last Gauss-Newton step moved its parameters by more than this did not
+/// converge.
+const PATCH_CONVERGED: f64 = 1e-9;
+
+/// The flat pattern of a ply draped with an outline (`outline`: the points as the drape was
+/// given them, on the tool): cut along the outline carried through the net into the flat frame
+/// (see the module comment). When some outline point does not land on the net within
+/// [`OUTLINE_REACH`] cells of a complete cell (the ply did not reach it: off the tool, a
+/// failure), or the carried outline crosses itself, the pattern is cut through the boundary
+/// nodes instead ([`flat_pattern`]); `cut` says which. Errors as [`flat_pattern`].
+pub fn flat_pattern_in_outline(net: &DrapeNet, outline: &[Point]) -> Result<FlatPattern, FlatError> {
+    let nodes = flat_pattern(net)?;
+    let Some(mut poly) = flat_outline(net, outline) else { return Ok(nodes) };
+    // Consecutive points that land on one flat point are one vertex.
+    poly.dedup_by(|a, b| a == b);
+    while poly.len() > 1 && poly.first() == poly.last() {
+        poly.pop();
+    }
+    if poly.len() < 3 || polygon_crosses_itself(&poly) {
+        return Ok(nodes);
+    }
+    let mut area = shoelace_area(&poly);
+    if area < 0.0 {
+        poly.reverse();
+        area = -area;
+    }
+    if !(area > 0.0) {
+        return Ok(nodes);
+    }
+    let regions = vec![Region { loops: vec![poly], cells: nodes.cells, area }];
+    Ok(pattern_of(net, regions, nodes.cells, nodes.half_cells, area, CutLine::Outline, nodes.anchor))
+}
+
+/// The pattern of a ply as the run cuts it: with a cutting margin the complete cells grown by it
+/// ([`flat_pattern_with_margin`]); without one, along the ply's outline when it has one
+/// ([`flat_pattern_in_outline`]), else through the boundary nodes ([`flat_pattern`]).
+pub fn ply_pattern(net: &DrapeNet, outline: Option<&[Point]>, margin: f64) -> Result<FlatPattern, FlatError> {
+    match outline {
+        Some(points) if margin == 0.0 => flat_pattern_in_outline(net, points),
+        _ => flat_pattern_with_margin(net, margin),
+    }
+}
+
+/// The outline's points carried into the flat frame, or `None` when one of them does not land
+/// on the net within [`OUTLINE_REACH`] cells.
+fn flat_outline(net: &DrapeNet, outline: &[Point]) -> Option<Vec<[f64; 2]>> {
+    let d = net.spacing;
+    let sampler = NetSampler::new(net)?;
+    let (i0, j0) = (net.origin_node.0 as f64, net.origin_node.1 as f64);
+    let mut out = Vec::with_capacity(outline.len());
+    for p in outline {
+        let h = sampler.nearest_within(p, (OUTLINE_REACH + 1.0) * std::f64::consts::SQRT_2 * d)?;
+        let (i, j) = h.cell;
+        let [s, t] = locate_on_patch(net, i, j, p, [h.s, h.t])?;
+        let beyond = (-s).max(s - 1.0).max(-t).max(t - 1.0);
+        if beyond > OUTLINE_REACH {
+            return None;
+        }
+        out.push([(i as f64 + s - i0) * d, (j as f64 + t - j0) * d]);
+    }
+    Some(out)
+}
+
+/// Bilinear parameters (s, t) of the point of cell (i, j)'s patch, extended beyond the cell,
+/// nearest to `p`: Gauss-Newton from `start`. `None` if it does not converge.
+fn locate_on_patch(net: &DrapeNet, i: usize, j: usize, p: &Point, start: [f64; 2]) -> Option<[f64; 2]> {
+    let [p00, p10, p01, p11] = net.cell_corners(i, j)?;
+    let [mut s, mut t] = start;
+    for _ in 0..PATCH_STEPS {
+        let b = p00.coords * ((1.0 - s) * (1.0 - t))
+            + p10.coords * (s * (1.0 - t))
+            + p11.coords * (s * t)
+            + p01.coords * ((1.0 - s) * t);
+        let r = p.coords - b;
+        let warp = (p10 - p00) * (1.0 - t) + (p11 - p01) * t;
+        let weft = (p01 - p00) * (1.0 - s) + (p11 - p10) * s;
+        let (a11, a12, a22) = (warp.dot(&warp), warp.dot(&weft), weft.dot(&weft));
+        let (b1, b2) = (warp.dot(&r), weft.dot(&r));
+        let det = a11 * a22 - a12 * a12;
+        if !(det > 0.0) {
+            return None;
+        }
+        let ds = (a22 * b1 - a12 * b2) / det;
+        let dt = (a11 * b2 - a12 * b1) / det;
+        s += ds;
+        t += dt;
+        if ds.abs().max(dt.abs()) <= PATCH_CONVERGED {
+            return Some([s, t]);
+        }
+    }
+    None
+}
+
+/// Whether two edges of a closed polygon that are not neighbours share a point.
+fn polygon_crosses_itself(poly: &[[f64; 2]]) -> bool {
+    let n = poly.len();
+    let orient = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        let v = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+        (v > 0.0) as i8 - (v < 0.0) as i8
+    };
+    let on = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        p[0].min(q[0]) <= r[0] && r[0] <= p[0].max(q[0]) && p[1].min(q[1]) <= r[1] && r[1] <= p[1].max(q[1])
+    };
+    // Edges sorted by their lowest x: only edges whose x ranges overlap are compared.
+    let mut edges: Vec<(f64, f64, usize)> =
+        (0..n).map(|k| (poly[k][0].min(poly[(k + 1) % n][0]), poly[k][0].max(poly[(k + 1) % n][0]), k)).collect();
+    edges.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    for (x, &(_, hi, a)) in edges.iter().enumerate() {
+        for &(lo, _, b) in &edges[x + 1..] {
+            if lo > hi {
+                break;
+            }
+            let (a, b) = (a.min(b), a.max(b));
+            if b == a + 1 || (a == 0 && b == n - 1) {
+                continue;
+            }
+            let (p, q, r, u) = (poly[a], poly[(a + 1) % n], poly[b], poly[(b + 1) % n]);
+            let (o1, o2, o3, o4) = (orient(p, q, r), orient(p, q, u), orient(r, u, p), orient(r, u, q));
+            if (o1 != o2 && o3 != o4)
+                || (o1 == 0 && on(p, q, r))
+                || (o2 == 0 && on(p, q, u))
+                || (o3 == 0 && on(r, u, p))
+                || (o4 == 0 && on(r, u, q))
+            {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+fn check_spacing(net: &DrapeNet) -> Result<(), FlatError> {
+    let d = net.spacing;
+    if !(d.is_finite() && d > 0.0) {
+        return Err(FlatError::BadSpacing { ply: net.name.clone(), spacing: d });
+    }
+    Ok(())
+}
+
+/// A pattern from its regions: the bounding box from the loops.
+fn pattern_of(
+    net: &DrapeNet,
+    regions: Vec<Region>,
+    cells: usize,
+    half_cells: usize,
+    area: f64,
+    cut: CutLine,
+    anchor: [f64; 2],
+) -> FlatPattern {
+    let mut min = [f64::INFINITY; 2];
+    let mut max = [f64::NEG_INFINITY; 2];
+    for p in regions.iter().flat_map(|r| r.loops.iter()).flatten() {
+        for k in 0..2 {
+            min[k] = min[k].min(p[k]);
+            max[k] = max[k].max(p[k]);
+        }
+    }
+    FlatPattern {
+        ply: net.name.clone(),
+        spacing: net.spacing,
+        origin_node: net.origin_node,
+        regions,
+        cells,
+        half_cells,
+        area,
+        cut,
+        min,
+        max,
+        anchor,
+    }
+}
+
+/// The triangles of a net's pattern, in grid (node index) coordinates.
+struct Triangles {
+    /// Corners, counter-clockwise.
+    corners: Vec<[[i64; 2]; 3]>,
+    /// Whether each is half of a complete cell (else it is a half cell).
+    complete: Vec<bool>,
+    /// Complete cells.
+    cells: usize,
+    /// Cells with exactly three placed corners.
+    half_cells: usize,
+}
+
+/// Two triangles (split along the 00-11 diagonal) per complete cell and one per cell with
+/// exactly three placed corners, in cell order.
+fn triangles_of(net: &DrapeNet) -> Triangles {
+    let mut t = Triangles { corners: Vec::new(), complete: Vec::new(), cells: 0, half_cells: 0 };
+    for i in 0..net.nu.saturating_sub(1) {
+        for j in 0..net.nv.saturating_sub(1) {
+            // Counter-clockwise round the cell.
+            let ring = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+            let placed = ring.map(|(a, b)| net.node(a, b).is_some());
+            let v = ring.map(|(a, b)| [a as i64, b as i64]);
+            match placed.iter().filter(|&&p| p).count() {
+                4 => {
+                    t.corners.push([v[0], v[1], v[2]]);
+                    t.corners.push([v[0], v[2], v[3]]);
+                    t.complete.extend([true, true]);
+                    t.cells += 1;
+                }
+                3 => {
+                    let missing = placed.iter().position(|&p| !p).expect("one corner is missing");
+                    t.corners.push([v[(missing + 1) % 4], v[(missing + 2) % 4], v[(missing + 3) % 4]]);
+                    t.complete.push(false);
+                    t.half_cells += 1;
+                }
+                _ => {}
+            }
+        }
+    }
+    t
+}
+
+/// A region of triangles traced on the integer grid (see [`trace_triangles`]).
+struct TriangleRegion {
+    /// Loops of grid nodes, outer (counter-clockwise) first, then holes (clockwise).
+    loops: Vec<Vec<[i64; 2]>>,
+    /// Complete cells.
+    cells: usize,
+    /// Triangles (each half a cell).
+    triangles: usize,
+    /// Grid coordinates of the centroid of the region's triangle nearest to the region's
+    /// centroid (lowest triangle on ties).
+    anchor: [f64; 2],
+}
+
+/// The boundary of the union of the triangles: one region per set of triangles joined through
+/// edges, most triangles first (ties in cell order). Boundary edges are the triangles' edges
+/// that no other triangle has reversed, directed with their triangle on the left (outer loops
+/// counter-clockwise, holes clockwise); chained as [`trace`] chains cell edges, taking at each
+/// node the sharpest left turn (which keeps pieces touching at a node apart) and splitting a
+/// chain that returns to a node into loops that visit no node twice.
+fn trace_triangles(tri: &Triangles) -> Vec<TriangleRegion> {
+    let n = tri.corners.len();
+    // Every directed edge and its triangle.
+    let mut edge_of: HashMap<([i64; 2], [i64; 2]), usize> = HashMap::with_capacity(3 * n);
+    for (k, c) in tri.corners.iter().enumerate() {
+        for e in 0..3 {
+            edge_of.insert((c[e], c[(e + 1) % 3]), k);
+        }
+    }
+    // Regions: union-find over edges shared (reversed) by two triangles.
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    let mut boundary: Vec<([i64; 2], [i64; 2], usize)> = Vec::new();
+    for (k, c) in tri.corners.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (c[e], c[(e + 1) % 3]);
+            match edge_of.get(&(b, a)) {
+                Some(&other) => {
+                    let (ra, rb) = (root(&mut parent, k), root(&mut parent, other));
+                    // The lower root wins: labels do not depend on the order of the unions.
+                    parent[ra.max(rb)] = ra.min(rb);
+                }
+                None => boundary.push((a, b, k)),
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..n).map(|k| root(&mut parent, k)).collect();
+    let mut region_of_root: HashMap<usize, usize> = HashMap::new();
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for (k, &r) in roots.iter().enumerate() {
+        let id = *region_of_root.entry(r).or_insert_with(|| {
+            members.push(Vec::new());
+            members.len() - 1
+        });
+        members[id].push(k);
+    }
+
+    // Boundary edges out of each node, and which are still to chain.
+    let mut out: HashMap<[i64; 2], Vec<([i64; 2], bool)>> = HashMap::new();
+    for &(a, b, _) in &boundary {
+        out.entry(a).or_default().push((b, true));
+    }
+    let mut loops_of: Vec<Vec<Vec<[i64; 2]>>> = vec![Vec::new(); members.len()];
+    for &(a0, b0, k0) in &boundary {
+        let fresh = out[&a0].iter().any(|&(b, f)| b == b0 && f);
+        if !fresh {
+            continue;
+        }
+        let id = region_of_root[&roots[k0]];
+        let mut chain = Vec::new();
+        let (mut a, mut b) = (a0, b0);
+        loop {
+            chain.push(a);
+            let e = out.get_mut(&a).expect("edge start is a key");
+            e.iter_mut().find(|x| x.0 == b && x.1).expect("the edge is still to chain").1 = false;
+            // The sharpest left turn among the edges still to chain out of b.
+            let din = [b[0] - a[0], b[1] - a[1]];
+            let turn = |c: [i64; 2]| {
+                let dout = [c[0] - b[0], c[1] - b[1]];
+                let cross = (din[0] * dout[1] - din[1] * dout[0]) as f64;
+                let dot = (din[0] * dout[0] + din[1] * dout[1]) as f64;
+                cross.atan2(dot)
+            };
+            let next = out
+                .get(&b)
+                .and_then(|v| v.iter().filter(|x| x.1).map(|x| x.0).max_by(|&p, &q| turn(p).total_cmp(&turn(q))));
+            match next {
+                Some(c) => {
+                    a = b;
+                    b = c;
+                }
+                None => break,
+            }
+        }
+        debug_assert_eq!(b, a0, "boundary chains close on their start");
+        for l in split_at_repeats(chain) {
+            loops_of[id].push(merge_collinear(l));
+        }
+    }
+
+    let mut regions: Vec<TriangleRegion> = members
+        .into_iter()
+        .zip(loops_of)
+        .map(|(tris, mut loops)| {
+            loops.sort_by_key(|l| std::cmp::Reverse(twice_area(l) > 0));
+            let centroid = |k: usize| {
+                let c = tri.corners[k];
+                [(c[0][0] + c[1][0] + c[2][0]) as f64 / 3.0, (c[0][1] + c[1][1] + c[2][1]) as f64 / 3.0]
+            };
+            let m = tris.len() as f64;
+            let (sx, sy) = tris.iter().fold((0.0, 0.0), |(x, y), &k| (x + centroid(k)[0], y + centroid(k)[1]));
+            let (cx, cy) = (sx / m, sy / m);
+            let dist = |k: usize| (centroid(k)[0] - cx).powi(2) + (centroid(k)[1] - cy).powi(2);
+            let best = *tris
+                .iter()
+                .min_by(|&&a, &&b| dist(a).total_cmp(&dist(b)).then(a.cmp(&b)))
+                .expect("regions are not empty");
+            let cells = tris.iter().filter(|&&k| tri.complete[k]).count() / 2;
+            TriangleRegion { loops, cells, triangles: tris.len(), anchor: centroid(best) }
+        })
+        .collect();
+    // Stable: equal sizes keep cell order.
+    regions.sort_by_key(|r| std::cmp::Reverse(r.triangles));
+    regions
 }
 
 /// Grid coordinates closer than this (in spacings) are one coordinate when cells are grown by a
@@ -135,15 +536,17 @@ const SNAP: f64 = 1e-9;
 /// is a staircase); pieces closer than `2 margin` merge into one piece and narrower holes close.
 /// Then `area` is the area to cut (inside the grown outline), while `cells` still counts the
 /// ply's cells; each region's `cells` counts the cells it contains. `margin = 0` is
-/// [`flat_pattern`]. Errors as [`flat_pattern`], and for a negative or non-finite margin.
+/// [`flat_pattern`] (cut through the boundary nodes). Errors as [`flat_pattern`], and for a
+/// negative or non-finite margin.
 pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPattern, FlatError> {
-    let d = net.spacing;
-    if !(d.is_finite() && d > 0.0) {
-        return Err(FlatError::BadSpacing { ply: net.name.clone(), spacing: d });
-    }
+    check_spacing(net)?;
     if !(margin.is_finite() && margin >= 0.0) {
         return Err(FlatError::BadMargin { ply: net.name.clone(), margin });
     }
+    if margin == 0.0 {
+        return flat_pattern(net);
+    }
+    let d = net.spacing;
     let (ncx, ncy) = (net.nu.saturating_sub(1), net.nv.saturating_sub(1));
     let mut mask = CellMask::new(ncx, ncy);
     for i in 0..ncx {
@@ -159,53 +562,21 @@ pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPatte
     }
     let (i0, j0) = (net.origin_node.0 as f64, net.origin_node.1 as f64);
     let to_flat = |[x, y]: [f64; 2]| [(x - i0) * d, (y - j0) * d];
-    let regions: Vec<Region> = if margin == 0.0 {
-        traced
-            .iter()
-            .map(|r| Region {
-                loops: r
-                    .loops
-                    .iter()
-                    .map(|l| l.iter().map(|&[i, j]| to_flat([i as f64, j as f64])).collect())
-                    .collect(),
-                cells: r.cells,
-                area: r.cells as f64 * d * d,
-            })
-            .collect()
-    } else {
-        grown(&mask, margin / d)
-            .into_iter()
-            .map(|(loops, cells)| {
-                let loops: Vec<Vec<[f64; 2]>> = loops.iter().map(|l| l.iter().map(|&p| to_flat(p)).collect()).collect();
-                let area = loops.iter().map(|l| shoelace_area(l)).sum();
-                Region { loops, cells, area }
-            })
-            .collect()
-    };
-    let mut min = [f64::INFINITY; 2];
-    let mut max = [f64::NEG_INFINITY; 2];
-    for p in regions.iter().flat_map(|r| r.loops.iter()).flatten() {
-        for k in 0..2 {
-            min[k] = min[k].min(p[k]);
-            max[k] = max[k].max(p[k]);
-        }
-    }
+    let regions: Vec<Region> = grown(&mask, margin / d)
+        .into_iter()
+        .map(|(loops, cells)| {
+            let loops: Vec<Vec<[f64; 2]>> = loops.iter().map(|l| l.iter().map(|&p| to_flat(p)).collect()).collect();
+            let area = loops.iter().map(|l| shoelace_area(l)).sum();
+            Region { loops, cells, area }
+        })
+        .collect();
     let cells: usize = traced.iter().map(|r| r.cells).sum();
     // The arrow hangs on a cell of the ply itself, not on the allowance.
     let a = traced[0].anchor;
     let anchor = to_flat([a[0] as f64 + 0.5, a[1] as f64 + 0.5]);
-    let area = if margin == 0.0 { cells as f64 * d * d } else { regions.iter().map(|r| r.area).sum() };
-    Ok(FlatPattern {
-        ply: net.name.clone(),
-        spacing: d,
-        origin_node: net.origin_node,
-        regions,
-        cells,
-        area,
-        min,
-        max,
-        anchor,
-    })
+    let area = regions.iter().map(|r| r.area).sum();
+    let half_cells = triangles_of(net).half_cells;
+    Ok(pattern_of(net, regions, cells, half_cells, area, CutLine::GrownCells, anchor))
 }
 
 /// Sorted distinct coordinates, those within [`SNAP`] of a kept one dropped.

@@ -1,6 +1,7 @@
 //! Draping a layup: each ply in stacking order on the tool offset by the plies below it, its warp
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
+use super::flat::ply_pattern;
 use super::{Layup, Orientation, Ply, StackSide, Start};
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
@@ -93,7 +94,8 @@ pub struct PlyStats {
     pub coverage: SurfaceCoverage,
     /// Draped area (3D) of the complete cells, m^2.
     pub draped_area: f64,
-    /// Fabric used: the complete cells unsheared (cells x d^2), m^2; the flat pattern's area.
+    /// Fabric used, m^2: the area of the ply's flat pattern without a cutting margin (cut along
+    /// its outline when it has one, else through its boundary nodes; see `layup::flat`).
     pub fabric_area: f64,
     /// Mass of that fabric, kg, when the ply has a material card.
     pub fabric_mass: Option<f64>,
@@ -114,7 +116,9 @@ pub fn ply_stats(
     let s = net.shear_stats(locking_angle);
     let triangles: Vec<[Point; 3]> =
         surface.triangles().iter().map(|t| t.map(|v| surface.vertices()[v as usize])).collect();
-    let fabric_area = s.cells as f64 * net.spacing * net.spacing;
+    // The fabric cut for the ply: its flat pattern without a margin (along its outline, or
+    // through its boundary nodes).
+    let fabric_area = ply_pattern(net, outline.map(Outline::points), 0.0).map_or(0.0, |p| p.area);
     PlyStats {
         max_abs_shear: s.max_abs,
         mean_abs_shear: s.mean_abs,

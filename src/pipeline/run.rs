@@ -13,11 +13,12 @@ use super::folder::{prepare, FolderError};
 use super::scene::{Scene, SceneExport};
 use crate::geometry::ToolSurface;
 use crate::io::drawing::{write_cutting_plan, PatternError};
-use crate::io::flow::write_flow;
+use crate::io::flow::{write_flow_with, FlowOptions};
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::{read_flow_mesh, read_tool, write_net, ExportError, Format, ReadToolError};
 use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeError};
-use crate::layup::flat::{flat_pattern_with_margin, FlatError};
+use crate::kinematic::Extent;
+use crate::layup::flat::{ply_pattern, FlatError};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::stack::{drape_layup, LayupError, PlyResult};
 use crate::layup::table::{LayupRow, LayupTable, NestingRow};
@@ -304,8 +305,13 @@ fn cutting_plan(
     on: &mut dyn FnMut(Event),
 ) -> Result<Option<Nesting>, RunError> {
     let mut patterns = Vec::new();
-    for r in results {
-        match flat_pattern_with_margin(&r.net, scene.cutting_margin) {
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        // A ply draped with an outline is cut along it (without a margin).
+        let outline = match &ply.settings.extent {
+            Extent::Outline(points) => Some(points.as_slice()),
+            Extent::Grid { .. } => None,
+        };
+        match ply_pattern(&r.net, outline, scene.cutting_margin) {
             Ok(p) => patterns.push(p),
             Err(FlatError::NoCells { ply }) => on(Event::NoPattern { ply: &ply }),
             Err(e) => return Err(RunError::Flat(e)),
@@ -361,7 +367,8 @@ fn export_flow(
     let ms = flow.read_ms + t.elapsed().as_secs_f64() * 1e3;
     on(Event::FlowMapped { path: &export.mesh, mesh, map: &map, ms });
     for &format in &export.formats {
-        let files = write_flow(mesh, &map, format, &out.join(format.scene_file()))?;
+        let options = FlowOptions { vtu: export.vtu, ..FlowOptions::default() };
+        let files = write_flow_with(mesh, &map, format, &out.join(format.scene_file()), &options)?;
         on(Event::FlowWritten { files: &files });
         written.extend(files);
     }

@@ -21,6 +21,7 @@
 //! formats = ["vtu", "csv"]    # vtu, nastran, abaqus, calculix, optistruct, rtmsim, csv
 //! cavity = "fixed"            # "fixed" (Vf = Vf0 / cos g) or "free" (t = t0 / cos g)
 //! permeability = true         # permeability tensors (needs [flow] in the material cards)
+//! vtu = "auto"                # flow.vtu: "auto" (binary from 50k elements), "ascii" or "binary"
 //! [[ply]]
 //! name = "p0"
 //! origin = [0.0, 0.0, 0.1]
@@ -70,6 +71,7 @@ use super::{parse_generators, unit_scale};
 use crate::geometry::{Point, Vector};
 use crate::io::flow::FlowFormat;
 use crate::io::points::read_points;
+use crate::io::vtk::VtuEncoding;
 use crate::kinematic::fishnet::check_memory;
 use crate::kinematic::{Extent, KinematicSettings, SurfaceKind, DEFAULT_MAX_SHEAR_DEG};
 use crate::layup::{
@@ -136,6 +138,12 @@ struct ExportFile {
     cavity: String,
     #[serde(default)]
     permeability: bool,
+    #[serde(default = "default_vtu")]
+    vtu: String,
+}
+
+fn default_vtu() -> String {
+    "auto".into()
 }
 
 fn default_units() -> String {
@@ -249,6 +257,8 @@ pub struct SceneExport {
     pub cavity: Cavity,
     /// Whether to write permeability tensors.
     pub permeability: bool,
+    /// How `flow.vtu` stores its arrays.
+    pub vtu: VtuEncoding,
 }
 
 /// The mechanical refinement a ply asks for; errors name the field.
@@ -487,6 +497,7 @@ impl Scene {
                     "free" => Cavity::Free,
                     other => return Err(at("cavity", format!("unknown cavity '{other}': use \"fixed\" or \"free\""))),
                 };
+                let vtu: VtuEncoding = e.vtu.parse().map_err(|m| at("vtu", m))?;
                 let mesh = base.join(&e.mesh);
                 if !mesh.is_file() {
                     return Err(at(
@@ -494,7 +505,7 @@ impl Scene {
                         format!("no flow mesh at {}: check the path (relative to the scene file)", mesh.display()),
                     ));
                 }
-                Some(SceneExport { mesh, formats, cavity, permeability: e.permeability })
+                Some(SceneExport { mesh, formats, cavity, permeability: e.permeability, vtu })
             }
         };
         let mut plies = Vec::new();

@@ -4,3 +4,4 @@
 pub mod chebyshev;
 pub mod elastica;
 pub mod shear_frames;
+pub mod vtk_reader;
