@@ -81,12 +81,15 @@ grid = [21, 21]
         }
         checked += 1;
     }
-    assert_eq!(checked, 6, "geodesic and min-shear at three spacings");
+    assert_eq!(checked, 12, "geodesic and min-shear, on the facets and the smooth surface, at three spacings");
     assert!(sa.points.iter().any(|p| p.pareto));
     for f in ["speed_accuracy.png", "speed_accuracy.svg"] {
         assert!(std::fs::metadata(out.join(f)).unwrap().len() > 1000, "{f}");
     }
 }
+
+/// Shear below this (degrees) is rounding on a developable tool.
+const FLOOR_DEG: f64 = 1e-4;
 
 /// On the developable half cylinder every kinematic run has (nearly) zero shear, and so does
 /// its estimated error.
@@ -110,7 +113,9 @@ fn speed_accuracy_on_a_developable_tool_reports_near_zero_error() {
         let true_max = r.result.max_shear_deg.unwrap();
         let est = p.error_max_deg.unwrap();
         assert!(true_max < 0.05, "{}: shear {true_max} deg on a developable tool", p.method);
-        assert!(est >= 0.5 * true_max - 1e-9 && est < 0.05, "{}: estimate {est}, true {true_max}", p.method);
+        // Below 1e-4 deg the shear is the surface's rounding floor (the smooth surface leaves
+        // about 2e-5 deg), not a discretisation error a spacing study could see.
+        assert!(est >= 0.5 * true_max - FLOOR_DEG && est < 0.05, "{} {}: estimate {est}, true {true_max}", p.method, p.surface);
         assert_eq!(p.outcome, "ok");
     }
 }
