@@ -431,6 +431,39 @@ mod tests {
     }
 
     #[test]
+    fn the_file_and_the_statistics_are_the_same_whatever_the_thread_count() {
+        // More nodes and cells than one piece of the parallel writer, some not placed.
+        let (nu, nv) = (123, 101);
+        let mut net = DrapeNet::new("threads", 0.01, nu, nv, (60, 50));
+        for i in 0..nu {
+            for j in 0..nv {
+                let k = net.index(i, j);
+                let (x, y) = (i as f64 * 0.01, j as f64 * 0.0103);
+                net.positions[k] = Point::new(x, y, (3.0 * x).sin() * (2.0 * y).cos() / 7.0);
+                net.status[k] = if (i * 7 + j * 3) % 97 == 0 { NodeStatus::NoRoot } else { NodeStatus::Placed };
+                net.triangles[k] = (k * 13 % 9973) as u32;
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let path = dir.path().join(format!("t{threads}.drape.json"));
+            pool.install(|| write_json(&net, &path)).unwrap();
+            let stats = pool.install(|| net.shear_stats(0.3));
+            (std::fs::read(&path).unwrap(), format!("{stats:?}"))
+        };
+        let (one, stats) = run(1);
+        for threads in [2, 3] {
+            let (bytes, s) = run(threads);
+            assert!(bytes == one, "{threads} threads wrote other bytes");
+            assert_eq!(s, stats, "{threads} threads");
+        }
+        let back = read_net(&dir.path().join("t1.drape.json")).unwrap();
+        assert_eq!(back.status, net.status);
+        assert_eq!(format!("{:?}", back.shear_stats(0.3)), stats);
+    }
+
+    #[test]
     fn non_finite_node_is_refused_and_nothing_written() {
         let mut net = sample();
         let k = net.index(2, 3);
