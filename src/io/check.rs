@@ -64,9 +64,10 @@ pub(crate) fn check_net(net: &DrapeNet, frames: bool) -> Result<(), ExportError>
     // Nodes and cells are checked in parallel; the error is the one of the first bad node, or
     // else of the first bad cell, in file order, as a serial check would find.
     let nv = net.nv;
-    let bad_node = (0..n).into_par_iter().with_min_len(1 << 14).find_first(|&k| {
-        net.status[k] == NodeStatus::Placed && !net.positions[k].coords.iter().all(|c| c.is_finite())
-    });
+    let bad_node = (0..n)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .find_first(|&k| net.status[k] == NodeStatus::Placed && !net.positions[k].coords.iter().all(|c| c.is_finite()));
     if let Some(k) = bad_node {
         let p = net.positions[k];
         return bad(format!("node ({}, {}) is placed but its position is ({}, {}, {})", k / nv, k % nv, p.x, p.y, p.z));
@@ -92,7 +93,9 @@ fn cell_problem(net: &DrapeNet, i: usize, j: usize, frames: bool) -> Option<Stri
     if frames {
         match net.cell_frame(i, j) {
             None => {
-                return Some(format!("cell ({i}, {j}) is degenerate: its warp, weft or normal direction has zero length"))
+                return Some(format!(
+                    "cell ({i}, {j}) is degenerate: its warp, weft or normal direction has zero length"
+                ))
             }
             Some(f) => {
                 let all = f.centre.coords.iter().chain(&f.warp).chain(&f.weft).chain(&f.normal);
