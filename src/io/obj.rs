@@ -150,7 +150,7 @@ fn is_space(c: char) -> bool {
 /// The words of an ASCII line, split at white space as [`str::split_whitespace`] splits it.
 #[inline]
 fn ascii_words(line: &str) -> impl Iterator<Item = &str> {
-    line.split(|c: char| c == ' ' || c == '\t' || c == '\x0b' || c == '\x0c').filter(|w| !w.is_empty())
+    line.split([' ', '\t', '\x0b', '\x0c']).filter(|w| !w.is_empty())
 }
 
 /// [`statement`] for a line of ASCII text: the same statements and errors, read without
