@@ -128,28 +128,40 @@ impl ToolSurface {
         if triangles.is_empty() {
             return Err(ToolError::AllDegenerate { path: path.into() });
         }
-        let frames = triangles
-            .iter()
-            .map(|t| {
-                let v0 = vertices[t[0] as usize];
-                let e1 = vertices[t[1] as usize] - v0;
-                let e2 = vertices[t[2] as usize] - v0;
-                let normal = e1.cross(&e2).normalize();
-                let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-                let inv_den = 1.0 / (d11 * d22 - d12 * d12);
-                TriangleFrame { v0, e1, e2, normal, d11, d12, d22, inv_den }
-            })
-            .collect();
-        let spheres = triangles
-            .iter()
-            .map(|t| {
-                let p = t.map(|i| vertices[i as usize]);
-                let c = Point::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
-                let r = p.iter().map(|q| (q - c).norm()).fold(0.0, f64::max);
-                (c, r)
-            })
-            .collect();
-        let mesh = TriMesh::new(vertices.clone(), triangles.clone()).map_err(|e| ToolError::Parse {
+        // parry's BVH build is the slowest step of loading a tool and needs only the triangles:
+        // it runs beside the per-triangle frames and spheres (each a pure function of its
+        // triangle, so the same whatever the thread count).
+        let (mesh, (frames, spheres)) = rayon::join(
+            || TriMesh::new(vertices.clone(), triangles.clone()),
+            || {
+                use rayon::prelude::*;
+                let frames: Vec<TriangleFrame> = triangles
+                    .par_iter()
+                    .with_min_len(4096)
+                    .map(|t| {
+                        let v0 = vertices[t[0] as usize];
+                        let e1 = vertices[t[1] as usize] - v0;
+                        let e2 = vertices[t[2] as usize] - v0;
+                        let normal = e1.cross(&e2).normalize();
+                        let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+                        let inv_den = 1.0 / (d11 * d22 - d12 * d12);
+                        TriangleFrame { v0, e1, e2, normal, d11, d12, d22, inv_den }
+                    })
+                    .collect();
+                let spheres: Vec<(Point, f64)> = triangles
+                    .par_iter()
+                    .with_min_len(4096)
+                    .map(|t| {
+                        let p = t.map(|i| vertices[i as usize]);
+                        let c = Point::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+                        let r = p.iter().map(|q| (q - c).norm()).fold(0.0, f64::max);
+                        (c, r)
+                    })
+                    .collect();
+                (frames, spheres)
+            },
+        );
+        let mesh = mesh.map_err(|e| ToolError::Parse {
             path: path.into(),
             reason: format!("mesh rejected by the geometry kernel: {e}"),
         })?;

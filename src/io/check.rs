@@ -1,7 +1,8 @@
 //! Checks run before any output file is opened: a net that would need NaN, infinity or a
 //! made-up value in a file is refused with an error naming the node or cell.
 use super::ExportError;
-use crate::kinematic::DrapeNet;
+use crate::kinematic::{DrapeNet, NodeStatus};
+use rayon::prelude::*;
 
 /// Number of cells, `(nu - 1) * (nv - 1)`, zero for a degenerate grid (never underflows).
 pub(crate) fn cell_count(net: &DrapeNet) -> usize {
@@ -60,35 +61,49 @@ pub(crate) fn check_net(net: &DrapeNet, frames: bool) -> Result<(), ExportError>
             return bad(format!("the {what} time is {v} ms"));
         }
     }
-    for i in 0..net.nu {
-        for j in 0..net.nv {
-            if let Some(p) = net.node(i, j) {
-                if !p.coords.iter().all(|c| c.is_finite()) {
-                    return bad(format!("node ({i}, {j}) is placed but its position is ({}, {}, {})", p.x, p.y, p.z));
-                }
-            }
-        }
+    // Nodes and cells are checked in parallel; the error is the one of the first bad node, or
+    // else of the first bad cell, in file order, as a serial check would find.
+    let nv = net.nv;
+    let bad_node = (0..n)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .find_first(|&k| net.status[k] == NodeStatus::Placed && !net.positions[k].coords.iter().all(|c| c.is_finite()));
+    if let Some(k) = bad_node {
+        let p = net.positions[k];
+        return bad(format!("node ({}, {}) is placed but its position is ({}, {}, {})", k / nv, k % nv, p.x, p.y, p.z));
     }
-    for (i, j) in cells(net) {
-        let Some(g) = net.cell_shear(i, j) else { continue };
-        if !g.to_degrees().is_finite() {
-            return bad(format!("cell ({i}, {j}) has a shear angle of {g} rad"));
-        }
-        if frames {
-            match net.cell_frame(i, j) {
-                None => {
-                    return bad(format!(
-                        "cell ({i}, {j}) is degenerate: its warp, weft or normal direction has zero length"
-                    ))
-                }
-                Some(f) => {
-                    let all = f.centre.coords.iter().chain(&f.warp).chain(&f.weft).chain(&f.normal);
-                    if !all.into_iter().all(|c| c.is_finite()) {
-                        return bad(format!("cell ({i}, {j}) has a non-finite centre or fibre direction"));
-                    }
-                }
-            }
-        }
+    let cv = nv - 1;
+    let bad_cell = (0..cell_count(net))
+        .into_par_iter()
+        .with_min_len(1 << 13)
+        .find_first(|&k| cell_problem(net, k / cv, k % cv, frames).is_some());
+    if let Some(reason) = bad_cell.and_then(|k| cell_problem(net, k / cv, k % cv, frames)) {
+        return bad(reason);
     }
     Ok(())
+}
+
+/// What is wrong with cell (i, j), if anything: a non-finite shear, or (`frames`) no finite
+/// fibre frame.
+fn cell_problem(net: &DrapeNet, i: usize, j: usize, frames: bool) -> Option<String> {
+    let g = net.cell_shear(i, j)?;
+    if !g.to_degrees().is_finite() {
+        return Some(format!("cell ({i}, {j}) has a shear angle of {g} rad"));
+    }
+    if frames {
+        match net.cell_frame(i, j) {
+            None => {
+                return Some(format!(
+                    "cell ({i}, {j}) is degenerate: its warp, weft or normal direction has zero length"
+                ))
+            }
+            Some(f) => {
+                let all = f.centre.coords.iter().chain(&f.warp).chain(&f.weft).chain(&f.normal);
+                if !all.into_iter().all(|c| c.is_finite()) {
+                    return Some(format!("cell ({i}, {j}) has a non-finite centre or fibre direction"));
+                }
+            }
+        }
+    }
+    None
 }

@@ -1,6 +1,6 @@
 //! The files a draped net is written to: `<ply>.drape.json` (the contract), `<ply>.vtu` and
 //! `<ply>.cells.csv`, chosen by [`Format`] and written by [`write_net`].
-use super::{check, csv::write_csv, net_json::write_json, vtk::write_vtu, ExportError};
+use super::{check, csv::write_csv, net_json::write_json_checked, vtk::write_vtu, ExportError};
 use crate::kinematic::DrapeNet;
 use std::path::{Path, PathBuf};
 
@@ -100,7 +100,7 @@ pub fn write_net(net: &DrapeNet, dir: &Path, formats: &[Format]) -> Result<Vec<P
     for &f in formats {
         let path = f.path(dir, &net.name);
         match f {
-            Format::Json => write_json(net, &path)?,
+            Format::Json => write_json_checked(net, &path)?,
             Format::Vtu => write_vtu(net, &path)?,
             Format::Csv => write_csv(net, &path)?,
         }

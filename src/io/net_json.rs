@@ -12,6 +12,7 @@ use super::{write_atomic, ExportError};
 use crate::geometry::Point;
 use crate::kinematic::net::{Method, NodeStatus, Timing};
 use crate::kinematic::{DrapeNet, Provenance};
+use rayon::prelude::*;
 use serde::Deserialize;
 use serde_json::ser::{CompactFormatter, Formatter};
 use std::collections::BTreeMap;
@@ -22,7 +23,39 @@ use std::path::Path;
 /// if a placed node or a cell shear is not finite.
 pub fn write_json(net: &DrapeNet, path: &Path) -> Result<(), ExportError> {
     check_net(net, false)?;
+    write_json_checked(net, path)
+}
+
+/// [`write_json`] of a net that `check_net` has passed.
+pub(crate) fn write_json_checked(net: &DrapeNet, path: &Path) -> Result<(), ExportError> {
     write_atomic(path, |w| write_json_to(net, w))
+}
+
+/// Items per piece of an array formatted on one thread.
+const PIECE: usize = 1 << 12;
+/// Pieces formatted in parallel before they are written, in order (bounds the memory held).
+const PIECES_AT_ONCE: usize = 32;
+
+/// Write items `0..n` of an array, each appended to a byte buffer by `item` (separator
+/// included): pieces of [`PIECE`] items are formatted in parallel into their own buffers and
+/// written in order, so the bytes are those of a serial loop whatever the thread count.
+fn write_items<W: Write>(w: &mut W, n: usize, item: impl Fn(&mut Vec<u8>, usize) + Sync) -> io::Result<()> {
+    let pieces = n.div_ceil(PIECE);
+    for first in (0..pieces).step_by(PIECES_AT_ONCE) {
+        let buffers: Vec<Vec<u8>> = (first..pieces.min(first + PIECES_AT_ONCE))
+            .into_par_iter()
+            .map(|p| {
+                let items = p * PIECE..n.min((p + 1) * PIECE);
+                let mut buf = Vec::with_capacity(items.len() * 72);
+                items.for_each(|k| item(&mut buf, k));
+                buf
+            })
+            .collect();
+        for b in buffers {
+            w.write_all(&b)?;
+        }
+    }
+    Ok(())
 }
 
 /// The JSON document of a checked net (see the module doc for the layout).
@@ -62,44 +95,48 @@ fn write_json_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
         write!(w, "{}\"{}\": \"{}\"", if k > 0 { ", " } else { "" }, *s as u8, s.name())?;
     }
     w.write_all(b"},\n  \"node_codes\": [")?;
-    for (k, s) in net.status.iter().enumerate() {
-        write!(w, "{}{}", separator(k, net.nv), *s as u8)?;
-    }
+    let nv = net.nv;
+    write_items(w, net.status.len(), |b, k| {
+        b.extend_from_slice(separator(k, nv).as_bytes());
+        push_u32(b, u32::from(net.status[k] as u8));
+    })?;
     w.write_all(b"]},\n\"meta\": ")?;
     write_value(w, &net.meta.to_json())?;
 
     w.write_all(b",\n\"nodes\": [")?;
-    for (k, (p, s)) in net.positions.iter().zip(&net.status).enumerate() {
-        w.write_all(if k > 0 { b",\n" } else { b"\n" })?;
-        if *s == NodeStatus::Placed {
-            w.write_all(b"[")?;
-            write_f64(w, p.x)?;
-            w.write_all(b", ")?;
-            write_f64(w, p.y)?;
-            w.write_all(b", ")?;
-            write_f64(w, p.z)?;
-            w.write_all(b"]")?;
+    write_items(w, net.positions.len(), |b, k| {
+        b.extend_from_slice(if k > 0 { b",\n" } else { b"\n" });
+        if net.status[k] == NodeStatus::Placed {
+            let p = net.positions[k];
+            b.push(b'[');
+            push_f64(b, p.x);
+            b.extend_from_slice(b", ");
+            push_f64(b, p.y);
+            b.extend_from_slice(b", ");
+            push_f64(b, p.z);
+            b.push(b']');
         } else {
-            w.write_all(b"null")?;
+            b.extend_from_slice(b"null");
         }
-    }
+    })?;
     w.write_all(b"],\n\"cell_shear_deg\": [")?;
-    for (k, (i, j)) in cells(net).enumerate() {
-        w.write_all(if k > 0 { b",\n" } else { b"\n" })?;
-        match net.cell_shear(i, j) {
-            Some(g) => write_f64(w, g.to_degrees())?,
-            None => w.write_all(b"null")?,
+    let cv = nv.saturating_sub(1);
+    write_items(w, cell_count(net), |b, k| {
+        b.extend_from_slice(if k > 0 { b",\n" } else { b"\n" });
+        match net.cell_shear(k / cv, k % cv) {
+            Some(g) => push_f64(b, g.to_degrees()),
+            None => b.extend_from_slice(b"null"),
         }
-    }
+    })?;
     w.write_all(b"],\n\"triangles\": [")?;
-    for (k, (t, s)) in net.triangles.iter().zip(&net.status).enumerate() {
-        w.write_all(separator(k, net.nv).as_bytes())?;
-        if *s == NodeStatus::Placed {
-            write!(w, "{t}")?;
+    write_items(w, net.triangles.len(), |b, k| {
+        b.extend_from_slice(separator(k, nv).as_bytes());
+        if net.status[k] == NodeStatus::Placed {
+            push_u32(b, net.triangles[k]);
         } else {
-            w.write_all(b"null")?;
+            b.extend_from_slice(b"null");
         }
-    }
+    })?;
     w.write_all(b"]\n}\n")
 }
 
@@ -116,6 +153,21 @@ fn separator(k: usize, row: usize) -> &'static str {
 fn write_f64<W: Write>(w: &mut W, x: f64) -> io::Result<()> {
     debug_assert!(x.is_finite(), "checked before writing");
     CompactFormatter.write_f64(w, x)
+}
+
+/// Append a finite f64 in the shortest form that parses back to the same bits (the bytes of
+/// [`write_f64`]).
+#[inline]
+fn push_f64(b: &mut Vec<u8>, x: f64) {
+    debug_assert!(x.is_finite(), "checked before writing");
+    // Writing to a Vec cannot fail.
+    let _ = CompactFormatter.write_f64(b, x);
+}
+
+/// Append a u32 in decimal.
+#[inline]
+fn push_u32(b: &mut Vec<u8>, x: u32) {
+    let _ = CompactFormatter.write_u32(b, x);
 }
 
 fn write_value<W: Write, T: serde::Serialize + ?Sized>(w: &mut W, v: &T) -> io::Result<()> {
@@ -392,6 +444,39 @@ mod tests {
         assert_eq!(v["status"]["failed"], serde_json::json!({"no_root": 2, "fold": 1}));
         assert_eq!(v["status"]["legend"]["3"], "no_root");
         assert_eq!(v["grid"], serde_json::json!([7, 5]));
+    }
+
+    #[test]
+    fn the_file_and_the_statistics_are_the_same_whatever_the_thread_count() {
+        // More nodes and cells than one piece of the parallel writer, some not placed.
+        let (nu, nv) = (123, 101);
+        let mut net = DrapeNet::new("threads", 0.01, nu, nv, (60, 50));
+        for i in 0..nu {
+            for j in 0..nv {
+                let k = net.index(i, j);
+                let (x, y) = (i as f64 * 0.01, j as f64 * 0.0103);
+                net.positions[k] = Point::new(x, y, (3.0 * x).sin() * (2.0 * y).cos() / 7.0);
+                net.status[k] = if (i * 7 + j * 3) % 97 == 0 { NodeStatus::NoRoot } else { NodeStatus::Placed };
+                net.triangles[k] = (k * 13 % 9973) as u32;
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let path = dir.path().join(format!("t{threads}.drape.json"));
+            pool.install(|| write_json(&net, &path)).unwrap();
+            let stats = pool.install(|| net.shear_stats(0.3));
+            (std::fs::read(&path).unwrap(), format!("{stats:?}"))
+        };
+        let (one, stats) = run(1);
+        for threads in [2, 3] {
+            let (bytes, s) = run(threads);
+            assert!(bytes == one, "{threads} threads wrote other bytes");
+            assert_eq!(s, stats, "{threads} threads");
+        }
+        let back = read_net(&dir.path().join("t1.drape.json")).unwrap();
+        assert_eq!(back.status, net.status);
+        assert_eq!(format!("{:?}", back.shear_stats(0.3)), stats);
     }
 
     #[test]

@@ -32,18 +32,29 @@ pub struct ObjText {
     pub vertices: Vec<([f64; 3], usize)>,
     /// Faces in file order.
     pub faces: Vec<ObjFace>,
+    /// The corners of all faces, face after face (see [`ObjFace::corners`]): vertex numbers
+    /// from 1, relative numbers resolved; not checked against the vertex count (a face may
+    /// refer to a vertex further down the file). One array instead of one per face, so a
+    /// large file is read without an allocation per face.
+    pub corners: Vec<u64>,
     /// `l` (polyline) statements, which are not surfaces.
     pub lines: usize,
     /// `p` (point) statements, which are not surfaces.
     pub points: usize,
 }
 
+impl ObjText {
+    /// The vertex numbers of `face`, in order.
+    pub fn face_corners(&self, face: &ObjFace) -> &[u64] {
+        &self.corners[face.corners.clone()]
+    }
+}
+
 /// One `f` statement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ObjFace {
-    /// Vertex numbers from 1, relative numbers resolved; not checked against the vertex count
-    /// (a face may refer to a vertex further down the file).
-    pub corners: Vec<u64>,
+    /// Where its vertex numbers are in [`ObjText::corners`].
+    pub corners: std::ops::Range<usize>,
     /// Its line in the file.
     pub line: usize,
 }
@@ -58,8 +69,18 @@ pub struct ObjSyntaxError {
 }
 
 /// Parse the statements of an OBJ file's bytes (see the module documentation).
+///
+/// Lines of ASCII text that do not continue on the next one (nearly all lines of nearly all
+/// files) are read from the bytes as they are, with no allocation; a line with other bytes
+/// (read as UTF-8, invalid sequences replaced) or a continued line goes through the same
+/// statement reading as text. Both give the same statements and the same errors (tested).
 pub fn parse(bytes: &[u8]) -> Result<ObjText, ObjSyntaxError> {
-    if bytes.contains(&0) {
+    parse_with(bytes, true)
+}
+
+/// [`parse`], with the byte path for ASCII lines or (`fast` false) every line read as text.
+fn parse_with(bytes: &[u8], fast: bool) -> Result<ObjText, ObjSyntaxError> {
+    if memchr::memchr(0, bytes).is_some() {
         return Err(ObjSyntaxError {
             line: 0,
             message: "it is a binary file, not a text (Wavefront) OBJ; binary STL, zipped or native CAD files cannot be read"
@@ -69,8 +90,19 @@ pub fn parse(bytes: &[u8]) -> Result<ObjText, ObjSyntaxError> {
     let mut text = ObjText::default();
     let mut joined: Option<(usize, String)> = None;
     for (number, raw) in lines(bytes) {
-        let raw = String::from_utf8_lossy(raw);
-        let raw = raw.split('#').next().unwrap_or("");
+        // Everything from the first `#` on is a comment. (`#` is ASCII, so cutting the bytes
+        // there and then reading them as UTF-8 gives the text before the `#` of the line read
+        // as UTF-8.)
+        let content = &raw[..memchr::memchr(b'#', raw).unwrap_or(raw.len())];
+        if fast && joined.is_none() && content.is_ascii() {
+            // ASCII bytes are valid UTF-8, and every word boundary below is an ASCII byte.
+            let line = std::str::from_utf8(content).unwrap_or_default();
+            if !line.trim_end_matches(is_space).ends_with('\\') {
+                statement_ascii(line, number, &mut text)?;
+                continue;
+            }
+        }
+        let raw = String::from_utf8_lossy(content);
         let (start, mut line) = joined.take().unwrap_or((number, String::new()));
         if let Some(head) = raw.trim_end().strip_suffix('\\') {
             line.push_str(head);
@@ -78,7 +110,7 @@ pub fn parse(bytes: &[u8]) -> Result<ObjText, ObjSyntaxError> {
             joined = Some((start, line));
             continue;
         }
-        line.push_str(raw);
+        line.push_str(&raw);
         statement(&line, start, &mut text)?;
     }
     if let Some((start, line)) = joined {
@@ -96,7 +128,7 @@ fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
             return None;
         }
         number += 1;
-        let end = rest.iter().position(|&c| c == b'\n' || c == b'\r').unwrap_or(rest.len());
+        let end = memchr::memchr2(b'\n', b'\r', rest).unwrap_or(rest.len());
         let line = &rest[..end];
         let skip = match (rest.get(end), rest.get(end + 1)) {
             (Some(b'\r'), Some(b'\n')) => 2,
@@ -108,65 +140,165 @@ fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
     })
 }
 
+/// The ASCII characters that are white space to [`char::is_whitespace`] and can occur inside
+/// a line (line ends cannot).
+#[inline]
+fn is_space(c: char) -> bool {
+    matches!(c, ' ' | '\t' | '\x0b' | '\x0c')
+}
+
+/// The words of an ASCII line, split at white space as [`str::split_whitespace`] splits it.
+#[inline]
+fn ascii_words(line: &str) -> impl Iterator<Item = &str> {
+    line.split([' ', '\t', '\x0b', '\x0c']).filter(|w| !w.is_empty())
+}
+
+/// [`statement`] for a line of ASCII text: the same statements and errors, read without
+/// allocating.
+fn statement_ascii(line: &str, number: usize, text: &mut ObjText) -> Result<(), ObjSyntaxError> {
+    let mut words = ascii_words(line);
+    match words.next() {
+        Some("v") => {
+            let mut numbers = [0.0; 6];
+            let mut count = 0;
+            let mut valid = true;
+            for w in words {
+                match w.parse::<f64>() {
+                    Ok(x) if count < 6 => numbers[count] = x,
+                    Ok(_) => {}
+                    Err(_) => valid = false,
+                }
+                count += 1;
+            }
+            let xyz = match (valid, count) {
+                (true, 3 | 6) => [numbers[0], numbers[1], numbers[2]],
+                (true, 4) if numbers[3] != 0.0 => {
+                    let w = numbers[3];
+                    [numbers[0] / w, numbers[1] / w, numbers[2] / w]
+                }
+                _ => return Err(vertex_error(line, number)),
+            };
+            text.vertices.push((xyz, number));
+        }
+        Some("f") => {
+            let start = text.corners.len();
+            for word in words {
+                // Most words are plain vertex numbers.
+                if let Some(i) = small_number(word) {
+                    let vertex = resolve(i, text, number)?;
+                    text.corners.push(vertex);
+                    continue;
+                }
+                let mut parts = word.split('/');
+                let first = parts.next().unwrap_or_default();
+                let mut count = 1;
+                let mut well_formed = true;
+                for part in parts {
+                    count += 1;
+                    well_formed &= part.is_empty() || part.parse::<i64>().is_ok();
+                }
+                let Some(i) = first.parse::<i64>().ok().filter(|_| well_formed && count <= 3) else {
+                    return Err(face_error(line, number));
+                };
+                let vertex = resolve(i, text, number)?;
+                text.corners.push(vertex);
+            }
+            text.faces.push(ObjFace { corners: start..text.corners.len(), line: number });
+        }
+        Some("l") => text.lines += 1,
+        Some("p") => text.points += 1,
+        _ => {}
+    }
+    Ok(())
+}
+
+/// A word of 1 to 18 ASCII digits as a number (what `i64` parsing gives it), else `None`.
+#[inline]
+fn small_number(word: &str) -> Option<i64> {
+    if word.is_empty() || word.len() > 18 {
+        return None;
+    }
+    let mut n = 0i64;
+    for &c in word.as_bytes() {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            return None;
+        }
+        n = n * 10 + i64::from(d);
+    }
+    Some(n)
+}
+
+/// The error of a `v` statement that is not three numbers, optionally with a weight or colour.
+fn vertex_error(line: &str, number: usize) -> ObjSyntaxError {
+    ObjSyntaxError {
+        line: number,
+        message: format!(
+            "{}: a vertex is `v x y z` with three numbers, optionally followed by a weight w other than 0 or by a colour r g b",
+            quote(line)
+        ),
+    }
+}
+
+/// The error of an `f` statement with a word that is not a vertex reference.
+fn face_error(line: &str, number: usize) -> ObjSyntaxError {
+    ObjSyntaxError {
+        line: number,
+        message: format!(
+            "{}: a face is `f` followed by vertex numbers, such as `f 1 2 3` or `f 1/1/1 2/2/2 3/3/3`",
+            quote(line)
+        ),
+    }
+}
+
+/// The vertex number (from 1) that the face reference `i` of the face being read (the next
+/// one of `text`) on line `number` means: positive numbers as they are, negative ones counted
+/// back from the last vertex read.
+#[inline]
+fn resolve(i: i64, text: &ObjText, number: usize) -> Result<u64, ObjSyntaxError> {
+    let read_so_far = text.vertices.len() as u64;
+    match i {
+        i if i > 0 => Ok(i as u64),
+        0 => Err(ObjSyntaxError {
+            line: number,
+            message: format!("face {} refers to vertex 0, but OBJ vertex numbers start at 1", text.faces.len() + 1),
+        }),
+        i if i.unsigned_abs() <= read_so_far => Ok(read_so_far + 1 - i.unsigned_abs()),
+        i => Err(ObjSyntaxError {
+            line: number,
+            message: format!(
+                "face {} refers to relative vertex {i}, but only {read_so_far} vertices are defined before it",
+                text.faces.len() + 1
+            ),
+        }),
+    }
+}
+
 /// Add one statement (a whole line, continuations joined) to `text`.
 fn statement(line: &str, number: usize, text: &mut ObjText) -> Result<(), ObjSyntaxError> {
     let mut words = line.split_whitespace();
-    let quoted = || quote(line);
     match words.next() {
         Some("v") => {
             let numbers: Option<Vec<f64>> = words.map(|w| w.parse::<f64>().ok()).collect();
             let xyz = match numbers.as_deref() {
                 Some(&[x, y, z]) | Some(&[x, y, z, _, _, _]) => [x, y, z],
                 Some(&[x, y, z, w]) if w != 0.0 => [x / w, y / w, z / w],
-                _ => {
-                    return Err(ObjSyntaxError {
-                        line: number,
-                        message: format!(
-                            "{}: a vertex is `v x y z` with three numbers, optionally followed by a weight w other than 0 or by a colour r g b",
-                            quoted()
-                        ),
-                    })
-                }
+                _ => return Err(vertex_error(line, number)),
             };
             text.vertices.push((xyz, number));
         }
         Some("f") => {
-            let face = text.faces.len() + 1;
-            let read_so_far = text.vertices.len() as u64;
-            let mut corners = Vec::with_capacity(4);
+            let start = text.corners.len();
             for word in words {
                 let parts: Vec<&str> = word.split('/').collect();
                 let well_formed = parts.len() <= 3 && parts.iter().all(|p| p.is_empty() || p.parse::<i64>().is_ok());
                 let Some(i) = parts[0].parse::<i64>().ok().filter(|_| well_formed) else {
-                    return Err(ObjSyntaxError {
-                        line: number,
-                        message: format!(
-                            "{}: a face is `f` followed by vertex numbers, such as `f 1 2 3` or `f 1/1/1 2/2/2 3/3/3`",
-                            quoted()
-                        ),
-                    });
+                    return Err(face_error(line, number));
                 };
-                let vertex = match i {
-                    i if i > 0 => i as u64,
-                    0 => {
-                        return Err(ObjSyntaxError {
-                            line: number,
-                            message: format!("face {face} refers to vertex 0, but OBJ vertex numbers start at 1"),
-                        })
-                    }
-                    i if i.unsigned_abs() <= read_so_far => read_so_far + 1 - i.unsigned_abs(),
-                    i => {
-                        return Err(ObjSyntaxError {
-                            line: number,
-                            message: format!(
-                                "face {face} refers to relative vertex {i}, but only {read_so_far} vertices are defined before it"
-                            ),
-                        })
-                    }
-                };
-                corners.push(vertex);
+                let vertex = resolve(i, text, number)?;
+                text.corners.push(vertex);
             }
-            text.faces.push(ObjFace { corners, line: number });
+            text.faces.push(ObjFace { corners: start..text.corners.len(), line: number });
         }
         Some("l") => text.lines += 1,
         Some("p") => text.points += 1,
@@ -201,10 +333,11 @@ pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
     }
     // Vertices in the order the faces first use them.
     let mut index = vec![u32::MAX; count];
-    let mut mesh = TriangleMesh::default();
+    let mut mesh = TriangleMesh { vertices: Vec::with_capacity(count), triangles: Vec::with_capacity(text.faces.len()) };
+    let mut corners = Vec::with_capacity(8);
     for (f, face) in text.faces.iter().enumerate() {
-        let mut corners = Vec::with_capacity(face.corners.len());
-        for &v in &face.corners {
+        corners.clear();
+        for &v in text.face_corners(face) {
             let k = (v as usize).checked_sub(1).filter(|&k| k < count).ok_or(ToolError::BadIndex {
                 path: path.into(),
                 face: f + 1,
@@ -253,7 +386,7 @@ pub fn read(path: &Path, scale: f64) -> Result<FlowMesh, FlowMeshError> {
     let mut next_element: u64 = 1;
     for face in &text.faces {
         let loc = Loc { file: 0, line: face.line };
-        let c = &face.corners;
+        let c = text.face_corners(face);
         match c.len() {
             3 | 4 => {
                 b.add_element(next_element, c, 0, loc)?;
@@ -532,6 +665,45 @@ mod tests {
         assert_eq!(m.node_ids, [1, 2, 3, 4]);
         let e = read_flow("v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap_err().to_string();
         assert!(e.contains("line 3") && e.contains("at least 3"), "{e}");
+    }
+
+    #[test]
+    fn the_byte_path_reads_what_the_text_path_reads() {
+        // Random lines of OBJ-like words, white space of every ASCII kind, comments, continued
+        // lines, non-ASCII bytes and all three line ends: parsed with the byte path for ASCII
+        // lines and with every line read as text, the same statements or the same error.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut rnd = move |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as usize
+        };
+        let words = [
+            "v", "f", "vt", "l", "p", "1", "-1", "2", "-3", "0", "+4", "7/1", "2//5", "3/1/2", "1/2/3/4", "/", "//",
+            "1e40", "nan", "inf", "-0.5", "2.5e-3", ".5", "1.", "x", "#", "#c", "\\", "caf\u{e9}", "\u{a0}", "9999999999999999999999",
+        ];
+        let spaces = [" ", "  ", "\t", "\x0b", "\x0c", " \t"];
+        let ends = ["\n", "\r\n", "\r"];
+        for round in 0..3000 {
+            let mut text = String::new();
+            for _ in 0..1 + rnd(6) {
+                let kind = ["v", "f", "f", "l", "#", "g"][rnd(6)];
+                text += kind;
+                for _ in 0..rnd(7) {
+                    text += spaces[rnd(spaces.len())];
+                    text += if rnd(3) == 0 { words[rnd(words.len())] } else { ["1", "2", "3", "-1", "0.25"][rnd(5)] };
+                }
+                if rnd(4) == 0 {
+                    text += spaces[rnd(spaces.len())];
+                }
+                text += ends[rnd(ends.len())];
+            }
+            let bytes = if round % 7 == 0 { [text.as_bytes(), b"v 1 \xff 2\n"].concat() } else { text.into_bytes() };
+            // Compared as Debug text: NaN coordinates are not equal to themselves.
+            let (fast, text) = (parse_with(&bytes, true), parse_with(&bytes, false));
+            assert_eq!(format!("{fast:?}"), format!("{text:?}"), "{:?}", String::from_utf8_lossy(&bytes));
+        }
     }
 
     #[test]
