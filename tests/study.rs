@@ -115,7 +115,12 @@ fn speed_accuracy_on_a_developable_tool_reports_near_zero_error() {
         assert!(true_max < 0.05, "{}: shear {true_max} deg on a developable tool", p.method);
         // Below 1e-4 deg the shear is the surface's rounding floor (the smooth surface leaves
         // about 2e-5 deg), not a discretisation error a spacing study could see.
-        assert!(est >= 0.5 * true_max - FLOOR_DEG && est < 0.05, "{} {}: estimate {est}, true {true_max}", p.method, p.surface);
+        assert!(
+            est >= 0.5 * true_max - FLOOR_DEG && est < 0.05,
+            "{} {}: estimate {est}, true {true_max}",
+            p.method,
+            p.surface
+        );
         assert_eq!(p.outcome, "ok");
     }
 }
