@@ -15,11 +15,13 @@
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
 pub mod change;
 mod html;
+mod raster;
 mod render;
+pub mod shade;
 mod view;
 
-pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL_TRIANGLE_LIMIT, WIDTH};
-pub use view::{change_limit, colour_limit, shear_colour, View, VIEW_TILT_DEG};
+pub use render::{bin_shares, bin_width, register_fonts, HEIGHT, WIDTH};
+pub use view::{change_limit, colour_limit, shear_colour, View};
 
 use crate::geometry::Point;
 use crate::io::layup_json::{self, LAYUP_FILE};
@@ -32,7 +34,8 @@ use crate::layup::{locking_angle_deg, LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
 use crate::material::MaterialCard;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
-use render::{Mark, ToolLayer};
+use render::{LegendItem, Mark, ShadedPicture, Swatch};
+use shade::{CellPaint, PlyScene, ToolMesh};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -118,6 +121,18 @@ pub struct PlyReport {
     /// For a mechanical ply: the noise floor of its change from the kinematic net (no change
     /// map is drawn when every change lies within it).
     pub change_noise: Option<change::ChangeNoise>,
+    /// Names of the views drawn (the first is isometric).
+    pub views: Vec<String>,
+    /// Share of the drawn cells that some view shows (facing it, not hidden).
+    pub seen_share: f64,
+    /// Fibre lines are drawn every `fibre_step`-th fibre (in the first view).
+    pub fibre_step: usize,
+    /// Cells sheared past the locking angle (hatched).
+    pub over_locking_cells: usize,
+    /// Cells folded over against their neighbours (wrinkle risk).
+    pub folded_cells: usize,
+    /// Where the net stopped: failure status and how many placed nodes border it.
+    pub stops: Vec<(crate::kinematic::NodeStatus, usize)>,
     /// Pictures written for this ply.
     pub files: Vec<PathBuf>,
     /// What could not be drawn for this ply.
@@ -157,12 +172,19 @@ struct RawTool {
     hi: Point,
     /// Its facets' sagitta (file units), computed when a change map first needs it.
     sagitta: std::sync::OnceLock<Option<f64>>,
+    /// Its smooth corner normals (for the shading), computed once for all plies.
+    normals: std::sync::OnceLock<Vec<[crate::geometry::Vector; 3]>>,
 }
 
 impl RawTool {
     /// The median sagitta of its curved facets, file units ([`change::facet_sagitta`]).
     fn sagitta(&self) -> Option<f64> {
         *self.sagitta.get_or_init(|| change::facet_sagitta(&self.vertices, &self.triangles))
+    }
+
+    /// Its corner normals ([`shade::corner_normals`]; a uniform scale does not change them).
+    fn normals(&self) -> &[[crate::geometry::Vector; 3]] {
+        self.normals.get_or_init(|| shade::corner_normals(&self.vertices, &self.triangles))
     }
 }
 
@@ -185,7 +207,14 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
         lo = lo.inf(v);
         hi = hi.sup(v);
     }
-    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi, sagitta: Default::default() })
+    Ok(RawTool {
+        vertices: raw.vertices,
+        triangles: raw.triangles,
+        lo,
+        hi,
+        sagitta: Default::default(),
+        normals: Default::default(),
+    })
 }
 
 /// The scale (metres per file unit) the run read the tool with, for a net that does not record
@@ -370,9 +399,10 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     }
     bar.set_message("drawing");
 
+    let limit = shared_limit(&inputs);
     let reports: Vec<Result<PlyReport, ReportError>> = inputs
         .par_iter()
-        .map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), out, &bar))
+        .map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), limit, out, &bar))
         .collect();
     let mut plies = Vec::new();
     for r in reports {
@@ -483,10 +513,64 @@ pub(crate) fn method_name(m: Method) -> &'static str {
     }
 }
 
-/// Draw one ply's pictures into `out`.
+/// The colour limit (degrees, symmetric) shared by every ply of a report: one scale for the
+/// whole layup, so equal colours mean equal shear on every ply.
+fn shared_limit(inputs: &[PlyInput]) -> f64 {
+    let max = inputs.iter().map(|i| i.net.shear_stats(i.locking_deg.to_radians()).max_abs.to_degrees()).fold(0.0, f64::max);
+    let lock = inputs.iter().map(|i| i.locking_deg).fold(0.0, f64::max);
+    colour_limit(max, lock)
+}
+
+/// What each failure status means, for legends and the page.
+pub fn status_meaning(s: crate::kinematic::NodeStatus) -> &'static str {
+    use crate::kinematic::NodeStatus as S;
+    match s {
+        S::Placed => "placed on the tool",
+        S::Pending => "not computed (never left in a finished net)",
+        S::OffTool => "the fibre ran off the tool's edge",
+        S::NoRoot => "no point of the tool at one fibre length from both neighbours",
+        S::ShearLimit => "the cell would shear past the limit",
+        S::Fold => "the only place would fold the fabric over itself",
+        S::SheetJump => "the only place is on another sheet of the tool",
+        S::ParentMissing => "a node it depends on was not placed",
+        S::OutsideOutline => "outside the ply outline: trimmed",
+        S::Detached => "hung on by a corner only: left out of the mechanical result",
+    }
+}
+
+/// Short legend text of a failure status.
+fn status_short(s: crate::kinematic::NodeStatus) -> &'static str {
+    use crate::kinematic::NodeStatus as S;
+    match s {
+        S::Placed | S::Pending => "",
+        S::OffTool => "off the tool",
+        S::NoRoot => "no root",
+        S::ShearLimit => "shear limit",
+        S::Fold => "would fold",
+        S::SheetJump => "sheet jump",
+        S::ParentMissing => "parent missing",
+        S::OutsideOutline => "outside outline",
+        S::Detached => "detached",
+    }
+}
+
+/// "1st", "2nd", "3rd", "4th"...
+fn ordinal(k: usize) -> String {
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
+}
+
+/// Draw one ply's pictures into `out`, on the colour scale `limit` shared by all plies.
 fn draw_ply(
     input: &PlyInput,
     tool: Option<&Result<RawTool, String>>,
+    limit: f64,
     out: &Path,
     bar: &ProgressBar,
 ) -> Result<PlyReport, ReportError> {
@@ -496,7 +580,7 @@ fn draw_ply(
     let (max_abs_deg, mean_abs_deg) = (st.max_abs.to_degrees(), st.mean_abs.to_degrees());
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
     let mut sagitta = None;
-    let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
+    let scaled: Option<(Vec<Point>, &RawTool)> = match tool {
         Some(Ok(t)) => {
             // The scale the run read the tool with, when the net records it.
             let recorded = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0);
@@ -504,7 +588,7 @@ fn draw_ply(
             if net.method == Method::Mechanical {
                 sagitta = t.sagitta().map(|v| v * s);
             }
-            Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
+            Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), t))
         }
         Some(Err(e)) => {
             notes.push(format!("tool not drawn: {e}"));
@@ -512,9 +596,10 @@ fn draw_ply(
         }
         None => None,
     };
-    let layer = scaled.as_ref().map(|(v, t)| ToolLayer { vertices: v, triangles: t });
-    let tool_text = match (&input.tool, &layer) {
-        (Some(p), Some(l)) => format!("grey: tool {} ({} triangles)", p.display(), l.triangles.len()),
+    let tool_mesh =
+        || scaled.as_ref().map(|(v, t)| ToolMesh { vertices: v, triangles: &t.triangles, normals: t.normals() });
+    let tool_text = match (&input.tool, &scaled) {
+        (Some(p), Some((_, t))) => format!("tool {} ({} triangles)", p.display(), t.triangles.len()),
         _ => "tool not drawn (see the report page)".to_string(),
     };
     if st.cells == 0 {
@@ -522,20 +607,79 @@ fn draw_ply(
     }
     let kind = method_name(net.method);
     let lock = input.locking_deg;
-    let limit = colour_limit(max_abs_deg, lock);
     let lock_marks = vec![
         Mark { value: lock, label: format!("+{lock:.0}° locking") },
         Mark { value: -lock, label: format!("−{lock:.0}° locking") },
     ];
-    let mut map = render::layout_map(net, &values, layer.as_ref(), limit);
-    map.title = format!("Ply {}: shear angle ({kind})", input.stem);
-    map.subtitle =
-        format!("{} cells, view along the mean ply normal tilted {VIEW_TILT_DEG:.0}°; {tool_text}", st.cells);
-    map.bar_label = "shear angle (deg)".into();
-    map.marks = lock_marks.clone();
+    let folded = shade::folded_cells(net);
+    let paint: Vec<Option<CellPaint>> = values
+        .iter()
+        .zip(&folded)
+        .map(|(v, f)| {
+            v.map(|g| CellPaint { colour: if *f { shade::FOLD_FILL } else { shear_colour(g, limit) }, hatch: g.abs() > lock })
+        })
+        .collect();
+    let folded_count = folded.iter().filter(|f| **f).count();
+    let scene = PlyScene::new(net, tool_mesh(), paint, true);
+    let (views, seen_share) = if st.cells > 0 { shade::choose_views(&scene) } else { (Vec::new(), 1.0) };
+    if seen_share < 1.0 {
+        notes.push(format!(
+            "the {} views show {:.1}% of the cells; the rest are hidden or seen edge-on from every direction tried (use the interactive view)",
+            views.len(),
+            100.0 * seen_share
+        ));
+    }
+    // The fibre step depends on the picture's scale: draw once to learn it, then the legend.
+    let mut legend = vec![
+        LegendItem { swatch: Swatch::Line(shade::WARP_LINE), text: "warp fibres".into() },
+        LegendItem { swatch: Swatch::Line(shade::WEFT_LINE), text: "weft fibres".into() },
+        LegendItem { swatch: Swatch::Seed, text: "seed, arrow: warp direction".into() },
+        LegendItem { swatch: Swatch::Line(shade::EDGE_LINE), text: "ply edge".into() },
+        LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
+        LegendItem {
+            swatch: Swatch::Hatch(shear_colour(limit, limit)),
+            text: format!("past locking: {} cells", st.over_locking),
+        },
+        LegendItem { swatch: Swatch::Fill(shade::FOLD_FILL), text: format!("folded (wrinkle): {folded_count}") },
+    ];
+    let mut stops: BTreeMap<crate::kinematic::NodeStatus, usize> = BTreeMap::new();
+    for (_, s) in &scene.frontier {
+        *stops.entry(*s).or_default() += 1;
+    }
+    for (s, n) in &stops {
+        legend.push(LegendItem {
+            swatch: Swatch::Dot(shade::status_colour(*s)),
+            text: format!("stopped, {}: {n}", status_short(*s)),
+        });
+    }
+    let mut pic = ShadedPicture {
+        title: format!("Ply {}: shear angle ({kind})", input.stem),
+        subtitle: format!(
+            "{} cells; {} view{} showing {:.1}% of them; colour scale ±{limit:.0}° for the whole layup; {tool_text}",
+            st.cells,
+            views.len(),
+            if views.len() == 1 { "" } else { "s" },
+            100.0 * seen_share
+        ),
+        limit,
+        bar_label: "shear angle (deg)".into(),
+        marks: lock_marks.clone(),
+        legend,
+    };
     let mut files = Vec::new();
     let name = |suffix: &str| out.join(format!("{}-{suffix}", input.stem));
-    write_pair(&name("shear"), |r| render::draw_map(r, &map), |r| render::draw_map(r, &map), &mut files)?;
+    let draw_err = |p: &Path| {
+        let p = p.to_path_buf();
+        move |message: String| ReportError::Draw { path: p.clone(), message }
+    };
+    let shear_png = name("shear.png");
+    let (_, outs) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
+    let fibre_step = outs.first().map_or(0, |o| o.fibre_step);
+    let every = if fibre_step <= 1 { "every fibre".to_string() } else { format!("every {} fibre", ordinal(fibre_step)) };
+    pic.legend[0].text = format!("warp fibres ({every})");
+    let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
+    write_atomic(&shear_png, |w| w.write_all(&bytes))?;
+    files.push(shear_png);
     bar.inc(1);
 
     let hist = render::HistogramPicture {
@@ -574,25 +718,37 @@ fn draw_ply(
                     ));
                 } else {
                     // Changes within the noise are drawn as no change; the scale starts above it.
-                    let shown: Vec<Option<f64>> =
-                        change.iter().map(|v| v.map(|x| if x.abs() <= floor { 0.0 } else { x })).collect();
-                    let limit = change_limit(max);
-                    let mut map = render::layout_map(net, &shown, layer.as_ref(), limit);
-                    map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
-                    map.subtitle = format!(
-                        "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
-                    );
-                    map.bar_label = "shear change (deg)".into();
-                    map.marks = vec![
-                        Mark { value: floor, label: format!("+{floor:.2}° noise") },
-                        Mark { value: -floor, label: format!("−{floor:.2}° noise") },
-                    ];
-                    write_pair(
-                        &name("change"),
-                        |r| render::draw_map(r, &map),
-                        |r| render::draw_map(r, &map),
-                        &mut files,
-                    )?;
+                    let climit = change_limit(max);
+                    let paint: Vec<Option<CellPaint>> = change
+                        .iter()
+                        .map(|v| {
+                            v.map(|x| CellPaint {
+                                colour: shear_colour(if x.abs() <= floor { 0.0 } else { x }, climit),
+                                hatch: false,
+                            })
+                        })
+                        .collect();
+                    let scene = PlyScene::new(net, tool_mesh(), paint, false);
+                    let pic = ShadedPicture {
+                        title: format!("Ply {}: change of shear, mechanical − kinematic", input.stem),
+                        subtitle: format!(
+                            "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
+                        ),
+                        limit: climit,
+                        bar_label: "shear change (deg)".into(),
+                        marks: vec![
+                            Mark { value: floor, label: format!("+{floor:.2}° noise") },
+                            Mark { value: -floor, label: format!("−{floor:.2}° noise") },
+                        ],
+                        legend: vec![
+                            LegendItem { swatch: Swatch::Line(shade::EDGE_LINE), text: "ply edge".into() },
+                            LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
+                        ],
+                    };
+                    let p = name("change.png");
+                    let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&p))?;
+                    write_atomic(&p, |w| w.write_all(&bytes))?;
+                    files.push(p);
                 }
                 change_noise = Some(noise);
             }
@@ -608,8 +764,14 @@ fn draw_ply(
         max_abs_shear_deg: max_abs_deg,
         mean_abs_shear_deg: mean_abs_deg,
         colour_limit_deg: limit,
-        tool_drawn: layer.is_some(),
+        tool_drawn: scaled.is_some(),
         change_noise,
+        views: views.into_iter().map(|(_, n)| n).collect(),
+        seen_share,
+        fibre_step,
+        over_locking_cells: st.over_locking,
+        folded_cells: folded_count,
+        stops: stops.into_iter().collect(),
         files,
         notes,
     })
@@ -677,6 +839,7 @@ mod tests {
             lo: Point::new(-k, -k, 0.0),
             hi: Point::new(k, k, k),
             sagitta: Default::default(),
+            normals: Default::default(),
         };
         let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
         for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {
