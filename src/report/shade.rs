@@ -277,7 +277,7 @@ fn view_bounds(scene: &PlyScene, view: &View) -> Option<[f64; 4]> {
         let (x, y, _) = view.project(p);
         b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
     }
-    let pad = 0.08 * (b[1] - b[0]).max(b[3] - b[2]).max(1e-9);
+    let pad = 0.12 * (b[1] - b[0]).max(b[3] - b[2]).max(1e-9);
     Some([b[0] - pad, b[1] + pad, b[2] - pad, b[3] + pad])
 }
 
