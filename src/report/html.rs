@@ -75,7 +75,8 @@ table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:
 th{background:#f3f3f3}td.t,th.t{text-align:left}img{max-width:100%;height:auto;border:1px solid #ddd;margin:.5em 0}\
 .notes{background:#fff6e0;border-left:4px solid #e0a000;padding:.5em 1em}.small{color:#666;font-size:.9em}\
 dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dt{color:#666}dd{margin:0}\
-.pattern svg{max-width:100%;height:auto;border:1px solid #ddd}";
+.pattern svg{max-width:100%;height:auto;border:1px solid #ddd}\
+#drape-view{width:100%;height:auto;border:1px solid #ddd;cursor:grab}.viewer-controls label{margin-right:1em}";
 
 /// The whole page.
 pub(crate) fn page(p: &Page) -> String {
@@ -110,6 +111,7 @@ pub(crate) fn page(p: &Page) -> String {
         }
         let _ = writeln!(h, "</ul></div>");
     }
+    h.push_str(&p.viewer);
     for ply in &p.plies {
         ply_section(&mut h, ply, p.extra.get(&ply.name).map(Vec::as_slice).unwrap_or(&[]));
     }

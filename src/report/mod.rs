@@ -19,6 +19,7 @@ mod raster;
 mod render;
 pub mod shade;
 mod view;
+pub mod viewer;
 
 pub use render::{bin_shares, bin_width, register_fonts, HEIGHT, WIDTH};
 pub use view::{change_limit, colour_limit, shear_colour, View};
@@ -255,6 +256,8 @@ struct PlyInput {
     given: Option<LayupRow>,
     tool: Option<PathBuf>,
     tool_note: Option<String>,
+    /// The material card the net records, when it can be read.
+    card: Option<MaterialCard>,
 }
 
 /// Everything the page shows, gathered by [`write_report`].
@@ -266,6 +269,8 @@ pub(crate) struct Page {
     pub patterns: Vec<(String, Result<String, String>)>,
     pub notes: Vec<String>,
     pub extra: BTreeMap<String, Vec<(String, String)>>,
+    /// The interactive 3D view's HTML.
+    pub viewer: String,
 }
 
 /// Draw every ply of the run folder `dir` into `out` (created if missing) and write
@@ -334,18 +339,12 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         let net = nets.remove(&stem).expect("ordered from the map's keys");
         let given = layup.as_ref().and_then(|l| l.plies.iter().find(|r| r.name == stem)).cloned();
         let recorded_locking = given.as_ref().and_then(|r| r.locking_angle_deg).filter(|a| a.is_finite() && *a > 0.0);
+        // The card the net records, found as the tool is.
+        let card =
+            net.meta.material.as_deref().and_then(|m| locate_tool(m, dir)).and_then(|p| MaterialCard::load(&p).ok());
         let (locking_deg, locking_source) = match recorded_locking {
             Some(a) => (a, given.as_ref().and_then(|r| r.locking_angle_source).unwrap_or(LockingSource::Ply)),
-            None => {
-                // The card the net records, found as the tool is.
-                let card = net
-                    .meta
-                    .material
-                    .as_deref()
-                    .and_then(|m| locate_tool(m, dir))
-                    .and_then(|p| MaterialCard::load(&p).ok());
-                locking_angle_deg(None, card.as_ref())
-            }
+            None => locking_angle_deg(None, card.as_ref()),
         };
         if locking_source == LockingSource::Default {
             notes.push(format!(
@@ -366,7 +365,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                 ),
             },
         };
-        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note });
+        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note, card });
     }
 
     std::fs::create_dir_all(out).map_err(|source| ReportError::CreateDir { path: out.to_path_buf(), source })?;
@@ -438,6 +437,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         patterns.push((name, body));
     }
 
+    let viewer = viewer_section(&inputs, &tools, limit);
     let mut extra = BTreeMap::new();
     for i in &inputs {
         extra.insert(i.stem.clone(), html::net_facts(&i.net));
@@ -452,7 +452,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         [] => title,
         names => format!("NOT CONVERGED ({}): {title}", names.join(", ")),
     };
-    let page = Page { title, layup, rows, plies, patterns, notes, extra };
+    let page = Page { title, layup, rows, plies, patterns, notes, extra, viewer };
     bar.set_message("writing index.html");
     let index = out.join("index.html");
     let text = html::page(&page);
@@ -462,6 +462,33 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     files.push(index);
     let Page { plies, notes, .. } = page;
     Ok(ReportSummary { out: out.to_path_buf(), files, plies, notes })
+}
+
+/// The tool's vertices in metres, at the scale the run read it (recorded, else guessed).
+fn scaled_vertices(t: &RawTool, net: &DrapeNet) -> Vec<Point> {
+    let s = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or_else(|| guess_scale(t, net));
+    t.vertices.iter().map(|v| Point::from(v.coords * s)).collect()
+}
+
+/// The interactive 3D view of every ply on the first ply's tool.
+fn viewer_section(inputs: &[PlyInput], tools: &BTreeMap<PathBuf, Result<RawTool, String>>, limit: f64) -> String {
+    let tool_of = |i: &PlyInput| i.tool.as_ref().and_then(|p| tools.get(p)).and_then(|t| t.as_ref().ok());
+    let scaled: Vec<Option<Vec<Point>>> = inputs.iter().map(|i| tool_of(i).map(|t| scaled_vertices(t, &i.net))).collect();
+    let plies: Vec<viewer::ViewerPly> = inputs
+        .iter()
+        .zip(&scaled)
+        .map(|(i, v)| viewer::ViewerPly {
+            net: &i.net,
+            thickness: i.net.meta.thickness_m.or(i.given.as_ref().and_then(|r| r.thickness_m)).filter(|t| *t > 0.0),
+            vf: i.card.as_ref().and_then(|c| c.flow.as_ref()).map(|f| f.fibre_volume_fraction),
+            tool_vertices: v.as_deref(),
+        })
+        .collect();
+    let tool = inputs
+        .iter()
+        .zip(&scaled)
+        .find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())));
+    viewer::section(&viewer::data_json(tool, &plies, limit))
 }
 
 /// The table row of a net that `layup.json` does not list: its shear statistics and, when its

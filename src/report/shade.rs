@@ -124,23 +124,7 @@ pub struct PlyScene<'a> {
 impl<'a> PlyScene<'a> {
     /// The scene of `net` with cell paint `cells`.
     pub fn new(net: &'a DrapeNet, tool: Option<ToolMesh<'a>>, cells: Vec<Option<CellPaint>>, fibres: bool) -> Self {
-        let mut normals = node_normals(net);
-        // Turn the normals to the ply's outer side (away from the tool's centre, or up without
-        // a tool): the ply is drawn lifted off the tool that way, so from the tool's far side the
-        // tool hides it.
-        let centre = tool.as_ref().map(|t| {
-            let n = t.vertices.len().max(1) as f64;
-            Point::from(t.vertices.iter().fold(Vector::zeros(), |s, p| s + p.coords) / n)
-        });
-        let outward: f64 = net
-            .positions
-            .iter()
-            .zip(&normals)
-            .map(|(p, n)| centre.map_or(n.z, |c| n.dot(&(p - c))))
-            .sum();
-        if outward < 0.0 {
-            normals.iter_mut().for_each(|n| *n = -*n);
-        }
+        let normals = outer_normals(net, tool.as_ref().map(|t| t.vertices));
         let frontier = frontier(net).into_iter().filter(|(_, s)| *s != NodeStatus::OutsideOutline).collect();
         PlyScene { net, tool, cells, fibres, frontier, node_normals: normals }
     }
@@ -161,6 +145,22 @@ impl<'a> PlyScene<'a> {
         let pts = if pts.is_empty() { self.tool.as_ref().map(|t| t.vertices.to_vec()).unwrap_or_default() } else { pts };
         crate::geometry::surface::bounding_diagonal(&pts).max(1e-9)
     }
+}
+
+/// Unit node normals (zero where not placed) turned to the ply's outer side: away from the
+/// centre of the tool's vertices, or upwards without a tool. The ply is drawn lifted off the
+/// tool that way, so from the tool's far side the tool hides it.
+pub fn outer_normals(net: &DrapeNet, tool_vertices: Option<&[Point]>) -> Vec<Vector> {
+    let mut normals = node_normals(net);
+    let centre = tool_vertices.filter(|v| !v.is_empty()).map(|v| {
+        Point::from(v.iter().fold(Vector::zeros(), |s, p| s + p.coords) / v.len() as f64)
+    });
+    let outward: f64 =
+        net.positions.iter().zip(&normals).map(|(p, n)| centre.map_or(n.z, |c| n.dot(&(p - c)))).sum();
+    if outward < 0.0 {
+        normals.iter_mut().for_each(|n| *n = -*n);
+    }
+    normals
 }
 
 /// Cells whose normal points against the summed normals of their complete neighbours: the net

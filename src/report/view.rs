@@ -4,7 +4,7 @@ use crate::geometry::{Point, Vector};
 /// Control points of the diverging colour map (ColorBrewer's RdYlBu), from -1 (blue) through a
 /// pale yellow (0) to +1 (red). The centre is a colour, not a grey, so that an unsheared ply
 /// stands out from the grey tool and the white page.
-const DIVERGING: [(f64, [u8; 3]); 5] = [
+pub(crate) const DIVERGING: [(f64, [u8; 3]); 5] = [
     (-1.0, [49, 54, 149]),
     (-0.5, [116, 173, 209]),
     (0.0, [255, 250, 180]),
