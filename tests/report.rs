@@ -474,3 +474,51 @@ fn report_views_see_every_wall_of_a_hat_box() {
     assert!(stopped > 0, "{:?}", p.stops);
     check_picture(&dir.join("r/hat-shear.png"));
 }
+
+/// The page as a person sees it: headless Chromium (installed by tools/run-tests) opens
+/// index.html with every host name unresolvable; the page must load with no console error and
+/// no request beyond local files, every picture must load, the 3D view must draw the part (a
+/// screenshot with the part over a sizable area, in many colours), turn when dragged, and name
+/// the cell under the pointer; the page must stay a readable length.
+#[test]
+fn report_page_in_chromium() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    make_flat_and_curved(dir);
+    let out = dir.join("r");
+    write_report(dir, &out, false).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/report_browser.py");
+    let shot = dir.join("view.png");
+    let run = std::process::Command::new("python3")
+        .arg(&script)
+        .arg(out.join("index.html"))
+        .arg(&shot)
+        .output()
+        .expect("python3 must run tools/report_browser.py (tools/run-tests installs its requirements)");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "tools/report_browser.py failed ({}): {stdout}\n{}\nChromium and the Python requirements are installed by tools/run-tests.",
+        run.status,
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let seen: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    eprintln!("chromium saw: {seen}");
+    assert_eq!(seen["loaded"], true);
+    assert_eq!(seen["errors"], serde_json::json!([]), "console errors");
+    assert_eq!(seen["external_requests"], serde_json::json!([]), "requests beyond local files");
+    let images = seen["images"].as_array().unwrap();
+    assert!(images.len() >= 4 && images.iter().all(|i| i["loaded"] == true), "{images:?}");
+    assert_eq!(seen["plies"], 2);
+    assert!(seen["faces"].as_u64().unwrap() > 1000, "the 3D view drew {} faces", seen["faces"]);
+    assert!(seen["faces_by_thickness"].as_u64().unwrap() > 0);
+    let pick = seen["pick"].as_str().unwrap_or("");
+    assert!(pick.starts_with("ply ") && pick.contains("shear"), "under the centre: {pick:?}");
+    let shot = &seen["shots"]["initial"];
+    assert!(shot["part_share"].as_f64().unwrap() > 0.1, "the part is missing from the 3D view: {shot}");
+    assert!(shot["distinct_colours"].as_u64().unwrap() > 100, "a flat or blank 3D view: {shot}");
+    assert!(seen["shots"]["changed_share"].as_f64().unwrap() > 0.05, "dragging did not turn the view");
+    // Two plies with their pictures, the table, the 3D view: a page, not a scroll of 15,000 px.
+    let height = seen["height"].as_u64().unwrap();
+    assert!(height < 6000, "the page is {height} px long");
+}
