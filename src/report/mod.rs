@@ -271,6 +271,10 @@ pub(crate) struct Page {
     pub extra: BTreeMap<String, Vec<(String, String)>>,
     /// The interactive 3D view's HTML.
     pub viewer: String,
+    /// The laminate's totals, as (what, value) lines.
+    pub laminate: Vec<(String, String)>,
+    /// Node statuses other than placed: the status and its count in each ply (table order).
+    pub statuses: Vec<(crate::kinematic::NodeStatus, Vec<usize>)>,
 }
 
 /// Draw every ply of the run folder `dir` into `out` (created if missing) and write
@@ -452,7 +456,15 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         [] => title,
         names => format!("NOT CONVERGED ({}): {title}", names.join(", ")),
     };
-    let page = Page { title, layup, rows, plies, patterns, notes, extra, viewer };
+    let laminate = laminate_totals(&inputs, &rows, layup.as_ref());
+    let mut statuses: Vec<(crate::kinematic::NodeStatus, Vec<usize>)> = Vec::new();
+    for s in crate::kinematic::NodeStatus::ALL.into_iter().filter(|s| *s != crate::kinematic::NodeStatus::Placed) {
+        let counts: Vec<usize> = inputs.iter().map(|i| i.net.status.iter().filter(|x| **x == s).count()).collect();
+        if counts.iter().any(|c| *c > 0) {
+            statuses.push((s, counts));
+        }
+    }
+    let page = Page { title, layup, rows, plies, patterns, notes, extra, viewer, laminate, statuses };
     bar.set_message("writing index.html");
     let index = out.join("index.html");
     let text = html::page(&page);
@@ -462,6 +474,58 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     files.push(index);
     let Page { plies, notes, .. } = page;
     Ok(ReportSummary { out: out.to_path_buf(), files, plies, notes })
+}
+
+/// The laminate's totals: its thickness (nominal, and the range its plies' sheared thickness
+/// spans), areas, mass and the nesting's waste; only what the run recorded.
+fn laminate_totals(inputs: &[PlyInput], rows: &[LayupRow], layup: Option<&LayupTable>) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let (mut nominal, mut thin, mut thick, mut known) = (0.0, 0.0, 0.0, 0);
+    for (i, r) in inputs.iter().zip(rows) {
+        let Some(t0) = r.thickness_m.or(i.net.meta.thickness_m).filter(|t| *t > 0.0) else { continue };
+        let shears: Vec<f64> = (0..i.net.num_cells())
+            .filter_map(|k| i.net.cell_shear(k / (i.net.nv - 1), k % (i.net.nv - 1)))
+            .filter(|g| g.is_finite())
+            .map(f64::abs)
+            .collect();
+        let lo = shears.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = shears.iter().copied().fold(0.0, f64::max);
+        nominal += t0;
+        thin += crate::material::flow::sheared_thickness(t0, if lo.is_finite() { lo } else { 0.0 });
+        thick += crate::material::flow::sheared_thickness(t0, hi);
+        known += 1;
+    }
+    if known > 0 {
+        out.push((
+            "laminate thickness".into(),
+            format!(
+                "{:.2} mm laid flat ({known} of {} plies give a thickness); sheared cells thicken (t0 / cos γ): from {:.2} mm (every ply at its least shear) to {:.2} mm (every ply at its most)",
+                nominal * 1e3,
+                inputs.len(),
+                thin * 1e3,
+                thick * 1e3
+            ),
+        ));
+    }
+    let sum = |f: fn(&LayupRow) -> Option<f64>| {
+        let v: Vec<f64> = rows.iter().filter_map(f).filter(|x| x.is_finite()).collect();
+        (!v.is_empty()).then(|| (v.iter().sum::<f64>(), v.len()))
+    };
+    if let Some((a, n)) = sum(|r| r.draped_area_m2) {
+        out.push(("draped area".into(), format!("{a:.4} m² ({n} plies)")));
+    }
+    if let Some((a, n)) = sum(|r| r.fabric_area_m2) {
+        out.push(("fabric area".into(), format!("{a:.4} m² ({n} plies)")));
+    }
+    if let Some((m, n)) = sum(|r| r.fabric_mass_kg) {
+        out.push(("fabric mass".into(), format!("{:.1} g ({n} plies)", m * 1e3)));
+    }
+    if let Some(n) = layup.and_then(|l| l.nesting.as_ref()) {
+        if let (Some(w), Some(f)) = (n.waste_area_m2, n.waste_fraction) {
+            out.push(("waste in nesting".into(), format!("{w:.4} m² ({:.1}% of the roll used)", 100.0 * f)));
+        }
+    }
+    out
 }
 
 /// The tool's vertices in metres, at the scale the run read it (recorded, else guessed).
