@@ -158,6 +158,8 @@ fn report_draws_every_ply_and_the_page_shows_them() {
             "p0mech-histogram.png",
             "p0mech-histogram.svg",
             "p0mech-change.png",
+            "p0mech-change-histogram.png",
+            "p0mech-change-histogram.svg",
             "index.html"
         ]
     );
@@ -224,6 +226,12 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     };
     let (red, blue) = (count(&|r, g, _| r > g + 60), count(&|r, _, b| b > r + 30));
     assert!(red > 5000 && blue > 5000, "change map: {red} red and {blue} blue pixels");
+    // Its figures: the known change is CHANGE_STEP (i - j), largest at a corner of the grid.
+    let c = summary.plies[1].change.unwrap();
+    let (i, j) = c.largest_cell;
+    assert!((c.largest_deg - CHANGE_STEP * (i as f64 - j as f64)).abs() < 1e-9, "{c:?}");
+    assert!(c.largest_deg.abs() > 4.0 && c.mean_abs_deg > 1.0, "{c:?}");
+    check_picture(&out.join("p0mech-change-histogram.png"));
 
     check_svg(&out.join("p0-histogram.svg"), 10);
 
@@ -351,7 +359,7 @@ fn cli_report() {
         .assert()
         .success();
     let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
-    assert!(stdout.contains("ply p0:") && stdout.contains("wrote 8 files"), "{stdout}");
+    assert!(stdout.contains("ply p0:") && stdout.contains("wrote 10 files"), "{stdout}");
     assert!(out.join("index.html").is_file() && out.join("p0mech-change.png").is_file());
     // Bad input: exit code 2 and a message naming the folder.
     let empty = tmp.path().join("empty");
@@ -473,6 +481,10 @@ fn report_views_see_every_wall_of_a_hat_box() {
     let stopped: usize = p.stops.iter().map(|(_, n)| n).sum();
     assert!(stopped > 0, "{:?}", p.stops);
     check_picture(&dir.join("r/hat-shear.png"));
+    // The page says what each status means.
+    let html = std::fs::read_to_string(dir.join("r/index.html")).unwrap();
+    let (status, _) = p.stops[0];
+    assert!(html.contains("id=\"statuses\"") && html.contains(drape::report::status_meaning(status)), "status table");
 }
 
 /// The page as a person sees it: headless Chromium (installed by tools/run-tests) opens

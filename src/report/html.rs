@@ -223,6 +223,29 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         ("locking angle".to_string(), format!("{}°", num(Some(ply.locking_angle_deg), 1))),
         ("colour scale".to_string(), format!("±{}°", num(Some(ply.colour_limit_deg), 0))),
     ];
+    let mut summary = summary.to_vec();
+    if let Some(c) = &ply.change {
+        let at = c.largest_at;
+        let place = if at.iter().all(|x| x.is_finite()) {
+            format!(
+                " at cell ({}, {}), ({:.1}, {:.1}, {:.1}) mm",
+                c.largest_cell.0,
+                c.largest_cell.1,
+                at[0] * 1e3,
+                at[1] * 1e3,
+                at[2] * 1e3
+            )
+        } else {
+            String::new()
+        };
+        summary.push((
+            "mechanical − kinematic".to_string(),
+            format!(
+                "largest change {:+.2}°{place}; mean |change| {:.2}° over {} cells",
+                c.largest_deg, c.mean_abs_deg, c.cells
+            ),
+        ));
+    }
     for (k, v) in summary.iter().chain(facts) {
         let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
     }
@@ -235,12 +258,14 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         let _ = writeln!(h, "</ul></div>");
     }
     // The shaded views full width; the histogram and the change map side by side below.
-    let names: Vec<String> = ply.files.iter().filter_map(|f| Some(f.file_name()?.to_string_lossy().into_owned())).collect();
+    let names: Vec<String> =
+        ply.files.iter().filter_map(|f| Some(f.file_name()?.to_string_lossy().into_owned())).collect();
     let pngs: Vec<&String> = names.iter().filter(|n| n.ends_with(".png")).collect();
     let (main, small): (Vec<&String>, Vec<&String>) = pngs.into_iter().partition(|n| n.ends_with("-shear.png"));
     let figure = |h: &mut String, png: &str, class: &str| {
         let svg = png.trim_end_matches(".png").to_string() + ".svg";
-        let svg_link = if names.contains(&svg) { format!(" · <a href=\"{}\">SVG</a>", escape(&svg)) } else { String::new() };
+        let svg_link =
+            if names.contains(&svg) { format!(" · <a href=\"{}\">SVG</a>", escape(&svg)) } else { String::new() };
         let _ = writeln!(
             h,
             "<figure class=\"{class}\"><img src=\"{0}\" alt=\"{0}\" width=\"{1}\" height=\"{2}\"><figcaption class=\"small\"><a href=\"{0}\">PNG</a>{svg_link}</figcaption></figure>",

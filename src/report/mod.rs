@@ -1,15 +1,20 @@
 //! `drape report DIR`: pictures of every ply in a run's output folder and one HTML page that
-//! shows them with the layup table.
+//! shows them with the layup table and an interactive 3D view.
 //!
 //! For each `<ply>.drape.json` in DIR it writes, into DIR/report (or another folder):
-//! - `<ply>-shear.png/.svg`: the ply's cells seen obliquely along its mean normal, painted by
-//!   signed shear on a diverging colour map with symmetric limits, over the tool in light grey,
-//!   with a colour bar on which the locking angle +/- is marked;
+//! - `<ply>-shear.png`: the ply on its tool, lit and shaded, in the views that together show
+//!   every cell (an isometric view first), painted by signed shear on one diverging colour scale
+//!   shared by all plies of the report; warp and weft fibres every k-th fibre, the ply's edge,
+//!   the seed and the warp direction there, an axis triad; cells past locking hatched, folded
+//!   cells in their own colour, the placed nodes where the net stopped ringed in the colour of
+//!   why; a colour bar with the locking angle and a legend;
 //! - `<ply>-histogram.png/.svg`: the distribution of signed shear with the locking angle marked;
-//! - `<ply>-change.png/.svg` for a mechanical ply: the change of shear from the kinematic net;
+//! - for a mechanical ply, `<ply>-change.png` (the change of shear from the kinematic net, on
+//!   the same views) and `<ply>-change-histogram.png/.svg`, with the largest and mean change;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
-//!   nets), every picture, the summary numbers, the flat patterns (`*.svg` in DIR) and notes on
-//!   whatever could not be drawn.
+//!   nets), laminate totals, what each node status means, the interactive 3D view (the
+//!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
+//!   (`*.svg` in DIR) and notes on whatever could not be drawn.
 //!
 //! Text is rendered with the DejaVu Sans font compiled into the program (crate `dejavu`,
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
@@ -122,6 +127,8 @@ pub struct PlyReport {
     /// For a mechanical ply: the noise floor of its change from the kinematic net (no change
     /// map is drawn when every change lies within it).
     pub change_noise: Option<change::ChangeNoise>,
+    /// For a mechanical ply: the change of shear from the kinematic net, summed up.
+    pub change: Option<ChangeSummary>,
     /// Names of the views drawn (the first is isometric).
     pub views: Vec<String>,
     /// Share of the drawn cells that some view shows (facing it, not hidden).
@@ -145,7 +152,7 @@ const NET_SUFFIX: &str = ".drape.json";
 /// Flat-pattern SVGs larger than this are linked from the page instead of inlined.
 const PATTERN_INLINE_LIMIT: u64 = 8 << 20;
 /// The kinds of picture, as file-name suffixes after `<ply>-`.
-const PICTURES: [&str; 3] = ["shear", "histogram", "change"];
+const PICTURES: [&str; 4] = ["shear", "histogram", "change", "change-histogram"];
 /// Candidate scales (metres per OBJ unit) tried when the tool's units are not recorded.
 const TOOL_SCALES: [f64; 2] = [1.0, 1e-3];
 
@@ -537,7 +544,8 @@ fn scaled_vertices(t: &RawTool, net: &DrapeNet) -> Vec<Point> {
 /// The interactive 3D view of every ply on the first ply's tool.
 fn viewer_section(inputs: &[PlyInput], tools: &BTreeMap<PathBuf, Result<RawTool, String>>, limit: f64) -> String {
     let tool_of = |i: &PlyInput| i.tool.as_ref().and_then(|p| tools.get(p)).and_then(|t| t.as_ref().ok());
-    let scaled: Vec<Option<Vec<Point>>> = inputs.iter().map(|i| tool_of(i).map(|t| scaled_vertices(t, &i.net))).collect();
+    let scaled: Vec<Option<Vec<Point>>> =
+        inputs.iter().map(|i| tool_of(i).map(|t| scaled_vertices(t, &i.net))).collect();
     let plies: Vec<viewer::ViewerPly> = inputs
         .iter()
         .zip(&scaled)
@@ -548,10 +556,7 @@ fn viewer_section(inputs: &[PlyInput], tools: &BTreeMap<PathBuf, Result<RawTool,
             tool_vertices: v.as_deref(),
         })
         .collect();
-    let tool = inputs
-        .iter()
-        .zip(&scaled)
-        .find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())));
+    let tool = inputs.iter().zip(&scaled).find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())));
     viewer::section(&viewer::data_json(tool, &plies, limit))
 }
 
@@ -607,7 +612,8 @@ pub(crate) fn method_name(m: Method) -> &'static str {
 /// The colour limit (degrees, symmetric) shared by every ply of a report: one scale for the
 /// whole layup, so equal colours mean equal shear on every ply.
 fn shared_limit(inputs: &[PlyInput]) -> f64 {
-    let max = inputs.iter().map(|i| i.net.shear_stats(i.locking_deg.to_radians()).max_abs.to_degrees()).fold(0.0, f64::max);
+    let max =
+        inputs.iter().map(|i| i.net.shear_stats(i.locking_deg.to_radians()).max_abs.to_degrees()).fold(0.0, f64::max);
     let lock = inputs.iter().map(|i| i.locking_deg).fold(0.0, f64::max);
     colour_limit(max, lock)
 }
@@ -707,7 +713,10 @@ fn draw_ply(
         .iter()
         .zip(&folded)
         .map(|(v, f)| {
-            v.map(|g| CellPaint { colour: if *f { shade::FOLD_FILL } else { shear_colour(g, limit) }, hatch: g.abs() > lock })
+            v.map(|g| CellPaint {
+                colour: if *f { shade::FOLD_FILL } else { shear_colour(g, limit) },
+                hatch: g.abs() > lock,
+            })
         })
         .collect();
     let folded_count = folded.iter().filter(|f| **f).count();
@@ -766,7 +775,8 @@ fn draw_ply(
     let shear_png = name("shear.png");
     let (_, outs) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
     let fibre_step = outs.first().map_or(0, |o| o.fibre_step);
-    let every = if fibre_step <= 1 { "every fibre".to_string() } else { format!("every {} fibre", ordinal(fibre_step)) };
+    let every =
+        if fibre_step <= 1 { "every fibre".to_string() } else { format!("every {} fibre", ordinal(fibre_step)) };
     pic.legend[0].text = format!("warp fibres ({every})");
     let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
     write_atomic(&shear_png, |w| w.write_all(&bytes))?;
@@ -796,9 +806,11 @@ fn draw_ply(
     bar.inc(1);
 
     let mut change_noise = None;
+    let mut change_summary = None;
     if net.method == Method::Mechanical {
         match change_values(net) {
             Ok(change) => {
+                change_summary = summarise_change(net, &change);
                 let max = change.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
                 let noise = change::change_noise(&change, net.nu, net.nv, net.spacing, sagitta);
                 let floor = noise.floor_deg;
@@ -840,6 +852,26 @@ fn draw_ply(
                     let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&p))?;
                     write_atomic(&p, |w| w.write_all(&bytes))?;
                     files.push(p);
+                    // The distribution of the change, beside the map.
+                    let hist = render::HistogramPicture {
+                        title: format!("Ply {}: change of shear, mechanical − kinematic", input.stem),
+                        note: change_summary.as_ref().map_or(String::new(), |c| {
+                            format!(
+                                "{} cells · mean |change| {:.2}° · largest {:+.2}°",
+                                c.cells, c.mean_abs_deg, c.largest_deg
+                            )
+                        }),
+                        values: change.iter().flatten().copied().collect(),
+                        limit: climit,
+                        x_label: "shear change (deg)".into(),
+                        marks: pic.marks.clone(),
+                    };
+                    write_pair(
+                        &name("change-histogram"),
+                        |r| render::draw_histogram(r, &hist),
+                        |r| render::draw_histogram(r, &hist),
+                        &mut files,
+                    )?;
                 }
                 change_noise = Some(noise);
             }
@@ -857,6 +889,7 @@ fn draw_ply(
         colour_limit_deg: limit,
         tool_drawn: scaled.is_some(),
         change_noise,
+        change: change_summary,
         views: views.into_iter().map(|(_, n)| n).collect(),
         seen_share,
         fibre_step,
@@ -865,6 +898,37 @@ fn draw_ply(
         stops: stops.into_iter().collect(),
         files,
         notes,
+    })
+}
+
+/// The change of shear from the kinematic to the mechanical net, in figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChangeSummary {
+    /// Cells with a change.
+    pub cells: usize,
+    /// Mean |change|, degrees.
+    pub mean_abs_deg: f64,
+    /// The change of largest magnitude (signed), degrees.
+    pub largest_deg: f64,
+    /// Where it is: the cell (i, j) and its centre (m).
+    pub largest_cell: (usize, usize),
+    /// The centre of that cell, metres.
+    pub largest_at: [f64; 3],
+}
+
+/// Sum up a per-cell change (degrees by cell index); `None` when no cell has one.
+fn summarise_change(net: &DrapeNet, change: &[Option<f64>]) -> Option<ChangeSummary> {
+    let cv = net.nv.saturating_sub(1).max(1);
+    let values: Vec<(usize, f64)> = change.iter().enumerate().filter_map(|(k, v)| Some((k, (*v)?))).collect();
+    let (k, largest) = values.iter().copied().reduce(|a, b| if b.1.abs() > a.1.abs() { b } else { a })?;
+    let (i, j) = (k / cv, k % cv);
+    let at = net.cell_frame(i, j).map_or([f64::NAN; 3], |f| [f.centre.x, f.centre.y, f.centre.z]);
+    Some(ChangeSummary {
+        cells: values.len(),
+        mean_abs_deg: values.iter().map(|(_, v)| v.abs()).sum::<f64>() / values.len() as f64,
+        largest_deg: largest,
+        largest_cell: (i, j),
+        largest_at: at,
     })
 }
 

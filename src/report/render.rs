@@ -326,7 +326,8 @@ pub fn shaded_png(
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
         for ((_, name), (r, out)) in views.iter().zip(rects.iter().zip(&outs)) {
             let [x, y, w, h] = r.map(|v| v as i32);
-            root.draw(&Rectangle::new([(x, y), (x + w, y + h)], RGBColor(200, 200, 200).stroke_width(1))).map_err(de)?;
+            root.draw(&Rectangle::new([(x, y), (x + w, y + h)], RGBColor(200, 200, 200).stroke_width(1)))
+                .map_err(de)?;
             root.draw(&Text::new(name.clone(), (x + 8, y + 6), font(14.0).color(&RGBColor(60, 60, 60)))).map_err(de)?;
             for l in &out.labels {
                 let style = bold(14.0).color(&rgb(l.colour)).pos(Pos::new(HPos::Left, VPos::Center));

@@ -142,7 +142,8 @@ impl<'a> PlyScene<'a> {
     /// Bounding-box diagonal of the placed nodes (of the tool when none is placed), metres.
     fn diagonal(&self) -> f64 {
         let pts: Vec<Point> = self.placed().collect();
-        let pts = if pts.is_empty() { self.tool.as_ref().map(|t| t.vertices.to_vec()).unwrap_or_default() } else { pts };
+        let pts =
+            if pts.is_empty() { self.tool.as_ref().map(|t| t.vertices.to_vec()).unwrap_or_default() } else { pts };
         crate::geometry::surface::bounding_diagonal(&pts).max(1e-9)
     }
 }
@@ -152,11 +153,29 @@ impl<'a> PlyScene<'a> {
 /// tool that way, so from the tool's far side the tool hides it.
 pub fn outer_normals(net: &DrapeNet, tool_vertices: Option<&[Point]>) -> Vec<Vector> {
     let mut normals = node_normals(net);
-    let centre = tool_vertices.filter(|v| !v.is_empty()).map(|v| {
-        Point::from(v.iter().fold(Vector::zeros(), |s, p| s + p.coords) / v.len() as f64)
+    // The centre of the tool's vertices near the ply (a far-off part of the tool says nothing
+    // about which side of the ply is outside).
+    let placed_pts: Vec<Point> =
+        net.positions.iter().zip(&net.status).filter(|(_, s)| **s == NodeStatus::Placed).map(|(p, _)| *p).collect();
+    let (mut lo, mut hi) = (Point::from([f64::INFINITY; 3]), Point::from([f64::NEG_INFINITY; 3]));
+    for p in &placed_pts {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let grow = 0.25 * (hi - lo).norm();
+    let near = |p: &&Point| (0..3).all(|k| p[k] >= lo[k] - grow && p[k] <= hi[k] + grow);
+    let centre = tool_vertices.and_then(|v| {
+        let close: Vec<&Point> = v.iter().filter(near).collect();
+        (!close.is_empty())
+            .then(|| Point::from(close.iter().fold(Vector::zeros(), |s, p| s + p.coords) / close.len() as f64))
     });
-    let outward: f64 =
-        net.positions.iter().zip(&normals).map(|(p, n)| centre.map_or(n.z, |c| n.dot(&(p - c)))).sum();
+    // Mean cosine between the normals and the directions away from the tool's centre; on a
+    // flat tool that says nothing (all near zero) and up is taken as outside.
+    let placed: Vec<(&Point, &Vector)> = net.positions.iter().zip(&normals).filter(|(_, n)| n.norm() > 0.0).collect();
+    let away = |p: &Point, c: &Point| (p - c).try_normalize(0.0).unwrap_or(Vector::zeros());
+    let mean_cos = centre
+        .map_or(0.0, |c| placed.iter().map(|(p, n)| n.dot(&away(p, &c))).sum::<f64>() / placed.len().max(1) as f64);
+    let outward = if mean_cos.abs() > 0.05 { mean_cos } else { placed.iter().map(|(_, n)| n.z).sum() };
     if outward < 0.0 {
         normals.iter_mut().for_each(|n| *n = -*n);
     }
@@ -167,7 +186,8 @@ pub fn outer_normals(net: &DrapeNet, tool_vertices: Option<&[Point]>) -> Vec<Vec
 /// folded back over itself there (a wrinkle risk). By cell index.
 pub fn folded_cells(net: &DrapeNet) -> Vec<bool> {
     let (cu, cv) = (net.nu.saturating_sub(1), net.nv.saturating_sub(1));
-    let normal = |i: usize, j: usize| net.cell_corners(i, j).map(|[p00, p10, p01, p11]| (p11 - p00).cross(&(p01 - p10)));
+    let normal =
+        |i: usize, j: usize| net.cell_corners(i, j).map(|[p00, p10, p01, p11]| (p11 - p00).cross(&(p01 - p10)));
     let mut out = vec![false; cu * cv];
     for i in 0..cu {
         for j in 0..cv {
@@ -557,16 +577,15 @@ pub fn choose_views(scene: &PlyScene) -> (Vec<(View, String)>, f64) {
     let mut covered = vec![false; scene.cells.len()];
     let mut chosen: Vec<usize> = Vec::new();
     // The first view is an isometric one (the first eight candidates).
-    let first = (0..8).fold(0, |best, k| if count(&all[k].2, &covered) > count(&all[best].2, &covered) { k } else { best });
+    let first =
+        (0..8).fold(0, |best, k| if count(&all[k].2, &covered) > count(&all[best].2, &covered) { k } else { best });
     chosen.push(first);
     covered.iter_mut().zip(&all[first].2).for_each(|(c, s)| *c |= *s);
     while chosen.len() < MAX_VIEWS {
-        let best = (0..all.len())
-            .filter(|k| !chosen.contains(k))
-            .fold(None, |best: Option<usize>, k| match best {
-                Some(b) if count(&all[b].2, &covered) >= count(&all[k].2, &covered) => Some(b),
-                _ => Some(k),
-            });
+        let best = (0..all.len()).filter(|k| !chosen.contains(k)).fold(None, |best: Option<usize>, k| match best {
+            Some(b) if count(&all[b].2, &covered) >= count(&all[k].2, &covered) => Some(b),
+            _ => Some(k),
+        });
         let Some(b) = best.filter(|b| count(&all[*b].2, &covered) > 0) else { break };
         chosen.push(b);
         covered.iter_mut().zip(&all[b].2).for_each(|(c, s)| *c |= *s);
