@@ -1,14 +1,12 @@
 //! `drape report`: pictures are looked at, not only written. A real kinematic drape on a
-//! hemisphere plus a mechanical copy carrying a known per-cell change; the PNGs are decoded and
-//! must hold the colours of the cells' shear (and of the change), the tool's greys, text; the
-//! SVGs must hold the cells; the page must show every picture and one table row per ply.
+//! hemisphere plus a mechanical copy carrying a known per-cell change, a flat ply on a plate and
+//! a ply on a hat box; the PNGs are decoded and must show shading (many levels across a ply of
+//! one colour), fibre lines, the tool, both signs of a change, text; one colour scale for all
+//! plies; views that see the hat box's walls; the page must show every picture.
 use drape::geometry::{shapes, Point, Vector};
 use drape::io::{write_net, Format};
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, Method};
-use drape::report::{
-    bin_shares, bin_width, change_limit, colour_limit, shear_colour, tool_greys, write_report, ReportError, HEIGHT,
-    WIDTH,
-};
+use drape::report::{bin_shares, bin_width, colour_limit, shear_colour, write_report, ReportError, HEIGHT, WIDTH};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -21,8 +19,10 @@ const MIN_COLOURS_FOUND: f64 = 0.85;
 const WHITE: [u8; 3] = [255, 255, 255];
 /// The known change of p0mech per cell across the diagonal, degrees.
 const CHANGE_STEP: f64 = 0.2;
-/// Pixels in the tool's greys when the tool is drawn (the visible rim of the hemisphere).
+/// Pixels of the tool's slate grey when the tool is drawn (the visible rim of the hemisphere).
 const MIN_TOOL_PIXELS: usize = 5000;
+/// Width of the legend column on the right of a shaded picture.
+const LEGEND_COLUMN: u32 = 240;
 
 /// Write a hemisphere tool with `subdivisions` and drape ply `p0` on it; plus `p0mech`, a
 /// mechanical copy with change_from_kinematic = CHANGE_STEP deg * (i - j) per cell (null where
@@ -91,9 +91,22 @@ fn assert_colours(hist: &HashMap<[u8; 3], usize>, expected: &HashSet<[u8; 3]>, w
     );
 }
 
-/// Pixels painted in the tool's greys (anti-aliased text adds a few).
+/// Whether a pixel is the tool's slate grey (150, 154, 160), lit: bluer than red by a little,
+/// green 0.4 of the way (text, frames and the page are pure greys, the ply is coloured).
+fn is_tool(p: &[u8; 3]) -> bool {
+    let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+    (3..=11).contains(&(b - r)) && (2 * (g - r) - (b - r)).abs() <= 2 && (70..=245).contains(&r)
+}
+
+/// Pixels painted in the tool's shaded grey.
 fn tool_pixels(hist: &HashMap<[u8; 3], usize>) -> usize {
-    tool_greys().iter().map(|&g| hist.get(&[g, g, g]).copied().unwrap_or(0)).sum()
+    hist.iter().filter(|(c, _)| is_tool(c)).map(|(_, n)| n).sum()
+}
+
+/// Pixels of the map area (left of the legend column) of a decoded picture, row by row.
+fn map_rows(path: &Path) -> Vec<Vec<[u8; 3]>> {
+    let (w, _, px) = decode(path);
+    px.chunks(w as usize).map(|row| row[..(w - LEGEND_COLUMN) as usize].to_vec()).collect()
 }
 
 fn cell_shears_deg(net: &DrapeNet) -> Vec<f64> {
@@ -139,15 +152,14 @@ fn report_draws_every_ply_and_the_page_shows_them() {
         names(&summary.files),
         [
             "p0-shear.png",
-            "p0-shear.svg",
             "p0-histogram.png",
             "p0-histogram.svg",
             "p0mech-shear.png",
-            "p0mech-shear.svg",
             "p0mech-histogram.png",
             "p0mech-histogram.svg",
             "p0mech-change.png",
-            "p0mech-change.svg",
+            "p0mech-change-histogram.png",
+            "p0mech-change-histogram.svg",
             "index.html"
         ]
     );
@@ -166,13 +178,15 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     assert_eq!((p.name.as_str(), p.cells, p.locking_angle_deg), ("p0", shears.len(), 45.0));
     assert!(p.tool_drawn);
     assert!((p.max_abs_shear_deg - max).abs() < 1e-9);
-    let limit = colour_limit(max, 45.0);
-    assert_eq!(p.colour_limit_deg, limit);
+    // One colour scale for the layup: the larger locking angle of the two plies and the shear.
+    let lock = summary.plies.iter().map(|p| p.locking_angle_deg).fold(0.0, f64::max);
+    let limit = colour_limit(max, lock);
+    assert!(summary.plies.iter().all(|p| p.colour_limit_deg == limit), "{:?}", summary.plies);
+    assert_eq!(p.seen_share, 1.0, "the views show every cell of a hemisphere cap: {:?}", p.views);
+    assert!(p.views[0].starts_with("isometric"), "{:?}", p.views);
 
-    // Shear map: the cells' colours, the tool's greys, and both ends of the colour bar.
+    // Shear map: the tool, and both ends of the colour bar.
     let hist = check_picture(&out.join("p0-shear.png"));
-    let expected: HashSet<[u8; 3]> = shears.iter().map(|g| shear_colour(*g, limit)).collect();
-    assert_colours(&hist, &expected, "p0-shear.png cells");
     let greys = tool_pixels(&hist);
     assert!(greys > MIN_TOOL_PIXELS, "the tool is missing: {greys} pixels in its greys");
     // The colour bar reaches both ends of the map (within a few levels: it is drawn in steps).
@@ -196,34 +210,36 @@ fn report_draws_every_ply_and_the_page_shows_them() {
         .collect();
     assert_colours(&hist, &expected, "p0-histogram.png bars");
 
-    // Change map of the mechanical ply: the known change pattern's colours, changes within the
-    // noise floor (the facets of this 2304-triangle hemisphere against 7 mm cells; a smooth
-    // change has no scatter) drawn as none.
-    let hist = check_picture(&out.join("p0mech-change.png"));
+    // Change map of the mechanical ply: the known change runs from -CHANGE_STEP * 29 to
+    // +CHANGE_STEP * 29 across the diagonal, well above the noise floor (the facets of this
+    // 2304-triangle hemisphere against 7 mm cells; a smooth change has no scatter): both its
+    // blue and its red half show.
+    check_picture(&out.join("p0mech-change.png"));
     let noise = summary.plies[1].change_noise.unwrap();
     let facets = noise.facets_deg.unwrap();
     assert!(noise.scatter_deg < 1e-9 && noise.floor_deg == facets, "{noise:?}");
     // Facets about 8 mm across on R = 0.1 m: a sagitta of about 1e-4 m, 0.9 deg over 7 mm cells.
     assert!(facets > 0.6 && facets < 1.2, "{noise:?}");
-    let changes: Vec<f64> = (0..net.num_cells())
-        .filter(|k| net.cell_shear(k / (N - 1), k % (N - 1)).is_some())
-        .map(|k| CHANGE_STEP * ((k / (N - 1)) as f64 - (k % (N - 1)) as f64))
-        .collect();
-    let climit = change_limit(changes.iter().fold(0.0f64, |m, g| m.max(g.abs())));
-    let shown = |g: f64| if g.abs() <= noise.floor_deg { 0.0 } else { g };
-    let expected: HashSet<[u8; 3]> = changes.iter().map(|g| shear_colour(shown(*g), climit)).collect();
-    assert_colours(&hist, &expected, "p0mech-change.png cells");
+    let rows = map_rows(&out.join("p0mech-change.png"));
+    let count = |f: &dyn Fn(i32, i32, i32) -> bool| {
+        rows.iter().flatten().filter(|p| f(p[0] as i32, p[1] as i32, p[2] as i32)).count()
+    };
+    let (red, blue) = (count(&|r, g, _| r > g + 60), count(&|r, _, b| b > r + 30));
+    assert!(red > 5000 && blue > 5000, "change map: {red} red and {blue} blue pixels");
+    // Its figures: the known change is CHANGE_STEP (i - j), largest at a corner of the grid.
+    let c = summary.plies[1].change.unwrap();
+    let (i, j) = c.largest_cell;
+    assert!((c.largest_deg - CHANGE_STEP * (i as f64 - j as f64)).abs() < 1e-9, "{c:?}");
+    assert!(c.largest_deg.abs() > 4.0 && c.mean_abs_deg > 1.0, "{c:?}");
+    check_picture(&out.join("p0mech-change-histogram.png"));
 
-    for f in ["p0-shear.svg", "p0mech-shear.svg", "p0mech-change.svg"] {
-        check_svg(&out.join(f), shears.len() / 2);
-    }
     check_svg(&out.join("p0-histogram.svg"), 10);
 
     // The page: every picture, one table row per ply, in order.
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     for f in summary.files.iter().filter(|f| f.extension().unwrap() != "html") {
         let n = f.file_name().unwrap().to_str().unwrap();
-        let needle = if n.ends_with(".png") { format!("<img src=\"{n}\"") } else { format!("href=\"{n}\"") };
+        let needle = if n.ends_with(".png") { format!("src=\"{n}\"") } else { format!("href=\"{n}\"") };
         assert!(html.contains(&needle), "index.html does not show {n}");
     }
     let rows: Vec<&str> = html.split("<tr class=\"ply\">").skip(1).collect();
@@ -236,7 +252,7 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     // Deterministic: a second report is byte-identical.
     let again = dir.join("again");
     write_report(dir, &again, false).unwrap();
-    for f in ["p0-shear.png", "p0mech-change.svg", "index.html"] {
+    for f in ["p0-shear.png", "p0mech-change.png", "index.html"] {
         assert_eq!(
             std::fs::read(out.join(f)).unwrap(),
             std::fs::read(again.join(f)).unwrap(),
@@ -249,8 +265,7 @@ fn report_draws_every_ply_and_the_page_shows_them() {
 fn layup_file_patterns_large_tool_and_missing_tool() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    // 8100 triangles: above the limit, the tool is rasterised.
-    const { assert!(4 * 45 * 45 > drape::report::TOOL_TRIANGLE_LIMIT) };
+    // 8100 triangles.
     let (net, _) = make_run(dir, 45);
     // A third ply whose tool cannot be found.
     let mut lost = net.clone();
@@ -293,17 +308,15 @@ fn layup_file_patterns_large_tool_and_missing_tool() {
     assert!(s.notes.iter().any(|n| n.contains("ghost")), "{:?}", s.notes);
     assert!(s.notes.iter().any(|n| n.contains("lost") && n.contains("missing.obj")), "{:?}", s.notes);
 
-    // The rasterised tool still shows its greys; the lost ply still has its cells.
+    // The tool shows; the lost ply still has its cells, without a tool.
     let hist = check_picture(&out.join("p0-shear.png"));
-    let greys = tool_pixels(&hist);
-    assert!(greys > MIN_TOOL_PIXELS, "rasterised tool missing: {greys} pixels in its greys");
-    let shears = cell_shears_deg(&net);
-    let max = shears.iter().fold(0.0f64, |m, g| m.max(g.abs()));
-    let expected: HashSet<[u8; 3]> = shears.iter().map(|g| shear_colour(*g, colour_limit(max, 45.0))).collect();
+    let tool_greys = tool_pixels(&hist);
+    assert!(tool_greys > MIN_TOOL_PIXELS, "tool missing: {tool_greys} pixels in its greys");
     let lost_hist = check_picture(&out.join("lost-shear.png"));
-    assert_colours(&lost_hist, &expected, "lost-shear.png cells");
+    let coloured: usize = lost_hist.iter().filter(|(c, _)| c[0] as i32 - c[2] as i32 > 40).map(|(_, n)| n).sum();
+    assert!(coloured > 20_000, "lost-shear.png: only {coloured} pixels of the ply's warm colours");
     let greys = tool_pixels(&lost_hist);
-    assert!(greys < MIN_TOOL_PIXELS / 10, "no tool should be drawn for 'lost', yet {greys} pixels are in its greys");
+    assert!(greys * 10 < tool_greys, "no tool should be drawn for 'lost', yet {greys} pixels are in its greys");
 
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     let rows: Vec<&str> = html.split("<tr class=\"ply\">").skip(1).collect();
@@ -346,7 +359,7 @@ fn cli_report() {
         .assert()
         .success();
     let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
-    assert!(stdout.contains("ply p0:") && stdout.contains("wrote 11 files"), "{stdout}");
+    assert!(stdout.contains("ply p0:") && stdout.contains("wrote 10 files"), "{stdout}");
     assert!(out.join("index.html").is_file() && out.join("p0mech-change.png").is_file());
     // Bad input: exit code 2 and a message naming the folder.
     let empty = tmp.path().join("empty");
@@ -373,5 +386,151 @@ fn a_tool_given_as_a_shell_mesh_is_drawn_at_the_scale_the_run_read_it() {
     let s = write_report(tmp.path(), &tmp.path().join("r"), false).unwrap();
     assert!(s.plies[0].tool_drawn, "{:?}", s.notes);
     let hist = check_picture(&tmp.path().join("r/deck-shear.png"));
-    assert!(tool_pixels(&hist) > MIN_TOOL_PIXELS, "the plate is drawn around the ply");
+    let tool = tool_pixels(&hist);
+    assert!(tool > MIN_TOOL_PIXELS, "the plate is drawn around the ply: {tool} pixels");
+}
+
+/// A flat ply on a plate (no shear: one colour everywhere) next to a sheared ply on a
+/// hemisphere, in one run folder. Returns the flat net.
+fn make_flat_and_curved(dir: &Path) -> DrapeNet {
+    make_run(dir, 16);
+    std::fs::remove_file(dir.join("p0mech.drape.json")).unwrap();
+    let mesh = shapes::plate(0.3, 0.24, 30, 24);
+    let obj = dir.join("plate.obj");
+    std::fs::write(&obj, mesh.to_obj_string()).unwrap();
+    let tool = mesh.into_surface().unwrap();
+    let mut flat =
+        drape(&tool, &KinematicSettings::grid("flat", Point::new(0.0, 0.0, 0.0), Vector::x(), 0.005, 41, 33)).unwrap();
+    flat.meta.tool = Some(obj.display().to_string());
+    write_net(&flat, dir, &[Format::Json]).unwrap();
+    flat
+}
+
+/// Pixels of the flat ply's one colour (the zero of the map), lit: warm, yellow, never grey.
+fn is_ply_cream(p: &[u8; 3]) -> bool {
+    let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+    r > b + 20 && g > b + 15 && (r - g).abs() < 25
+}
+
+/// A ply of one colour is shaded (its pixels take many brightness levels across it, where a
+/// flat fill has one), stands out from the tool, carries fibre lines, and shares the colour
+/// scale of the sheared ply beside it.
+#[test]
+fn report_shades_a_flat_ply_draws_its_fibres_and_shares_one_scale() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let flat = make_flat_and_curved(dir);
+    let out = dir.join("r");
+    let s = write_report(dir, &out, false).unwrap();
+    let [flat_ply, curved] = [&s.plies[0], &s.plies[1]];
+    assert_eq!((flat_ply.name.as_str(), curved.name.as_str()), ("flat", "p0"));
+    assert!(flat_ply.max_abs_shear_deg < 1e-6 && curved.max_abs_shear_deg > 10.0);
+    assert_eq!(flat_ply.colour_limit_deg, curved.colour_limit_deg, "one colour scale for the layup");
+    assert_eq!(flat_ply.views.len(), 1, "one isometric view shows a flat ply: {:?}", flat_ply.views);
+
+    let rows = map_rows(&out.join("flat-shear.png"));
+    let cream: Vec<&[u8; 3]> = rows.iter().flatten().filter(|p| is_ply_cream(p)).collect();
+    assert!(cream.len() > 60_000, "the flat ply covers the view: {} pixels", cream.len());
+    // Shading: brightness spreads across the ply (a flat fill would sit at one level).
+    let mut lum: Vec<i32> = cream.iter().map(|p| p[0] as i32 + p[1] as i32 + p[2] as i32).collect();
+    lum.sort();
+    let (p10, p90) = (lum[lum.len() / 10], lum[lum.len() * 9 / 10]);
+    let levels: HashSet<i32> = lum.iter().copied().collect();
+    eprintln!("flat ply: {} levels, 10-90% brightness {p10}..{p90}", levels.len());
+    assert!(levels.len() > 60 && p90 - p10 > 25, "{} levels, 10-90% {p10}..{p90}: not shaded", levels.len());
+    // Stands out: the ply's colour is far from the tool's grey, and the tool shows around it.
+    let tool: usize = rows.iter().flatten().filter(|p| is_tool(p)).count();
+    assert!(tool > 3000, "the plate around the ply: {tool} pixels");
+    // Fibre lines: along the middle row of the ply, dark lines cross it again and again, at the
+    // drawn step (every k-th fibre of 41 x 33).
+    let dark = |p: &[u8; 3]| p.iter().all(|&c| c < 120);
+    let (mut best, mut best_row) = (0, 0);
+    for (y, row) in rows.iter().enumerate() {
+        let crossings = row.windows(2).filter(|w| is_ply_cream(&w[0]) && dark(&w[1])).count();
+        if crossings > best {
+            (best, best_row) = (crossings, y);
+        }
+    }
+    let k = flat_ply.fibre_step;
+    assert!(k >= 1, "fibre lines drawn");
+    let lines = (flat.nu + flat.nv) / k;
+    eprintln!("flat ply: every {k}th fibre, {best} line crossings on row {best_row}");
+    assert!(best >= lines / 3, "only {best} fibre-line crossings on any row, expected about {lines} lines");
+}
+
+/// On a hat box, the isometric view sees the top and two walls edge-on or not at all; the
+/// report adds views until every cell is seen from in front.
+#[test]
+fn report_views_see_every_wall_of_a_hat_box() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = shapes::hat_box(&shapes::HatBox::standard(), 0.008, 3);
+    let obj = dir.join("hat.obj");
+    std::fs::write(&obj, mesh.to_obj_string()).unwrap();
+    let tool = mesh.into_surface().unwrap();
+    let top = Point::new(0.0, 0.0, shapes::HatBox::standard().height);
+    let mut net = drape(&tool, &KinematicSettings::grid("hat", top, Vector::x(), 0.008, 41, 41)).unwrap();
+    net.meta.tool = Some(obj.display().to_string());
+    write_net(&net, dir, &[Format::Json]).unwrap();
+    let s = write_report(dir, &dir.join("r"), false).unwrap();
+    let p = &s.plies[0];
+    eprintln!("hat box views: {:?}, {:.4} seen", p.views, p.seen_share);
+    assert!(p.views.len() >= 2, "the walls the first view hides need more views: {:?}", p.views);
+    assert!(p.seen_share > 0.995, "{:.4} of the cells seen in {:?}", p.seen_share, p.views);
+    // The net stops at the corners: the report says where and why.
+    let stopped: usize = p.stops.iter().map(|(_, n)| n).sum();
+    assert!(stopped > 0, "{:?}", p.stops);
+    check_picture(&dir.join("r/hat-shear.png"));
+    // The page says what each status means.
+    let html = std::fs::read_to_string(dir.join("r/index.html")).unwrap();
+    let (status, _) = p.stops[0];
+    assert!(html.contains("id=\"statuses\"") && html.contains(drape::report::status_meaning(status)), "status table");
+}
+
+/// The page as a person sees it: headless Chromium (installed by tools/run-tests) opens
+/// index.html with every host name unresolvable; the page must load with no console error and
+/// no request beyond local files, every picture must load, the 3D view must draw the part (a
+/// screenshot with the part over a sizable area, in many colours), turn when dragged, and name
+/// the cell under the pointer; the page must stay a readable length.
+#[test]
+fn report_page_in_chromium() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    make_flat_and_curved(dir);
+    let out = dir.join("r");
+    write_report(dir, &out, false).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/report_browser.py");
+    let shot = dir.join("view.png");
+    let run = std::process::Command::new("python3")
+        .arg(&script)
+        .arg(out.join("index.html"))
+        .arg(&shot)
+        .output()
+        .expect("python3 must run tools/report_browser.py (tools/run-tests installs its requirements)");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "tools/report_browser.py failed ({}): {stdout}\n{}\nChromium and the Python requirements are installed by tools/run-tests.",
+        run.status,
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let seen: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    eprintln!("chromium saw: {seen}");
+    assert_eq!(seen["loaded"], true);
+    assert_eq!(seen["errors"], serde_json::json!([]), "console errors");
+    assert_eq!(seen["external_requests"], serde_json::json!([]), "requests beyond local files");
+    let images = seen["images"].as_array().unwrap();
+    assert!(images.len() >= 4 && images.iter().all(|i| i["loaded"] == true), "{images:?}");
+    assert_eq!(seen["plies"], 2);
+    assert!(seen["faces"].as_u64().unwrap() > 1000, "the 3D view drew {} faces", seen["faces"]);
+    assert!(seen["faces_by_thickness"].as_u64().unwrap() > 0);
+    let pick = seen["pick"].as_str().unwrap_or("");
+    assert!(pick.starts_with("ply ") && pick.contains("shear"), "under the centre: {pick:?}");
+    let shot = &seen["shots"]["initial"];
+    assert!(shot["part_share"].as_f64().unwrap() > 0.1, "the part is missing from the 3D view: {shot}");
+    assert!(shot["distinct_colours"].as_u64().unwrap() > 100, "a flat or blank 3D view: {shot}");
+    assert!(seen["shots"]["changed_share"].as_f64().unwrap() > 0.05, "dragging did not turn the view");
+    // Two plies with their pictures, the table, the 3D view: a page, not a scroll of 15,000 px.
+    let height = seen["height"].as_u64().unwrap();
+    assert!(height < 6000, "the page is {height} px long");
 }

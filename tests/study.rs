@@ -317,3 +317,27 @@ fn slurm_job_array_runs_the_shards_and_merges_them() {
     }
     assert!(out.join("stability.png").exists(), "the merge drew the map");
 }
+
+/// A study run into a run folder shows in that folder's report: its chart copied beside the
+/// page and a section saying what it shows.
+#[test]
+fn the_report_shows_the_studies_of_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let scene = repo("geometries/cylinder/scene.toml");
+    drape().arg("run").arg(&scene).arg("--out").arg(&run).assert().success();
+    drape()
+        .args(["study", "stability"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(run.join("stab"))
+        .args(["--params", "locking", "--axes", "locking,angle"])
+        .assert()
+        .success();
+    drape().arg("report").arg(&run).assert().success();
+    let html = std::fs::read_to_string(run.join("report/index.html")).unwrap();
+    assert!(html.contains("<h2 id=\"studies\">Studies</h2>"), "no study section");
+    assert!(html.contains("src=\"study-stab-stability.png\""));
+    assert!(html.contains("cases,"), "the section says what the map shows");
+    assert!(std::fs::metadata(run.join("report/study-stab-stability.png")).unwrap().len() > 1000);
+}

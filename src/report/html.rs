@@ -75,7 +75,9 @@ table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:
 th{background:#f3f3f3}td.t,th.t{text-align:left}img{max-width:100%;height:auto;border:1px solid #ddd;margin:.5em 0}\
 .notes{background:#fff6e0;border-left:4px solid #e0a000;padding:.5em 1em}.small{color:#666;font-size:.9em}\
 dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dt{color:#666}dd{margin:0}\
-.pattern svg{max-width:100%;height:auto;border:1px solid #ddd}";
+.pattern svg{max-width:100%;max-height:560px;height:auto;border:1px solid #ddd}\
+figure{margin:.5em 0}.pair{display:flex;gap:1em;flex-wrap:wrap}.pair figure{flex:1 1 45%;min-width:300px}\
+#drape-view{width:100%;height:auto;border:1px solid #ddd;cursor:grab}.viewer-controls label{margin-right:1em}";
 
 /// The whole page.
 pub(crate) fn page(p: &Page) -> String {
@@ -103,6 +105,40 @@ pub(crate) fn page(p: &Page) -> String {
             n.waste_fraction.filter(|w| w.is_finite()).map_or("—".into(), |w| format!("{:.1}%", 100.0 * w))
         );
     }
+    if !p.laminate.is_empty() {
+        let _ = writeln!(h, "<h3>Laminate</h3>\n<dl id=\"laminate\">");
+        for (k, v) in &p.laminate {
+            let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
+        }
+        let _ = writeln!(h, "</dl>");
+    }
+    if !p.statuses.is_empty() {
+        let _ = writeln!(
+            h,
+            "<h3>Where the nets stopped</h3>\n<p class=\"small\">Nodes of each ply's grid that were not placed, and why. In the pictures a ringed dot of the status's colour marks the placed nodes next to them.</p>\n<table id=\"statuses\"><tr><th class=\"t\">status</th><th class=\"t\">meaning</th>"
+        );
+        for ply in &p.plies {
+            let _ = write!(h, "<th>{}</th>", escape(&ply.name));
+        }
+        let _ = writeln!(h, "</tr>");
+        for (s, counts) in &p.statuses {
+            let c = super::shade::status_colour(*s);
+            let _ = write!(
+                h,
+                "<tr><td class=\"t\"><span style=\"color:rgb({},{},{})\">●</span> {}</td><td class=\"t\">{}</td>",
+                c[0],
+                c[1],
+                c[2],
+                s.name(),
+                escape(super::status_meaning(*s))
+            );
+            for n in counts {
+                let _ = write!(h, "<td>{n}</td>");
+            }
+            let _ = writeln!(h, "</tr>");
+        }
+        let _ = writeln!(h, "</table>");
+    }
     if !p.notes.is_empty() {
         let _ = writeln!(h, "<div class=\"notes\"><strong>Not everything could be drawn:</strong><ul>");
         for n in &p.notes {
@@ -110,8 +146,22 @@ pub(crate) fn page(p: &Page) -> String {
         }
         let _ = writeln!(h, "</ul></div>");
     }
+    h.push_str(&p.viewer);
     for ply in &p.plies {
         ply_section(&mut h, ply, p.extra.get(&ply.name).map(Vec::as_slice).unwrap_or(&[]));
+    }
+    if !p.studies.is_empty() {
+        let _ = writeln!(h, "<h2 id=\"studies\">Studies</h2>");
+        for f in &p.studies {
+            let _ = writeln!(
+                h,
+                "<h3>{}</h3>\n<p class=\"small\">{}</p>\n<img src=\"{}\" alt=\"{}\">",
+                escape(&f.heading),
+                escape(&f.summary),
+                escape(&f.picture),
+                escape(&f.heading)
+            );
+        }
     }
     if !p.patterns.is_empty() {
         let _ = writeln!(h, "<h2 id=\"patterns\">Flat patterns</h2>");
@@ -186,6 +236,29 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         ("locking angle".to_string(), format!("{}°", num(Some(ply.locking_angle_deg), 1))),
         ("colour scale".to_string(), format!("±{}°", num(Some(ply.colour_limit_deg), 0))),
     ];
+    let mut summary = summary.to_vec();
+    if let Some(c) = &ply.change {
+        let at = c.largest_at;
+        let place = if at.iter().all(|x| x.is_finite()) {
+            format!(
+                " at cell ({}, {}), ({:.1}, {:.1}, {:.1}) mm",
+                c.largest_cell.0,
+                c.largest_cell.1,
+                at[0] * 1e3,
+                at[1] * 1e3,
+                at[2] * 1e3
+            )
+        } else {
+            String::new()
+        };
+        summary.push((
+            "mechanical − kinematic".to_string(),
+            format!(
+                "largest change {:+.2}°{place}; mean |change| {:.2}° over {} cells",
+                c.largest_deg, c.mean_abs_deg, c.cells
+            ),
+        ));
+    }
     for (k, v) in summary.iter().chain(facts) {
         let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
     }
@@ -197,18 +270,31 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         }
         let _ = writeln!(h, "</ul></div>");
     }
-    for f in ply.files.iter().filter(|f| f.extension().is_some_and(|e| e == "png")) {
-        let png = f.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    // The shaded views full width; the histogram and the change map side by side below.
+    let names: Vec<String> =
+        ply.files.iter().filter_map(|f| Some(f.file_name()?.to_string_lossy().into_owned())).collect();
+    let pngs: Vec<&String> = names.iter().filter(|n| n.ends_with(".png")).collect();
+    let (main, small): (Vec<&String>, Vec<&String>) = pngs.into_iter().partition(|n| n.ends_with("-shear.png"));
+    let figure = |h: &mut String, png: &str, class: &str| {
         let svg = png.trim_end_matches(".png").to_string() + ".svg";
+        let svg_link =
+            if names.contains(&svg) { format!(" · <a href=\"{}\">SVG</a>", escape(&svg)) } else { String::new() };
         let _ = writeln!(
             h,
-            "<figure><img src=\"{0}\" alt=\"{0}\" width=\"{2}\" height=\"{3}\"><figcaption class=\"small\"><a href=\"{0}\">PNG</a> · <a href=\"{1}\">SVG</a></figcaption></figure>",
-            escape(&png),
-            escape(&svg),
+            "<figure class=\"{class}\"><img src=\"{0}\" alt=\"{0}\" width=\"{1}\" height=\"{2}\"><figcaption class=\"small\"><a href=\"{0}\">PNG</a>{svg_link}</figcaption></figure>",
+            escape(png),
             super::WIDTH,
             super::HEIGHT
         );
+    };
+    for png in main {
+        figure(h, png, "wide");
     }
+    let _ = writeln!(h, "<div class=\"pair\">");
+    for png in small {
+        figure(h, png, "half");
+    }
+    let _ = writeln!(h, "</div>");
 }
 
 #[cfg(test)]

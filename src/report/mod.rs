@@ -1,26 +1,34 @@
 //! `drape report DIR`: pictures of every ply in a run's output folder and one HTML page that
-//! shows them with the layup table.
+//! shows them with the layup table and an interactive 3D view.
 //!
 //! For each `<ply>.drape.json` in DIR it writes, into DIR/report (or another folder):
-//! - `<ply>-shear.png/.svg`: the ply's cells seen obliquely along its mean normal, painted by
-//!   signed shear on a diverging colour map with symmetric limits, over the tool in light grey,
-//!   with a colour bar on which the locking angle +/- is marked;
+//! - `<ply>-shear.png`: the ply on its tool, lit and shaded, in the views that together show
+//!   every cell (an isometric view first), painted by signed shear on one diverging colour scale
+//!   shared by all plies of the report; warp and weft fibres every k-th fibre, the ply's edge,
+//!   the seed and the warp direction there, an axis triad; cells past locking hatched, folded
+//!   cells in their own colour, the placed nodes where the net stopped ringed in the colour of
+//!   why; a colour bar with the locking angle and a legend;
 //! - `<ply>-histogram.png/.svg`: the distribution of signed shear with the locking angle marked;
-//! - `<ply>-change.png/.svg` for a mechanical ply: the change of shear from the kinematic net;
+//! - for a mechanical ply, `<ply>-change.png` (the change of shear from the kinematic net, on
+//!   the same views) and `<ply>-change-histogram.png/.svg`, with the largest and mean change;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
-//!   nets), every picture, the summary numbers, the flat patterns (`*.svg` in DIR) and notes on
-//!   whatever could not be drawn.
+//!   nets), laminate totals, what each node status means, the interactive 3D view (the
+//!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
+//!   (`*.svg` in DIR) and notes on whatever could not be drawn.
 //!
 //! Text is rendered with the DejaVu Sans font compiled into the program (crate `dejavu`,
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
 pub mod change;
 mod html;
+mod raster;
 mod render;
+pub mod shade;
 pub mod study;
 mod view;
+pub mod viewer;
 
-pub use render::{bin_shares, bin_width, register_fonts, tool_greys, HEIGHT, TOOL_TRIANGLE_LIMIT, WIDTH};
-pub use view::{change_limit, colour_limit, shear_colour, View, VIEW_TILT_DEG};
+pub use render::{bin_shares, bin_width, register_fonts, HEIGHT, WIDTH};
+pub use view::{change_limit, colour_limit, shear_colour, View};
 
 use crate::geometry::Point;
 use crate::io::layup_json::{self, LAYUP_FILE};
@@ -33,7 +41,8 @@ use crate::layup::{locking_angle_deg, LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
 use crate::material::MaterialCard;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
-use render::{Mark, ToolLayer};
+use render::{LegendItem, Mark, ShadedPicture, Swatch};
+use shade::{CellPaint, PlyScene, ToolMesh};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -119,6 +128,20 @@ pub struct PlyReport {
     /// For a mechanical ply: the noise floor of its change from the kinematic net (no change
     /// map is drawn when every change lies within it).
     pub change_noise: Option<change::ChangeNoise>,
+    /// For a mechanical ply: the change of shear from the kinematic net, summed up.
+    pub change: Option<ChangeSummary>,
+    /// Names of the views drawn (the first is isometric).
+    pub views: Vec<String>,
+    /// Share of the drawn cells that some view shows (facing it, not hidden).
+    pub seen_share: f64,
+    /// Fibre lines are drawn every `fibre_step`-th fibre (in the first view).
+    pub fibre_step: usize,
+    /// Cells sheared past the locking angle (hatched).
+    pub over_locking_cells: usize,
+    /// Cells folded over against their neighbours (wrinkle risk).
+    pub folded_cells: usize,
+    /// Where the net stopped: failure status and how many placed nodes border it.
+    pub stops: Vec<(crate::kinematic::NodeStatus, usize)>,
     /// Pictures written for this ply.
     pub files: Vec<PathBuf>,
     /// What could not be drawn for this ply.
@@ -130,7 +153,7 @@ const NET_SUFFIX: &str = ".drape.json";
 /// Flat-pattern SVGs larger than this are linked from the page instead of inlined.
 const PATTERN_INLINE_LIMIT: u64 = 8 << 20;
 /// The kinds of picture, as file-name suffixes after `<ply>-`.
-const PICTURES: [&str; 3] = ["shear", "histogram", "change"];
+const PICTURES: [&str; 4] = ["shear", "histogram", "change", "change-histogram"];
 /// Candidate scales (metres per OBJ unit) tried when the tool's units are not recorded.
 const TOOL_SCALES: [f64; 2] = [1.0, 1e-3];
 
@@ -158,12 +181,19 @@ struct RawTool {
     hi: Point,
     /// Its facets' sagitta (file units), computed when a change map first needs it.
     sagitta: std::sync::OnceLock<Option<f64>>,
+    /// Its smooth corner normals (for the shading), computed once for all plies.
+    normals: std::sync::OnceLock<Vec<[crate::geometry::Vector; 3]>>,
 }
 
 impl RawTool {
     /// The median sagitta of its curved facets, file units ([`change::facet_sagitta`]).
     fn sagitta(&self) -> Option<f64> {
         *self.sagitta.get_or_init(|| change::facet_sagitta(&self.vertices, &self.triangles))
+    }
+
+    /// Its corner normals ([`shade::corner_normals`]; a uniform scale does not change them).
+    fn normals(&self) -> &[[crate::geometry::Vector; 3]] {
+        self.normals.get_or_init(|| shade::corner_normals(&self.vertices, &self.triangles))
     }
 }
 
@@ -186,7 +216,14 @@ fn load_tool(path: &Path) -> Result<RawTool, String> {
         lo = lo.inf(v);
         hi = hi.sup(v);
     }
-    Ok(RawTool { vertices: raw.vertices, triangles: raw.triangles, lo, hi, sagitta: Default::default() })
+    Ok(RawTool {
+        vertices: raw.vertices,
+        triangles: raw.triangles,
+        lo,
+        hi,
+        sagitta: Default::default(),
+        normals: Default::default(),
+    })
 }
 
 /// The scale (metres per file unit) the run read the tool with, for a net that does not record
@@ -227,6 +264,8 @@ struct PlyInput {
     given: Option<LayupRow>,
     tool: Option<PathBuf>,
     tool_note: Option<String>,
+    /// The material card the net records, when it can be read.
+    card: Option<MaterialCard>,
 }
 
 /// Everything the page shows, gathered by [`write_report`].
@@ -238,6 +277,14 @@ pub(crate) struct Page {
     pub patterns: Vec<(String, Result<String, String>)>,
     pub notes: Vec<String>,
     pub extra: BTreeMap<String, Vec<(String, String)>>,
+    /// The interactive 3D view's HTML.
+    pub viewer: String,
+    /// The laminate's totals, as (what, value) lines.
+    pub laminate: Vec<(String, String)>,
+    /// Node statuses other than placed: the status and its count in each ply (table order).
+    pub statuses: Vec<(crate::kinematic::NodeStatus, Vec<usize>)>,
+    /// Studies found in the folder: (heading, picture file in the report folder, summary).
+    pub studies: Vec<study::StudyFigure>,
 }
 
 /// Draw every ply of the run folder `dir` into `out` (created if missing) and write
@@ -306,18 +353,12 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         let net = nets.remove(&stem).expect("ordered from the map's keys");
         let given = layup.as_ref().and_then(|l| l.plies.iter().find(|r| r.name == stem)).cloned();
         let recorded_locking = given.as_ref().and_then(|r| r.locking_angle_deg).filter(|a| a.is_finite() && *a > 0.0);
+        // The card the net records, found as the tool is.
+        let card =
+            net.meta.material.as_deref().and_then(|m| locate_tool(m, dir)).and_then(|p| MaterialCard::load(&p).ok());
         let (locking_deg, locking_source) = match recorded_locking {
             Some(a) => (a, given.as_ref().and_then(|r| r.locking_angle_source).unwrap_or(LockingSource::Ply)),
-            None => {
-                // The card the net records, found as the tool is.
-                let card = net
-                    .meta
-                    .material
-                    .as_deref()
-                    .and_then(|m| locate_tool(m, dir))
-                    .and_then(|p| MaterialCard::load(&p).ok());
-                locking_angle_deg(None, card.as_ref())
-            }
+            None => locking_angle_deg(None, card.as_ref()),
         };
         if locking_source == LockingSource::Default {
             notes.push(format!(
@@ -338,7 +379,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                 ),
             },
         };
-        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note });
+        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note, card });
     }
 
     std::fs::create_dir_all(out).map_err(|source| ReportError::CreateDir { path: out.to_path_buf(), source })?;
@@ -371,9 +412,10 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     }
     bar.set_message("drawing");
 
+    let limit = shared_limit(&inputs);
     let reports: Vec<Result<PlyReport, ReportError>> = inputs
         .par_iter()
-        .map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), out, &bar))
+        .map(|input| draw_ply(input, tools.get(input.tool.as_deref().unwrap_or(Path::new(""))), limit, out, &bar))
         .collect();
     let mut plies = Vec::new();
     for r in reports {
@@ -409,6 +451,7 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         patterns.push((name, body));
     }
 
+    let viewer = viewer_section(&inputs, &tools, limit);
     let mut extra = BTreeMap::new();
     for i in &inputs {
         extra.insert(i.stem.clone(), html::net_facts(&i.net));
@@ -423,7 +466,17 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         [] => title,
         names => format!("NOT CONVERGED ({}): {title}", names.join(", ")),
     };
-    let page = Page { title, layup, rows, plies, patterns, notes, extra };
+    let laminate = laminate_totals(&inputs, &rows, layup.as_ref());
+    let mut statuses: Vec<(crate::kinematic::NodeStatus, Vec<usize>)> = Vec::new();
+    for s in crate::kinematic::NodeStatus::ALL.into_iter().filter(|s| *s != crate::kinematic::NodeStatus::Placed) {
+        let counts: Vec<usize> = inputs.iter().map(|i| i.net.status.iter().filter(|x| **x == s).count()).collect();
+        if counts.iter().any(|c| *c > 0) {
+            statuses.push((s, counts));
+        }
+    }
+    let studies = study::collect_figures(dir, out)?;
+    files.extend(studies.iter().map(|f| out.join(&f.picture)));
+    let page = Page { title, layup, rows, plies, patterns, notes, extra, viewer, laminate, statuses, studies };
     bar.set_message("writing index.html");
     let index = out.join("index.html");
     let text = html::page(&page);
@@ -433,6 +486,83 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
     files.push(index);
     let Page { plies, notes, .. } = page;
     Ok(ReportSummary { out: out.to_path_buf(), files, plies, notes })
+}
+
+/// The laminate's totals: its thickness (nominal, and the range its plies' sheared thickness
+/// spans), areas, mass and the nesting's waste; only what the run recorded.
+fn laminate_totals(inputs: &[PlyInput], rows: &[LayupRow], layup: Option<&LayupTable>) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let (mut nominal, mut thin, mut thick, mut known) = (0.0, 0.0, 0.0, 0);
+    for (i, r) in inputs.iter().zip(rows) {
+        let Some(t0) = r.thickness_m.or(i.net.meta.thickness_m).filter(|t| *t > 0.0) else { continue };
+        let shears: Vec<f64> = (0..i.net.num_cells())
+            .filter_map(|k| i.net.cell_shear(k / (i.net.nv - 1), k % (i.net.nv - 1)))
+            .filter(|g| g.is_finite())
+            .map(f64::abs)
+            .collect();
+        let lo = shears.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = shears.iter().copied().fold(0.0, f64::max);
+        nominal += t0;
+        thin += crate::material::flow::sheared_thickness(t0, if lo.is_finite() { lo } else { 0.0 });
+        thick += crate::material::flow::sheared_thickness(t0, hi);
+        known += 1;
+    }
+    if known > 0 {
+        out.push((
+            "laminate thickness".into(),
+            format!(
+                "{:.2} mm laid flat ({known} of {} plies give a thickness); sheared cells thicken (t0 / cos γ): from {:.2} mm (every ply at its least shear) to {:.2} mm (every ply at its most)",
+                nominal * 1e3,
+                inputs.len(),
+                thin * 1e3,
+                thick * 1e3
+            ),
+        ));
+    }
+    let sum = |f: fn(&LayupRow) -> Option<f64>| {
+        let v: Vec<f64> = rows.iter().filter_map(f).filter(|x| x.is_finite()).collect();
+        (!v.is_empty()).then(|| (v.iter().sum::<f64>(), v.len()))
+    };
+    if let Some((a, n)) = sum(|r| r.draped_area_m2) {
+        out.push(("draped area".into(), format!("{a:.4} m² ({n} plies)")));
+    }
+    if let Some((a, n)) = sum(|r| r.fabric_area_m2) {
+        out.push(("fabric area".into(), format!("{a:.4} m² ({n} plies)")));
+    }
+    if let Some((m, n)) = sum(|r| r.fabric_mass_kg) {
+        out.push(("fabric mass".into(), format!("{:.1} g ({n} plies)", m * 1e3)));
+    }
+    if let Some(n) = layup.and_then(|l| l.nesting.as_ref()) {
+        if let (Some(w), Some(f)) = (n.waste_area_m2, n.waste_fraction) {
+            out.push(("waste in nesting".into(), format!("{w:.4} m² ({:.1}% of the roll used)", 100.0 * f)));
+        }
+    }
+    out
+}
+
+/// The tool's vertices in metres, at the scale the run read it (recorded, else guessed).
+fn scaled_vertices(t: &RawTool, net: &DrapeNet) -> Vec<Point> {
+    let s = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or_else(|| guess_scale(t, net));
+    t.vertices.iter().map(|v| Point::from(v.coords * s)).collect()
+}
+
+/// The interactive 3D view of every ply on the first ply's tool.
+fn viewer_section(inputs: &[PlyInput], tools: &BTreeMap<PathBuf, Result<RawTool, String>>, limit: f64) -> String {
+    let tool_of = |i: &PlyInput| i.tool.as_ref().and_then(|p| tools.get(p)).and_then(|t| t.as_ref().ok());
+    let scaled: Vec<Option<Vec<Point>>> =
+        inputs.iter().map(|i| tool_of(i).map(|t| scaled_vertices(t, &i.net))).collect();
+    let plies: Vec<viewer::ViewerPly> = inputs
+        .iter()
+        .zip(&scaled)
+        .map(|(i, v)| viewer::ViewerPly {
+            net: &i.net,
+            thickness: i.net.meta.thickness_m.or(i.given.as_ref().and_then(|r| r.thickness_m)).filter(|t| *t > 0.0),
+            vf: i.card.as_ref().and_then(|c| c.flow.as_ref()).map(|f| f.fibre_volume_fraction),
+            tool_vertices: v.as_deref(),
+        })
+        .collect();
+    let tool = inputs.iter().zip(&scaled).find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())));
+    viewer::section(&viewer::data_json(tool, &plies, limit))
 }
 
 /// The table row of a net that `layup.json` does not list: its shear statistics and, when its
@@ -484,10 +614,65 @@ pub(crate) fn method_name(m: Method) -> &'static str {
     }
 }
 
-/// Draw one ply's pictures into `out`.
+/// The colour limit (degrees, symmetric) shared by every ply of a report: one scale for the
+/// whole layup, so equal colours mean equal shear on every ply.
+fn shared_limit(inputs: &[PlyInput]) -> f64 {
+    let max =
+        inputs.iter().map(|i| i.net.shear_stats(i.locking_deg.to_radians()).max_abs.to_degrees()).fold(0.0, f64::max);
+    let lock = inputs.iter().map(|i| i.locking_deg).fold(0.0, f64::max);
+    colour_limit(max, lock)
+}
+
+/// What each failure status means, for legends and the page.
+pub fn status_meaning(s: crate::kinematic::NodeStatus) -> &'static str {
+    use crate::kinematic::NodeStatus as S;
+    match s {
+        S::Placed => "placed on the tool",
+        S::Pending => "not computed (never left in a finished net)",
+        S::OffTool => "the fibre ran off the tool's edge",
+        S::NoRoot => "no point of the tool at one fibre length from both neighbours",
+        S::ShearLimit => "the cell would shear past the limit",
+        S::Fold => "the only place would fold the fabric over itself",
+        S::SheetJump => "the only place is on another sheet of the tool",
+        S::ParentMissing => "a node it depends on was not placed",
+        S::OutsideOutline => "outside the ply outline: trimmed",
+        S::Detached => "hung on by a corner only: left out of the mechanical result",
+    }
+}
+
+/// Short legend text of a failure status.
+fn status_short(s: crate::kinematic::NodeStatus) -> &'static str {
+    use crate::kinematic::NodeStatus as S;
+    match s {
+        S::Placed | S::Pending => "",
+        S::OffTool => "off the tool",
+        S::NoRoot => "no root",
+        S::ShearLimit => "shear limit",
+        S::Fold => "would fold",
+        S::SheetJump => "sheet jump",
+        S::ParentMissing => "parent missing",
+        S::OutsideOutline => "outside outline",
+        S::Detached => "detached",
+    }
+}
+
+/// "1st", "2nd", "3rd", "4th"...
+fn ordinal(k: usize) -> String {
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
+}
+
+/// Draw one ply's pictures into `out`, on the colour scale `limit` shared by all plies.
 fn draw_ply(
     input: &PlyInput,
     tool: Option<&Result<RawTool, String>>,
+    limit: f64,
     out: &Path,
     bar: &ProgressBar,
 ) -> Result<PlyReport, ReportError> {
@@ -497,7 +682,7 @@ fn draw_ply(
     let (max_abs_deg, mean_abs_deg) = (st.max_abs.to_degrees(), st.mean_abs.to_degrees());
     let mut notes: Vec<String> = input.tool_note.iter().cloned().collect();
     let mut sagitta = None;
-    let scaled: Option<(Vec<Point>, &[[u32; 3]])> = match tool {
+    let scaled: Option<(Vec<Point>, &RawTool)> = match tool {
         Some(Ok(t)) => {
             // The scale the run read the tool with, when the net records it.
             let recorded = net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0);
@@ -505,7 +690,7 @@ fn draw_ply(
             if net.method == Method::Mechanical {
                 sagitta = t.sagitta().map(|v| v * s);
             }
-            Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), &t.triangles))
+            Some((t.vertices.iter().map(|v| Point::from(v.coords * s)).collect(), t))
         }
         Some(Err(e)) => {
             notes.push(format!("tool not drawn: {e}"));
@@ -513,9 +698,10 @@ fn draw_ply(
         }
         None => None,
     };
-    let layer = scaled.as_ref().map(|(v, t)| ToolLayer { vertices: v, triangles: t });
-    let tool_text = match (&input.tool, &layer) {
-        (Some(p), Some(l)) => format!("grey: tool {} ({} triangles)", p.display(), l.triangles.len()),
+    let tool_mesh =
+        || scaled.as_ref().map(|(v, t)| ToolMesh { vertices: v, triangles: &t.triangles, normals: t.normals() });
+    let tool_text = match (&input.tool, &scaled) {
+        (Some(p), Some((_, t))) => format!("tool {} ({} triangles)", p.display(), t.triangles.len()),
         _ => "tool not drawn (see the report page)".to_string(),
     };
     if st.cells == 0 {
@@ -523,20 +709,83 @@ fn draw_ply(
     }
     let kind = method_name(net.method);
     let lock = input.locking_deg;
-    let limit = colour_limit(max_abs_deg, lock);
     let lock_marks = vec![
         Mark { value: lock, label: format!("+{lock:.0}° locking") },
         Mark { value: -lock, label: format!("−{lock:.0}° locking") },
     ];
-    let mut map = render::layout_map(net, &values, layer.as_ref(), limit);
-    map.title = format!("Ply {}: shear angle ({kind})", input.stem);
-    map.subtitle =
-        format!("{} cells, view along the mean ply normal tilted {VIEW_TILT_DEG:.0}°; {tool_text}", st.cells);
-    map.bar_label = "shear angle (deg)".into();
-    map.marks = lock_marks.clone();
+    let folded = shade::folded_cells(net);
+    let paint: Vec<Option<CellPaint>> = values
+        .iter()
+        .zip(&folded)
+        .map(|(v, f)| {
+            v.map(|g| CellPaint {
+                colour: if *f { shade::FOLD_FILL } else { shear_colour(g, limit) },
+                hatch: g.abs() > lock,
+            })
+        })
+        .collect();
+    let folded_count = folded.iter().filter(|f| **f).count();
+    let scene = PlyScene::new(net, tool_mesh(), paint, true);
+    let (views, seen_share) = if st.cells > 0 { shade::choose_views(&scene) } else { (Vec::new(), 1.0) };
+    if seen_share < 1.0 {
+        notes.push(format!(
+            "the {} views show {:.1}% of the cells; the rest are hidden or seen edge-on from every direction tried (use the interactive view)",
+            views.len(),
+            100.0 * seen_share
+        ));
+    }
+    // The fibre step depends on the picture's scale: draw once to learn it, then the legend.
+    let mut legend = vec![
+        LegendItem { swatch: Swatch::Line(shade::WARP_LINE), text: "warp fibres".into() },
+        LegendItem { swatch: Swatch::Line(shade::WEFT_LINE), text: "weft fibres".into() },
+        LegendItem { swatch: Swatch::Seed, text: "seed, arrow: warp direction".into() },
+        LegendItem { swatch: Swatch::Line(shade::EDGE_LINE), text: "ply edge".into() },
+        LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
+        LegendItem {
+            swatch: Swatch::Hatch(shear_colour(limit, limit)),
+            text: format!("past locking: {} cells", st.over_locking),
+        },
+        LegendItem { swatch: Swatch::Fill(shade::FOLD_FILL), text: format!("folded (wrinkle): {folded_count}") },
+    ];
+    let mut stops: BTreeMap<crate::kinematic::NodeStatus, usize> = BTreeMap::new();
+    for (_, s) in &scene.frontier {
+        *stops.entry(*s).or_default() += 1;
+    }
+    for (s, n) in &stops {
+        legend.push(LegendItem {
+            swatch: Swatch::Dot(shade::status_colour(*s)),
+            text: format!("stopped, {}: {n}", status_short(*s)),
+        });
+    }
+    let mut pic = ShadedPicture {
+        title: format!("Ply {}: shear angle ({kind})", input.stem),
+        subtitle: format!(
+            "{} cells; {} view{} showing {:.1}% of them; colour scale ±{limit:.0}° for the whole layup; {tool_text}",
+            st.cells,
+            views.len(),
+            if views.len() == 1 { "" } else { "s" },
+            100.0 * seen_share
+        ),
+        limit,
+        bar_label: "shear angle (deg)".into(),
+        marks: lock_marks.clone(),
+        legend,
+    };
     let mut files = Vec::new();
     let name = |suffix: &str| out.join(format!("{}-{suffix}", input.stem));
-    write_pair(&name("shear"), |r| render::draw_map(r, &map), |r| render::draw_map(r, &map), &mut files)?;
+    let draw_err = |p: &Path| {
+        let p = p.to_path_buf();
+        move |message: String| ReportError::Draw { path: p.clone(), message }
+    };
+    let shear_png = name("shear.png");
+    let (_, outs) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
+    let fibre_step = outs.first().map_or(0, |o| o.fibre_step);
+    let every =
+        if fibre_step <= 1 { "every fibre".to_string() } else { format!("every {} fibre", ordinal(fibre_step)) };
+    pic.legend[0].text = format!("warp fibres ({every})");
+    let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
+    write_atomic(&shear_png, |w| w.write_all(&bytes))?;
+    files.push(shear_png);
     bar.inc(1);
 
     let hist = render::HistogramPicture {
@@ -562,9 +811,11 @@ fn draw_ply(
     bar.inc(1);
 
     let mut change_noise = None;
+    let mut change_summary = None;
     if net.method == Method::Mechanical {
         match change_values(net) {
             Ok(change) => {
+                change_summary = summarise_change(net, &change);
                 let max = change.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
                 let noise = change::change_noise(&change, net.nu, net.nv, net.spacing, sagitta);
                 let floor = noise.floor_deg;
@@ -575,23 +826,55 @@ fn draw_ply(
                     ));
                 } else {
                     // Changes within the noise are drawn as no change; the scale starts above it.
-                    let shown: Vec<Option<f64>> =
-                        change.iter().map(|v| v.map(|x| if x.abs() <= floor { 0.0 } else { x })).collect();
-                    let limit = change_limit(max);
-                    let mut map = render::layout_map(net, &shown, layer.as_ref(), limit);
-                    map.title = format!("Ply {}: change of shear, mechanical − kinematic", input.stem);
-                    map.subtitle = format!(
-                        "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
-                    );
-                    map.bar_label = "shear change (deg)".into();
-                    map.marks = vec![
-                        Mark { value: floor, label: format!("+{floor:.2}° noise") },
-                        Mark { value: -floor, label: format!("−{floor:.2}° noise") },
-                    ];
+                    let climit = change_limit(max);
+                    let paint: Vec<Option<CellPaint>> = change
+                        .iter()
+                        .map(|v| {
+                            v.map(|x| CellPaint {
+                                colour: shear_colour(if x.abs() <= floor { 0.0 } else { x }, climit),
+                                hatch: false,
+                            })
+                        })
+                        .collect();
+                    let scene = PlyScene::new(net, tool_mesh(), paint, false);
+                    let pic = ShadedPicture {
+                        title: format!("Ply {}: change of shear, mechanical − kinematic", input.stem),
+                        subtitle: format!(
+                            "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
+                        ),
+                        limit: climit,
+                        bar_label: "shear change (deg)".into(),
+                        marks: vec![
+                            Mark { value: floor, label: format!("+{floor:.2}° noise") },
+                            Mark { value: -floor, label: format!("−{floor:.2}° noise") },
+                        ],
+                        legend: vec![
+                            LegendItem { swatch: Swatch::Line(shade::EDGE_LINE), text: "ply edge".into() },
+                            LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
+                        ],
+                    };
+                    let p = name("change.png");
+                    let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&p))?;
+                    write_atomic(&p, |w| w.write_all(&bytes))?;
+                    files.push(p);
+                    // The distribution of the change, beside the map.
+                    let hist = render::HistogramPicture {
+                        title: format!("Ply {}: change of shear, mechanical − kinematic", input.stem),
+                        note: change_summary.as_ref().map_or(String::new(), |c| {
+                            format!(
+                                "{} cells · mean |change| {:.2}° · largest {:+.2}°",
+                                c.cells, c.mean_abs_deg, c.largest_deg
+                            )
+                        }),
+                        values: change.iter().flatten().copied().collect(),
+                        limit: climit,
+                        x_label: "shear change (deg)".into(),
+                        marks: pic.marks.clone(),
+                    };
                     write_pair(
-                        &name("change"),
-                        |r| render::draw_map(r, &map),
-                        |r| render::draw_map(r, &map),
+                        &name("change-histogram"),
+                        |r| render::draw_histogram(r, &hist),
+                        |r| render::draw_histogram(r, &hist),
                         &mut files,
                     )?;
                 }
@@ -609,10 +892,48 @@ fn draw_ply(
         max_abs_shear_deg: max_abs_deg,
         mean_abs_shear_deg: mean_abs_deg,
         colour_limit_deg: limit,
-        tool_drawn: layer.is_some(),
+        tool_drawn: scaled.is_some(),
         change_noise,
+        change: change_summary,
+        views: views.into_iter().map(|(_, n)| n).collect(),
+        seen_share,
+        fibre_step,
+        over_locking_cells: st.over_locking,
+        folded_cells: folded_count,
+        stops: stops.into_iter().collect(),
         files,
         notes,
+    })
+}
+
+/// The change of shear from the kinematic to the mechanical net, in figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChangeSummary {
+    /// Cells with a change.
+    pub cells: usize,
+    /// Mean |change|, degrees.
+    pub mean_abs_deg: f64,
+    /// The change of largest magnitude (signed), degrees.
+    pub largest_deg: f64,
+    /// Where it is: the cell (i, j) and its centre (m).
+    pub largest_cell: (usize, usize),
+    /// The centre of that cell, metres.
+    pub largest_at: [f64; 3],
+}
+
+/// Sum up a per-cell change (degrees by cell index); `None` when no cell has one.
+fn summarise_change(net: &DrapeNet, change: &[Option<f64>]) -> Option<ChangeSummary> {
+    let cv = net.nv.saturating_sub(1).max(1);
+    let values: Vec<(usize, f64)> = change.iter().enumerate().filter_map(|(k, v)| Some((k, (*v)?))).collect();
+    let (k, largest) = values.iter().copied().reduce(|a, b| if b.1.abs() > a.1.abs() { b } else { a })?;
+    let (i, j) = (k / cv, k % cv);
+    let at = net.cell_frame(i, j).map_or([f64::NAN; 3], |f| [f.centre.x, f.centre.y, f.centre.z]);
+    Some(ChangeSummary {
+        cells: values.len(),
+        mean_abs_deg: values.iter().map(|(_, v)| v.abs()).sum::<f64>() / values.len() as f64,
+        largest_deg: largest,
+        largest_cell: (i, j),
+        largest_at: at,
     })
 }
 
@@ -678,6 +999,7 @@ mod tests {
             lo: Point::new(-k, -k, 0.0),
             hi: Point::new(k, k, k),
             sagitta: Default::default(),
+            normals: Default::default(),
         };
         let mut net = DrapeNet::new("n", 0.01, 2, 2, (0, 0));
         for (k, p) in [(0.0, 0.0), (0.05, 0.0), (0.0, 0.05), (0.05, 0.05)].iter().enumerate() {

@@ -210,3 +210,70 @@ pub fn draw_stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, s: &Sta
     }
     Ok(())
 }
+
+/// A study's chart on the report page.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyFigure {
+    /// The section's heading.
+    pub heading: String,
+    /// The chart, copied into the report folder (a file name there).
+    pub picture: String,
+    /// One line saying what the chart shows.
+    pub summary: String,
+}
+
+/// The studies that ran in the run folder `dir` (into it, or into a folder inside it): their
+/// charts, copied into the report folder `out`. A study whose file does not read is skipped.
+pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate::io::ExportError> {
+    let mut places: Vec<PathBuf> = vec![dir.to_path_buf()];
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        let mut subs: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.is_dir()).collect();
+        subs.sort();
+        places.extend(subs);
+    }
+    let mut figures = Vec::new();
+    for place in places {
+        let tag = if place == dir {
+            "study".to_string()
+        } else {
+            format!("study-{}", place.file_name().unwrap_or_default().to_string_lossy())
+        };
+        let read = |name: &str| std::fs::read_to_string(place.join(name)).ok();
+        let mut found = Vec::new();
+        if let Some(s) =
+            read(crate::study::speed_accuracy::FILE).and_then(|t| serde_json::from_str::<SpeedAccuracy>(&t).ok())
+        {
+            let ok = s.points.iter().filter(|p| p.error_max_deg.is_some()).count();
+            let summary = format!(
+                "Ply {}: {} runs ({ok} compared) against {} ({}); circled points are the Pareto front: no other run is both faster and more accurate.",
+                s.ply,
+                s.points.len(),
+                if s.reference.kind == "mechanical" { format!("{} at d = {:.4} m", s.reference.method, s.reference.spacing) } else { "each method's Richardson limit".into() },
+                s.reference.kind
+            );
+            found.push((
+                "speed_accuracy",
+                format!("Speed against accuracy, ply {} ({})", s.ply, place.display()),
+                summary,
+            ));
+        }
+        if let Some(s) = read(crate::study::stability::FILE).and_then(|t| serde_json::from_str::<Stability>(&t).ok()) {
+            let failed = s.cases.iter().filter(|c| c.outcome != "ok").count();
+            let summary = format!(
+                "Ply {}: {} cases, {failed} ended in a named failure; the map shows the outcome over {} and {}.",
+                s.ply,
+                s.cases.len(),
+                s.axes[0],
+                s.axes[1]
+            );
+            found.push(("stability", format!("Where the methods fail, ply {} ({})", s.ply, place.display()), summary));
+        }
+        for (stem, heading, summary) in found {
+            let Ok(bytes) = std::fs::read(place.join(format!("{stem}.png"))) else { continue };
+            let picture = format!("{tag}-{stem}.png");
+            crate::io::write_atomic(&out.join(&picture), |w| std::io::Write::write_all(w, &bytes))?;
+            figures.push(StudyFigure { heading, picture, summary });
+        }
+    }
+    Ok(figures)
+}

@@ -1,15 +1,15 @@
-//! Colour map and the projection of a ply (and its tool) onto the picture plane.
+//! Colour map, orthographic views and the fit of a view into a pixel rectangle.
 use crate::geometry::{Point, Vector};
-use crate::kinematic::DrapeNet;
 
-/// Control points of the diverging colour map, from -1 (blue) through a light grey (0) to +1
-/// (red). The centre is not pure white so that unsheared cells still stand out from the page.
-const DIVERGING: [(f64, [u8; 3]); 5] = [
-    (-1.0, [33, 102, 172]),
-    (-0.5, [103, 169, 207]),
-    (0.0, [236, 236, 236]),
-    (0.5, [239, 138, 98]),
-    (1.0, [178, 24, 43]),
+/// Control points of the diverging colour map (ColorBrewer's RdYlBu), from -1 (blue) through a
+/// pale yellow (0) to +1 (red). The centre is a colour, not a grey, so that an unsheared ply
+/// stands out from the grey tool and the white page.
+pub(crate) const DIVERGING: [(f64, [u8; 3]); 5] = [
+    (-1.0, [49, 54, 149]),
+    (-0.5, [116, 173, 209]),
+    (0.0, [255, 250, 180]),
+    (0.5, [244, 109, 67]),
+    (1.0, [165, 0, 38]),
 ];
 
 /// Colour of `value` on the diverging map with symmetric limits `[-limit, limit]` (values outside
@@ -69,9 +69,6 @@ pub(crate) fn nice_floor(x: f64) -> f64 {
     p
 }
 
-/// Angle by which the view is tilted from the ply's mean normal, so curvature reads as depth.
-pub const VIEW_TILT_DEG: f64 = 30.0;
-
 /// An orthographic view: screen right, screen up, and towards the viewer.
 #[derive(Debug, Clone, Copy)]
 pub struct View {
@@ -84,46 +81,18 @@ pub struct View {
 }
 
 impl View {
-    /// Look at `net` along its area-weighted mean normal, oriented to face world +z when the
-    /// ply is not on a vertical wall (plies are laid from above by convention), then tilted by
-    /// [`VIEW_TILT_DEG`] so the viewer looks from the front (-y side) and above.
-    pub fn for_net(net: &DrapeNet) -> View {
-        let mut n = Vector::zeros();
-        for_each_cell(net, |_, c| n += (c[2] - c[0]).cross(&(c[3] - c[1])));
-        let z = Vector::z();
-        let mut toward = n.try_normalize(1e-300).unwrap_or(z);
-        // A ply on a vertical wall keeps its own orientation; otherwise face upwards.
-        if toward.dot(&z) < -VERTICAL_WALL_COS {
-            toward = -toward;
-        }
-        let reference = if toward.cross(&z).norm() > 0.1 { z } else { Vector::y() };
+    /// An orthographic view looking along `-toward` (towards the viewer is `toward`), with world
+    /// +z up on the screen (world +y when looking straight down or up).
+    pub fn looking(toward: Vector) -> View {
+        let toward = toward.try_normalize(1e-300).unwrap_or(Vector::z());
+        let reference = if toward.cross(&Vector::z()).norm() > 0.1 { Vector::z() } else { Vector::y() };
         let right = reference.cross(&toward).try_normalize(0.0).unwrap_or(Vector::x());
-        let up = toward.cross(&right);
-        let t = VIEW_TILT_DEG.to_radians();
-        // Rotate about `right`: the viewer moves towards -up (the front) and keeps looking at it.
-        let up2 = t.cos() * up + t.sin() * toward;
-        let toward2 = -t.sin() * up + t.cos() * toward;
-        View { right, up: up2, toward: toward2 }
+        View { right, up: toward.cross(&right), toward }
     }
 
     /// Screen coordinates (right, up) and depth (larger = nearer the viewer) of `p`.
     pub fn project(&self, p: &Point) -> (f64, f64, f64) {
         (p.coords.dot(&self.right), p.coords.dot(&self.up), p.coords.dot(&self.toward))
-    }
-}
-
-/// |cos| of the angle to world z below which a ply counts as on a vertical wall.
-const VERTICAL_WALL_COS: f64 = 0.1;
-
-/// Call `f(cell_index, corners)` for every complete cell, with cell index `i * (nv - 1) + j` and
-/// corners in ring order [(i,j), (i+1,j), (i+1,j+1), (i,j+1)].
-pub fn for_each_cell(net: &DrapeNet, mut f: impl FnMut(usize, [Point; 4])) {
-    for i in 0..net.nu.saturating_sub(1) {
-        for j in 0..net.nv.saturating_sub(1) {
-            if let Some([p00, p10, p01, p11]) = net.cell_corners(i, j) {
-                f(i * (net.nv - 1) + j, [p00, p10, p11, p01]);
-            }
-        }
     }
 }
 
@@ -160,11 +129,11 @@ mod tests {
 
     #[test]
     fn colours_are_symmetric_and_clamped() {
-        assert_eq!(shear_colour(0.0, 10.0), [236, 236, 236]);
-        assert_eq!(shear_colour(10.0, 10.0), [178, 24, 43]);
-        assert_eq!(shear_colour(50.0, 10.0), [178, 24, 43]);
-        assert_eq!(shear_colour(-10.0, 10.0), [33, 102, 172]);
-        assert_eq!(shear_colour(f64::NAN, 10.0), [236, 236, 236]);
+        assert_eq!(shear_colour(0.0, 10.0), [255, 250, 180]);
+        assert_eq!(shear_colour(10.0, 10.0), [165, 0, 38]);
+        assert_eq!(shear_colour(50.0, 10.0), [165, 0, 38]);
+        assert_eq!(shear_colour(-10.0, 10.0), [49, 54, 149]);
+        assert_eq!(shear_colour(f64::NAN, 10.0), [255, 250, 180]);
         assert_ne!(shear_colour(2.0, 10.0), shear_colour(-2.0, 10.0));
     }
 
@@ -177,18 +146,5 @@ mod tests {
         assert_eq!(change_limit(0.0), 0.1);
         assert_eq!(nice_floor(0.37), 0.2);
         assert_eq!(nice_ceil(3.0), 5.0);
-    }
-
-    #[test]
-    fn view_of_a_flat_ply_faces_up_whatever_its_winding() {
-        let mut net = DrapeNet::new("f", 1.0, 2, 2, (0, 0));
-        // Weft along -y: warp x weft points down.
-        for (k, p) in [(0.0, 0.0), (0.0, -1.0), (1.0, 0.0), (1.0, -1.0)].iter().enumerate() {
-            net.positions[k] = Point::new(p.0, p.1, 0.0);
-            net.status[k] = crate::kinematic::NodeStatus::Placed;
-        }
-        let v = View::for_net(&net);
-        assert!(v.toward.z > 0.8, "{v:?}");
-        assert!((v.right.cross(&v.up) - v.toward).norm() < 1e-12);
     }
 }
