@@ -52,7 +52,8 @@ pub struct CaseResult {
 }
 
 impl CaseResult {
-    fn refused(reason: String, tool_triangles: usize) -> CaseResult {
+    /// A case that gave no net, and why.
+    pub fn refused(reason: String, tool_triangles: usize) -> CaseResult {
         CaseResult {
             outcome: reason,
             time_s: 0.0,

@@ -122,7 +122,18 @@ pub fn run(
         .map_err(|e| StudyError::Write(format!("cannot start {jobs} worker threads: {e}")))?;
     pool.install(|| {
         pending.par_iter().try_for_each(|case| {
-            let result = run_case(base, &scene.layup, case, &tools[&case.variant.tool]);
+            let tool = &tools[&case.variant.tool];
+            // A case that panics is a named failure of that case, not the end of the study.
+            let result =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_case(base, &scene.layup, case, tool)))
+                    .unwrap_or_else(|panic| {
+                        let what = panic
+                            .downcast_ref::<String>()
+                            .cloned()
+                            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                            .unwrap_or_default();
+                        CaseResult::refused(format!("panic: {what}"), tool.num_triangles())
+                    });
             write_json(&case_path(dir, case.index), &CaseRecord { case: (*case).clone(), result })?;
             on_done(done.fetch_add(1, Ordering::SeqCst) + 1, mine.len());
             Ok::<(), StudyError>(())
