@@ -1,10 +1,13 @@
 //! What a study is: the scene, the ply, and the list of independent [`Case`]s it runs. A plan is
 //! written to `DIR/study.json` before any case runs; shards and resumed runs read it back, so
 //! every process of one study agrees on what case `k` is.
+use super::StudyError;
 use crate::kinematic::SurfaceKind;
+use crate::layup::Ply;
+use crate::pipeline::Scene;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The plan's file in a study folder.
 pub const PLAN_FILE: &str = "study.json";
@@ -90,6 +93,53 @@ pub struct Variant {
     /// Load steps of the mechanical stage, when the case sets them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load_steps: Option<usize>,
+}
+
+impl Variant {
+    /// The ply as the scene gives it, drawn by `method` on the facets of `tool` at `spacing`.
+    pub fn baseline(method: StudyMethod, tool: PathBuf, spacing: f64) -> Variant {
+        Variant {
+            method,
+            surface: SurfaceKind::Facets,
+            tool,
+            spacing,
+            angle_deg: None,
+            seed_shift: [0.0, 0.0],
+            pre_shear_deg: None,
+            max_shear_deg: None,
+            tension_factor: 1.0,
+            load_steps: None,
+        }
+    }
+}
+
+/// `path` made absolute, so every process of a study (shards, Slurm tasks) finds it.
+pub fn absolute(path: &Path) -> Result<PathBuf, StudyError> {
+    std::path::absolute(path).map_err(|e| StudyError::Input(format!("{}: {e}", path.display())))
+}
+
+/// The tools a study runs on: the scene's, then the further resolutions given (`--tools`).
+pub fn study_tools(scene: &Scene, extra: &[PathBuf]) -> Result<Vec<PathBuf>, StudyError> {
+    let mut tools = vec![absolute(&scene.tool)?];
+    for t in extra {
+        if !t.is_file() {
+            return Err(StudyError::Input(format!("--tools: {} is not a file", t.display())));
+        }
+        tools.push(absolute(t)?);
+    }
+    Ok(tools)
+}
+
+/// The ply of `scene` named `name`, or its first.
+pub fn find_ply<'a>(scene: &'a Scene, name: Option<&str>) -> Result<&'a Ply, StudyError> {
+    let plies = &scene.layup.plies;
+    match name {
+        None => plies.first().ok_or_else(|| StudyError::Input("the scene has no ply".into())),
+        Some(n) => plies.iter().find(|p| p.settings.name == n).ok_or_else(|| {
+            let names: Vec<&str> = plies.iter().map(|p| p.settings.name.as_str()).collect();
+            StudyError::Input(format!("the scene has no ply '{n}': its plies are {}", names.join(", ")))
+        }),
+    }
 }
 
 /// One independent case of a study.

@@ -9,7 +9,7 @@
 //! reference's own grid (the second-finest for an extrapolated one): the finer net's value there
 //! is its average of the cells around it, a coarser net's is interpolated from its cell centres,
 //! as a user of that net would.
-use super::plan::{Case, Plan, StudyKind, StudyMethod, Variant};
+use super::plan::{absolute, find_ply, study_tools, Case, Plan, StudyKind, StudyMethod, Variant};
 use super::runner::CaseRecord;
 use super::StudyError;
 use crate::kinematic::fabric_field::ShearField;
@@ -68,18 +68,6 @@ pub fn methods_for(ply: &Ply) -> Vec<StudyMethod> {
     m
 }
 
-/// The ply of `scene` named `name`, or its first.
-pub fn find_ply<'a>(scene: &'a Scene, name: Option<&str>) -> Result<&'a Ply, StudyError> {
-    let plies = &scene.layup.plies;
-    match name {
-        None => plies.first().ok_or_else(|| StudyError::Input("the scene has no ply".into())),
-        Some(n) => plies.iter().find(|p| p.settings.name == n).ok_or_else(|| {
-            let names: Vec<&str> = plies.iter().map(|p| p.settings.name.as_str()).collect();
-            StudyError::Input(format!("the scene has no ply '{n}': its plies are {}", names.join(", ")))
-        }),
-    }
-}
-
 /// The cases of the study of `scene`.
 pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
     let ply = find_ply(scene, opts.ply.as_deref())?;
@@ -96,14 +84,7 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
     };
     let kin = spacings(&opts.spacings, &KINEMATIC_SPACING_FACTORS)?;
     let mech = spacings(&opts.mechanical_spacings, &MECHANICAL_SPACING_FACTORS)?;
-    let scene_tool = std::path::absolute(&scene.tool).map_err(|e| StudyError::Input(e.to_string()))?;
-    let mut tools = vec![scene_tool];
-    for t in &opts.tools {
-        if !t.is_file() {
-            return Err(StudyError::Input(format!("--tools: {} is not a file", t.display())));
-        }
-        tools.push(std::path::absolute(t).map_err(|e| StudyError::Input(e.to_string()))?);
-    }
+    let tools = study_tools(scene, &opts.tools)?;
     let mut cases = Vec::new();
     for method in methods_for(ply) {
         let (ds, ts, repeats) =
@@ -112,25 +93,19 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
         let surfaces: &[SurfaceKind] = if method.is_mechanical() { &[SurfaceKind::Facets] } else { &SurfaceKind::ALL };
         for (tool, &surface) in ts.iter().flat_map(|t| surfaces.iter().map(move |s| (t, s))) {
             for &spacing in ds {
-                let variant = Variant {
-                    method,
-                    surface,
-                    tool: tool.clone(),
-                    spacing,
-                    angle_deg: None,
-                    seed_shift: [0.0, 0.0],
-                    pre_shear_deg: None,
-                    max_shear_deg: None,
-                    tension_factor: 1.0,
-                    load_steps: None,
-                };
+                let variant = Variant { surface, ..Variant::baseline(method, tool.clone(), spacing) };
                 let params = BTreeMap::from([("spacing".to_string(), spacing)]);
                 cases.push(Case { index: cases.len(), variant, params, repeats, keep_field: true });
             }
         }
     }
-    let scene_path = std::path::absolute(&scene.path).map_err(|e| StudyError::Input(e.to_string()))?;
-    Ok(Plan { kind: StudyKind::SpeedAccuracy, scene: scene_path, ply: ply.settings.name.clone(), axes: None, cases })
+    Ok(Plan {
+        kind: StudyKind::SpeedAccuracy,
+        scene: absolute(&scene.path)?,
+        ply: ply.settings.name.clone(),
+        axes: None,
+        cases,
+    })
 }
 
 /// The reference the errors are measured against.

@@ -1,12 +1,10 @@
 //! `drape study stability`: the ply draped under the conditions that break drape methods, each
 //! case ending in a result or a named failure. Each parameter is swept alone about the scene's
 //! ply, and the two `--axes` parameters over their whole product, for the outcome map.
-use super::plan::{Case, Plan, StudyKind, StudyMethod, Variant};
+use super::plan::{absolute, find_ply, study_tools, Case, Plan, StudyKind, StudyMethod, Variant};
 use super::runner::CaseRecord;
-use super::speed_accuracy::find_ply;
 use super::StudyError;
 use crate::geometry::ToolSurface;
-use crate::kinematic::SurfaceKind;
 use crate::mechanics::ContactMode;
 use crate::pipeline::Scene;
 use serde::{Deserialize, Serialize};
@@ -170,13 +168,7 @@ pub fn smallest_radius(tool: &ToolSurface) -> f64 {
 pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyError> {
     let ply = find_ply(scene, opts.ply.as_deref())?;
     let d0 = ply.settings.spacing;
-    let mut tools = vec![std::path::absolute(&scene.tool).map_err(|e| StudyError::Input(e.to_string()))?];
-    for t in &opts.tools {
-        if !t.is_file() {
-            return Err(StudyError::Input(format!("--tools: {} is not a file", t.display())));
-        }
-        tools.push(std::path::absolute(t).map_err(|e| StudyError::Input(e.to_string()))?);
-    }
+    let tools = study_tools(scene, &opts.tools)?;
     let free = ply.refinement.as_ref().is_some_and(|r| r.mode == ContactMode::Free);
     let mechanical = ply.material.is_some() || ply.refinement.is_some();
     let applies = |p: Parameter| match p {
@@ -219,18 +211,6 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
             StudyMethod::KinematicGeodesic
         }
     };
-    let base = |method| Variant {
-        method,
-        surface: SurfaceKind::Facets,
-        tool: tools[0].clone(),
-        spacing: d0,
-        angle_deg: None,
-        seed_shift: [0.0, 0.0],
-        pre_shear_deg: None,
-        max_shear_deg: None,
-        tension_factor: 1.0,
-        load_steps: None,
-    };
     let mut settings: Vec<Vec<(Parameter, f64)>> = Vec::new();
     for a in axes[0].values(tools.len()) {
         for b in axes[1].values(tools.len()) {
@@ -245,7 +225,7 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
     let mut cases = Vec::new();
     for s in settings {
         let ps: Vec<Parameter> = s.iter().map(|(p, _)| *p).collect();
-        let mut v = base(method_for(&ps));
+        let mut v = Variant::baseline(method_for(&ps), tools[0].clone(), d0);
         let mut named = BTreeMap::new();
         for (p, x) in &s {
             p.apply(*x, &mut v, d0, &tools);
@@ -255,10 +235,9 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
         named.insert("d_over_r".into(), if radius.is_finite() { v.spacing / radius } else { 0.0 });
         cases.push(Case { index: cases.len(), variant: v, params: named, repeats: 1, keep_field: false });
     }
-    let scene_path = std::path::absolute(&scene.path).map_err(|e| StudyError::Input(e.to_string()))?;
     Ok(Plan {
         kind: StudyKind::Stability,
-        scene: scene_path,
+        scene: absolute(&scene.path)?,
         ply: ply.settings.name.clone(),
         axes: Some(axes.map(|a| a.name().to_string())),
         cases,
