@@ -4,6 +4,7 @@
 mod common;
 mod energy_common;
 
+mod auto_method;
 mod calculix;
 mod chebyshev_reference;
 mod cli;

@@ -6,7 +6,10 @@ use crate::io::points::read_points;
 use crate::io::{write_net, Format};
 use crate::kinematic::fishnet::check_settings;
 use crate::kinematic::{drape, Extent, KinematicSettings, SurfaceKind};
-use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
+use crate::layup::auto::{choose, DEFAULT_TOLERANCE_DEG};
+use crate::layup::stack::refine_ply;
+use crate::layup::{locking_angle_deg, AutoModel, Refinement};
+use crate::material::MaterialCard;
 use crate::pipeline::{parse_generators, unit_scale};
 use clap::Args;
 use std::path::PathBuf;
@@ -49,9 +52,20 @@ pub struct KinematicArgs {
     /// surface over them, the one the pressed contact slides on).
     #[arg(long, default_value = "facets")]
     pub surface: String,
-    /// Locking angle (degrees) for the summary's count of cells over it.
-    #[arg(long, default_value_t = DEFAULT_LOCKING_ANGLE_DEG)]
-    pub locking_angle: f64,
+    /// Locking angle (degrees) for the summary's count of cells over it [default: the
+    /// material card's two-slope locking angle, else 45].
+    #[arg(long)]
+    pub locking_angle: Option<f64>,
+    /// kinematic, or auto: mechanics (pressed, with --material) runs only where the kinematic
+    /// net is not within --tolerance of it; the choice and its reason are in the net's meta.
+    #[arg(long, default_value = "kinematic")]
+    pub method: String,
+    /// Material card (TOML): needed by --method auto; gives the locking angle.
+    #[arg(long)]
+    pub material: Option<PathBuf>,
+    /// --method auto: the largest cell-shear error accepted, degrees.
+    #[arg(long)]
+    pub tolerance: Option<f64>,
     /// Units of the OBJ and of the lengths given here: m or mm (output is always in metres).
     #[arg(long, default_value = "m")]
     pub units: String,
@@ -69,12 +83,33 @@ pub struct KinematicArgs {
 pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
     let scale = unit_scale(&a.units).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?;
-    if !(a.locking_angle > 0.0 && a.locking_angle < 90.0) {
+    let card = match &a.material {
+        Some(path) => Some(MaterialCard::load(path).map_err(|e| input(anyhow::anyhow!("--material: {e}")))?),
+        None => None,
+    };
+    let (locking_angle, _) = locking_angle_deg(a.locking_angle, card.as_ref());
+    if !(locking_angle > 0.0 && locking_angle < 90.0) {
         return Err(input(anyhow::anyhow!(
-            "--locking-angle must lie strictly between 0 and 90 degrees, got {}",
-            a.locking_angle
+            "--locking-angle must lie strictly between 0 and 90 degrees, got {locking_angle}"
         )));
     }
+    let auto = match (a.method.as_str(), a.tolerance) {
+        ("kinematic", None) => None,
+        ("kinematic", Some(_)) => return Err(input(anyhow::anyhow!("--tolerance is for --method auto"))),
+        ("auto", t) => {
+            let t = t.unwrap_or(DEFAULT_TOLERANCE_DEG);
+            if !(t.is_finite() && t > 0.0) {
+                return Err(input(anyhow::anyhow!("--tolerance must be a positive angle in degrees, got {t}")));
+            }
+            let (Some(card), Some(path)) = (card.clone(), a.material.clone()) else {
+                return Err(input(anyhow::anyhow!(
+                    "--method auto weighs the kinematic net under a material card: give --material CARD.toml"
+                )));
+            };
+            Some((AutoModel { tolerance_deg: t }, Refinement::pressed(card, path)))
+        }
+        (other, _) => return Err(input(anyhow::anyhow!("--method: unknown method '{other}': use kinematic or auto"))),
+    };
     let base = std::env::current_dir().unwrap_or_default();
     let generators =
         parse_generators(&a.generators, &base, scale).map_err(|m| input(anyhow::anyhow!("--generators: {m}")))?;
@@ -103,18 +138,36 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     let tool = crate::io::read_tool(&a.tool, scale).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
-    let mut net = drape(&tool, &settings).map_err(input)?;
+    let mut net = match &auto {
+        None => drape(&tool, &settings).map_err(input)?,
+        Some((model, refinement)) => {
+            let chosen = choose(&tool, &settings, refinement, locking_angle.to_radians(), *model).map_err(input)?;
+            let mut net = chosen.net;
+            if chosen.choice.chosen == "mechanical" {
+                net = refine_ply(&net, &tool, refinement).map_err(|e| input(anyhow::anyhow!("refinement: {e}")))?.0;
+            }
+            println!("auto: ran {}: {}", chosen.choice.chosen, chosen.choice.reason);
+            net.meta.method_choice = Some(chosen.choice);
+            net
+        }
+    };
     net.timing.load_ms = load_ms;
     net.meta.tool = Some(a.tool.display().to_string());
     net.meta.tool_scale = Some(scale);
     let t_write = Instant::now();
     let written = write_net(&net, &a.out, &formats).map_err(super::write_failure)?;
     let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
-    println!("{}", summary(&net, a.locking_angle.to_radians(), load_ms, write_ms));
+    println!("{}", summary(&net, locking_angle.to_radians(), load_ms, write_ms));
     for p in written {
         println!("  wrote {}", p.display());
     }
-    Ok(())
+    match &net.meta.solver {
+        Some(s) if !s.converged => Err(Failure::Compute(anyhow::anyhow!(
+            "the mechanical solver stopped without equilibrium: {}; the last accepted state was written",
+            s.reason.as_deref().unwrap_or(&s.outcome)
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// One line on what the mesh checks found.

@@ -133,7 +133,7 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
 /// The layup table: one row per ply in stacking order.
 fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     let mut out = format!(
-        "layup: {} plies on {}\n{:<12} {:>7} {:<11} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "layup: {} plies on {}\n{:<12} {:>7} {:<16} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
         scene.layup.plies.len(),
         scene.tool.display(),
         "ply",
@@ -150,20 +150,24 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         "offset"
     );
     out += &format!(
-        "{:<12} {:>7} {:<11} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "{:<12} {:>7} {:<16} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
         "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm"
     );
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         let s = &r.stats;
         out += &format!(
-            "{:<12} {:>7} {:<11} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
+            "{:<12} {:>7} {:<16} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
-            match &r.refined {
-                Some(refined) if !refined.ok() => "UNCONVERGED",
-                Some(_) => "mechanical",
-                None => "kinematic",
-            },
+            format!(
+                "{}{}",
+                if r.choice.is_some() { "auto: " } else { "" },
+                match &r.refined {
+                    Some(refined) if !refined.ok() => "UNCONVERGED",
+                    Some(_) => "mechanical",
+                    None => "kinematic",
+                }
+            ),
             ply.material.as_ref().map_or("-", |m| m.name.as_str()),
             format!(
                 "{:.1}{}",
@@ -186,6 +190,11 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 ply.settings.name,
                 refined.describe_failure()
             );
+        }
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if let Some(c) = &r.choice {
+            out += &format!("auto: ply '{}' ran {}: {}\n", ply.settings.name, c.chosen, c.reason);
         }
     }
     let defaults: Vec<&str> = scene

@@ -240,6 +240,26 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                     if p.pareto { "  (Pareto)" } else { "" }
                 );
             }
+            for a in &s.auto {
+                println!(
+                    "auto at d = {:.5} m ran {}: error {} against the {} deg tolerance ({}), {:.3} s{}",
+                    a.spacing,
+                    a.chosen,
+                    a.error_max_deg.map_or("not compared".to_string(), |e| format!("{e:.4} deg")),
+                    a.tolerance_deg,
+                    match a.within_tolerance {
+                        Some(true) => "within",
+                        Some(false) => "OUTSIDE",
+                        None => "no reference",
+                    },
+                    a.time_s,
+                    a.cost_ratio.map_or(String::new(), |r| format!(
+                        ", {:.0}% of the {:.3} s mechanics takes",
+                        100.0 * r,
+                        a.mechanical_time_s.unwrap_or_default()
+                    ))
+                );
+            }
         }
         Finished::Stability(s) => {
             let mut counts = std::collections::BTreeMap::new();

@@ -13,7 +13,7 @@ pub mod surface;
 
 pub use fishnet::{drape, drape_on, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};
-pub use provenance::{CellChanges, Provenance, SolverRecord, UnbalancedRecord};
+pub use provenance::{CellChanges, ChoiceIndicators, MethodChoice, Provenance, SolverRecord, UnbalancedRecord};
 pub use surface::DrapeSurface;
 
 use crate::geometry::{Point, Vector};
@@ -129,5 +129,25 @@ impl KinematicSettings {
             max_shear: DEFAULT_MAX_SHEAR_DEG.to_radians(),
             surface: SurfaceKind::Facets,
         }
+    }
+
+    /// The same ply at fibre spacing `spacing`: a grid keeps its extent in fabric length on each
+    /// side of its origin node (rounded to whole cells), an outline stays as it is. Only the
+    /// spacing and the grid change.
+    pub fn at_spacing(&self, spacing: f64) -> KinematicSettings {
+        let mut s = self.clone();
+        if let Extent::Grid { nu, nv, origin_node } = self.extent {
+            let o = origin_node.unwrap_or((nu / 2, nv / 2));
+            let r = self.spacing / spacing;
+            let scaled = |n: usize| (n as f64 * r).round() as usize;
+            let (i0, j0) = (scaled(o.0), scaled(o.1));
+            s.extent = Extent::Grid {
+                nu: i0 + scaled(nu - 1 - o.0) + 1,
+                nv: j0 + scaled(nv - 1 - o.1) + 1,
+                origin_node: Some((i0, j0)),
+            };
+        }
+        s.spacing = spacing;
+        s
     }
 }

@@ -54,9 +54,57 @@ pub struct Provenance {
     /// For a refined net: what the solver did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub solver: Option<SolverRecord>,
+    /// For a ply draped with `method = "auto"`: what was chosen and why.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method_choice: Option<MethodChoice>,
     /// Keys other tools wrote, kept on a round trip.
     #[serde(flatten)]
     pub other: Map<String, Value>,
+}
+
+/// What `method = "auto"` chose for a ply, and why (`"method_choice"` in the net's meta and in
+/// `layup.json`; the method that ran is `"method"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodChoice {
+    /// What the ply asked for: `auto`.
+    pub requested: String,
+    /// What ran: `kinematic` or `mechanical`.
+    pub chosen: String,
+    /// The largest cell-shear error the ply accepts, degrees.
+    pub tolerance_deg: f64,
+    /// The fibre spacing that ran, m (finer than the ply's when the discretisation needed it).
+    pub spacing_m: f64,
+    /// Why, in words.
+    pub reason: String,
+    /// What the choice was made from.
+    pub indicators: ChoiceIndicators,
+}
+
+/// The cheap measurements on the kinematic net that `method = "auto"` decides from.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ChoiceIndicators {
+    /// The ply's own spacing, m.
+    pub spacing_m: f64,
+    /// Estimated largest cell-shear error of the kinematic net from its spacing, degrees: the
+    /// difference from a net at twice the spacing, at the same fabric points, over 2^p - 1 with
+    /// the fishnet's order p = 2 (absent when the coarser net has no cell to compare).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub discretisation_deg: Option<f64>,
+    /// The spacing that error estimate asks for to stay within its share of the tolerance, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing_needed_m: Option<f64>,
+    /// Largest cell-shear change of one step of the mechanical model from the kinematic net,
+    /// degrees: the kinematic net's out-of-balance forces under the ply's card, turned into
+    /// shear by the model's stiffness (absent when the step could not be taken).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub equilibrium_step_deg: Option<f64>,
+    /// |F - P| / |P| of the mechanical model after that step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual_after_step: Option<f64>,
+    /// Share of the draped area sheared at or past the locking angle.
+    pub locking_share: f64,
+    /// Time spent measuring these, ms.
+    pub time_ms: f64,
 }
 
 /// The change of every cell (index `i * (nv - 1) + j`) of a refined net from its kinematic net,

@@ -4,8 +4,9 @@
 use crate::geometry::Vector;
 use crate::kinematic::KinematicSettings;
 use crate::material::MaterialCard;
+use crate::mechanics::refine::RefineSettings;
 use crate::mechanics::sheet::SheetFeatures;
-use crate::mechanics::ContactMode;
+use crate::mechanics::{ContactMode, SolverSettings};
 use std::path::PathBuf;
 
 /// Locking angle used for reporting when neither the ply nor its material card gives one
@@ -78,8 +79,12 @@ pub struct Ply {
     pub material: Option<PlyMaterial>,
     /// Thickness as laid flat, metres: the ply's `thickness`, else its card's; `None` if neither.
     pub thickness: Option<f64>,
-    /// Mechanical refinement after the kinematic drape, if the ply asks for it.
+    /// Mechanical refinement after the kinematic drape, if the ply asks for it (with
+    /// [`Ply::auto`], if the choice falls on mechanics).
     pub refinement: Option<Refinement>,
+    /// `method = "auto"`: mechanics runs only where the kinematic net is not within the
+    /// tolerance.
+    pub auto: Option<AutoModel>,
     /// Locking angle for reporting, radians.
     pub locking_angle: f64,
     /// Where the locking angle comes from.
@@ -125,6 +130,43 @@ pub struct Refinement {
     pub sheet: SheetFeatures,
     /// Free drape: nodes the tool holds up stay where they touch.
     pub stick: bool,
+}
+
+impl Refinement {
+    /// The default pressed refinement with a material card: from the kinematic net, one load
+    /// step, [`DEFAULT_SOLVER_ITERATIONS`], no sheet features.
+    pub fn pressed(material: MaterialCard, material_path: PathBuf) -> Refinement {
+        Refinement {
+            material,
+            material_path,
+            mode: ContactMode::Pressed,
+            start: Start::Kinematic,
+            load_steps: 1,
+            max_iterations: DEFAULT_SOLVER_ITERATIONS,
+            sheet: SheetFeatures::default(),
+            stick: false,
+        }
+    }
+
+    /// The mechanical stage's settings for this refinement.
+    pub fn settings(&self) -> RefineSettings {
+        RefineSettings {
+            mode: self.mode,
+            load_steps: self.load_steps,
+            solver: SolverSettings::default().max_iterations(self.max_iterations),
+            sheet: self.sheet.clone(),
+            stick: self.stick,
+            ..RefineSettings::default()
+        }
+    }
+}
+
+/// `method = "auto"`: the ply runs the least model that keeps its cell shear within the
+/// tolerance (see [`super::auto`]); its `refinement` is what runs if mechanics is needed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutoModel {
+    /// The largest cell-shear error accepted, degrees.
+    pub tolerance_deg: f64,
 }
 
 /// Where a mechanical ply starts.

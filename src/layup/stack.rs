@@ -1,19 +1,19 @@
 //! Draping a layup: each ply in stacking order on the tool offset by the plies below it, its warp
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
+use super::auto::choose;
 use super::flat::ply_pattern;
-use super::{Layup, Orientation, Ply, StackSide, Start};
+use super::{Layup, Orientation, Ply, Refinement, StackSide, Start};
 use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
 use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
-use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings};
+use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice};
 use crate::material::flow::sheared_thickness;
-use crate::mechanics::refine::{annotate, refine, RefineError, RefineSettings, Refined};
+use crate::mechanics::refine::{annotate, refine, RefineError, Refined};
 use crate::mechanics::sheet::{default_origin_node, flat_sheet, SheetError};
-use crate::mechanics::SolverSettings;
 use std::time::Instant;
 
 /// A reference direction closer than this (sine of the angle) to the tool normal at a seed has
@@ -72,6 +72,8 @@ pub struct PlyResult {
     pub net: DrapeNet,
     /// The solver's record, for a mechanical ply.
     pub refined: Option<Refined>,
+    /// For a ply with `method = "auto"`: what ran and why.
+    pub choice: Option<MethodChoice>,
     /// The warp direction at the seed, resolved on the ply's surface.
     pub warp: Vector,
     /// How the tool was offset for this ply (nothing moved for the first).
@@ -271,37 +273,36 @@ pub fn drape_layup(
         }
         .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
-        let mut net = match start {
-            Start::Kinematic => {
-                drape(surface, &settings).map_err(|source| LayupError::Drape { ply: name.clone(), line, source })?
+        let drape_error = |source| LayupError::Drape { ply: name.clone(), line, source };
+        let (mut net, choice) = match (start, &ply.auto, &ply.refinement) {
+            (Start::Kinematic, Some(auto), Some(r)) => {
+                let a = choose(surface, &settings, r, ply.locking_angle, *auto).map_err(drape_error)?;
+                let mechanical = a.mechanical();
+                (a.net, Some((a.choice, mechanical)))
             }
-            Start::Flat { normal } => flat_start(ply, &settings, &normal, surface)
-                .map_err(|source| LayupError::Refine { ply: name.clone(), line, source: source.into() })?,
+            (Start::Kinematic, _, _) => (drape(surface, &settings).map_err(drape_error)?, None),
+            (Start::Flat { normal }, _, _) => (
+                flat_start(ply, &settings, &normal, surface).map_err(|source| LayupError::Refine {
+                    ply: name.clone(),
+                    line,
+                    source: source.into(),
+                })?,
+                None,
+            ),
         };
+        let run_mechanics = choice.as_ref().map_or(ply.refinement.is_some(), |(_, m)| *m);
         let mut refined = None;
-        if let Some(r) = &ply.refinement {
-            let t = Instant::now();
-            let settings = RefineSettings {
-                mode: r.mode,
-                load_steps: r.load_steps,
-                solver: SolverSettings::default().max_iterations(r.max_iterations),
-                sheet: r.sheet.clone(),
-                stick: r.stick,
-                ..RefineSettings::default()
-            };
-            let result = refine(&net, surface, &r.material, &settings).map_err(|source| LayupError::Refine {
+        if let Some(r) = ply.refinement.as_ref().filter(|_| run_mechanics) {
+            let (out, result) = refine_ply(&net, surface, r).map_err(|source| LayupError::Refine {
                 ply: name.clone(),
                 line,
                 source,
             })?;
-            let mut out = result.net.clone();
-            annotate(&mut out, &net, &result, &r.material_path);
-            out.timing.load_ms = net.timing.load_ms;
-            out.timing.generators_ms = 0.0;
-            out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
             net = out;
             refined = Some(result);
         }
+        let choice = choice.map(|(c, _)| c);
+        net.meta.method_choice = choice.clone();
         // What later stages (exports, reports) need to know about the ply.
         net.meta.stack_offset_max_m = Some(offset.max_distance);
         net.meta.angle_deg = ply.angle_deg();
@@ -317,13 +318,26 @@ pub fn drape_layup(
         let areal_mass = ply.material.as_ref().map(|m| m.card.areal_mass);
         // The outline as the drape checked it (it cannot fail here: the drape used it).
         let outline = match &settings.extent {
-            Extent::Outline(points) => Outline::new(surface, points, settings.spacing).ok(),
+            Extent::Outline(points) => Outline::new(surface, points, net.spacing).ok(),
             Extent::Grid { .. } => None,
         };
         let stats = ply_stats(&net, surface, outline.as_ref(), ply.locking_angle, areal_mass);
-        results.push(PlyResult { net, refined, warp, offset, stats });
+        results.push(PlyResult { net, refined, choice, warp, offset, stats });
     }
     Ok(results)
+}
+
+/// Refine a ply's kinematic `net` on `surface` as `r` says: the refined net, annotated with the
+/// solver's record and the change from the kinematic net, and the solver's result.
+pub fn refine_ply(net: &DrapeNet, surface: &ToolSurface, r: &Refinement) -> Result<(DrapeNet, Refined), RefineError> {
+    let t = Instant::now();
+    let result = refine(net, surface, &r.material, &r.settings())?;
+    let mut out = result.net.clone();
+    annotate(&mut out, net, &result, &r.material_path);
+    out.timing.load_ms = net.timing.load_ms;
+    out.timing.generators_ms = 0.0;
+    out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
+    Ok((out, result))
 }
 
 /// Add a draped ply's thickness t0 / cos(gamma) (sheared cells keep their fibre lengths, so their

@@ -5,6 +5,7 @@ use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
 use crate::kinematic::coverage::SurfaceCoverage;
+use crate::kinematic::MethodChoice;
 use serde::{Deserialize, Serialize};
 
 /// `layup.json`: the layup table of a run. Every field but a row's name may be missing in a file
@@ -46,9 +47,13 @@ pub struct LayupRow {
     /// Unit warp direction at the seed.
     #[serde(default)]
     pub warp: Option<[f64; 3]>,
-    /// `kinematic` or `mechanical`.
+    /// What ran: `kinematic` or `mechanical`.
     #[serde(default)]
     pub method: Option<String>,
+    /// For a ply with `method = "auto"`: what was asked for, why `method` was chosen, and the
+    /// measurements it was chosen from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method_choice: Option<MethodChoice>,
     /// For a mechanical ply: whether the solver reached equilibrium (|F - P| / |P| within its
     /// tolerance in every load step). A ply with `false` here is the last accepted state, not
     /// a drape.
@@ -174,7 +179,8 @@ impl LayupRow {
             material_card: ply.material.as_ref().map(|m| m.path.display().to_string()),
             angle_deg: ply.angle_deg(),
             warp: Some([w.x, w.y, w.z]),
-            method: Some(if ply.refinement.is_some() { "mechanical" } else { "kinematic" }.into()),
+            method: Some(if result.refined.is_some() { "mechanical" } else { "kinematic" }.into()),
+            method_choice: result.choice.clone(),
             converged: result.refined.as_ref().map(|r| r.ok()),
             solver_failure: result.refined.as_ref().filter(|r| !r.ok()).map(|r| r.describe_failure()),
             thickness_m: ply.thickness,

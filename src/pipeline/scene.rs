@@ -40,7 +40,9 @@
 //! max_shear_deg = 75.0        # optional: nodes shearing past this are not placed
 //! surface = "smooth"          # optional: this ply's surface (default: the scene's)
 //! method = "kinematic"       # or "mechanical": kinematic, then refinement with the
-//!                             # ply's material card
+//!                             # ply's material card; or "auto": mechanics only where the
+//!                             # kinematic net is not within the tolerance (layup::auto)
+//! # tolerance_deg = 1.0       # method = "auto": the cell-shear error accepted (default 1)
 //! # mode = "pressed"          # or "free" (gravity drape with one-sided contact)
 //! # start = "kinematic"       # mechanical plies: start from the kinematic drape (default) or
 //!                             # "flat": a flat sheet laid over the tool, its origin node over
@@ -74,9 +76,10 @@ use crate::io::points::read_points;
 use crate::io::vtk::VtuEncoding;
 use crate::kinematic::fishnet::check_memory;
 use crate::kinematic::{Extent, KinematicSettings, SurfaceKind, DEFAULT_MAX_SHEAR_DEG};
+use crate::layup::auto::DEFAULT_TOLERANCE_DEG;
 use crate::layup::{
-    locking_angle_deg, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start, DEFAULT_SOLVER_ITERATIONS,
-    MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
+    locking_angle_deg, AutoModel, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start,
+    DEFAULT_SOLVER_ITERATIONS, MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
 };
 use crate::material::flow::Cavity;
 use crate::material::MaterialCard;
@@ -177,6 +180,7 @@ struct PlyFile {
     surface: Option<toml::Spanned<String>>,
     #[serde(default = "default_method")]
     method: String,
+    tolerance_deg: Option<f64>,
     material: Option<String>,
     thickness: Option<f64>,
     mode: Option<String>,
@@ -602,9 +606,37 @@ impl Scene {
                     None
                 }
                 "mechanical" => Some(refinement(p, material.as_ref(), &extent, scale).map_err(|(f, m)| at(f, m))?),
-                other => {
-                    return Err(at("method", format!("unknown method '{other}': use \"kinematic\" or \"mechanical\"")))
+                "auto" => {
+                    if material.is_none() {
+                        return Err(at(
+                            "material",
+                            "method = \"auto\" weighs the kinematic net under the ply's material card: give material = \"card.toml\" or a name from [materials]".into(),
+                        ));
+                    }
+                    let r = refinement(p, material.as_ref(), &extent, scale).map_err(|(f, m)| at(f, m))?;
+                    if r.mode != ContactMode::Pressed {
+                        return Err(at(
+                            "mode",
+                            "method = \"auto\" chooses between the kinematic net and the pressed drape; a free (hanging) drape has no kinematic counterpart: use method = \"mechanical\"".into(),
+                        ));
+                    }
+                    Some(r)
                 }
+                other => {
+                    return Err(at(
+                        "method",
+                        format!("unknown method '{other}': use \"kinematic\", \"mechanical\" or \"auto\""),
+                    ))
+                }
+            };
+            let auto = match (p.method.as_str(), p.tolerance_deg) {
+                ("auto", None) => Some(AutoModel { tolerance_deg: DEFAULT_TOLERANCE_DEG }),
+                ("auto", Some(t)) if t.is_finite() && t > 0.0 => Some(AutoModel { tolerance_deg: t }),
+                ("auto", Some(t)) => {
+                    return Err(at("tolerance_deg", format!("must be a positive angle in degrees, got {t}")))
+                }
+                (_, None) => None,
+                (_, Some(_)) => return Err(at("tolerance_deg", "only a ply with method = \"auto\" uses it".into())),
             };
             // A seamed sheet is held on its stitch line unless told otherwise.
             let extent = match (extent, refinement.as_ref().and_then(|r| r.sheet.seam)) {
@@ -651,6 +683,7 @@ impl Scene {
                 material,
                 thickness,
                 refinement,
+                auto,
                 locking_angle: locking.to_radians(),
                 locking_source,
                 line,

@@ -201,8 +201,14 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             escape(&r.name),
             escape(material.as_deref().unwrap_or("—")),
             num(r.angle_deg, 1),
-            match r.converged {
-                Some(false) => format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or(""))),
+            match (r.converged, &r.method_choice) {
+                (Some(false), _) => format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or(""))),
+                (_, Some(c)) => format!(
+                    "{} <span class=\"small\" title=\"{}\">(auto, ±{}°)</span>",
+                    escape(r.method.as_deref().unwrap_or(&c.chosen)),
+                    escape(&c.reason),
+                    c.tolerance_deg
+                ),
                 _ => escape(r.method.as_deref().unwrap_or("—")),
             },
             match r.locking_angle_source {
@@ -222,6 +228,19 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
         );
     }
     let _ = writeln!(h, "</table>");
+    // Why each ply with method = "auto" ran what it ran, in words under the table.
+    for r in rows {
+        if let Some(c) = &r.method_choice {
+            let _ = writeln!(
+                h,
+                "<p class=\"choice\">Ply {}: <code>method = \"auto\"</code> (±{}°) ran <strong>{}</strong>: {}.</p>",
+                escape(&r.name),
+                c.tolerance_deg,
+                escape(&c.chosen),
+                escape(&c.reason)
+            );
+        }
+    }
 }
 
 fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {

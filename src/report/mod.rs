@@ -593,6 +593,7 @@ fn row_of_net(input: &PlyInput, tool: Option<&RawTool>) -> LayupRow {
         offset_m: net.meta.stack_offset_max_m,
         converged: net.meta.solver.as_ref().map(|s| s.converged),
         solver_failure: net.meta.solver.as_ref().and_then(|s| s.reason.clone()),
+        method_choice: net.meta.method_choice.clone(),
         ..LayupRow::default()
     }
 }

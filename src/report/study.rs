@@ -251,6 +251,27 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                 if s.reference.kind == "mechanical" { format!("{} at d = {:.4} m", s.reference.method, s.reference.spacing) } else { "each method's Richardson limit".into() },
                 s.reference.kind
             );
+            // What method = "auto" kept and saved, in words under the chart.
+            let auto: String = s
+                .auto
+                .iter()
+                .map(|a| {
+                    format!(
+                        " auto at d = {:.4} m ran {}: largest error {} (tolerance {} deg), {:.2} s{}.",
+                        a.spacing,
+                        a.chosen,
+                        a.error_max_deg.map_or("not compared".to_string(), |e| format!("{e:.3} deg")),
+                        a.tolerance_deg,
+                        a.time_s,
+                        a.cost_ratio.map_or(String::new(), |r| format!(
+                            " against {:.2} s for mechanics ({:.0}% of its cost)",
+                            a.mechanical_time_s.unwrap_or_default(),
+                            100.0 * r
+                        ))
+                    )
+                })
+                .collect();
+            let summary = summary + &auto;
             found.push((
                 "speed_accuracy",
                 format!("Speed against accuracy, ply {} ({})", s.ply, place.display()),

@@ -3,9 +3,11 @@
 use super::plan::{Case, StudyMethod, Variant};
 use crate::geometry::{Point, ToolSurface};
 use crate::kinematic::fabric_field::ShearField;
+use crate::kinematic::MethodChoice;
 use crate::kinematic::{DrapeNet, Extent, GeneratorKind, NodeStatus};
+use crate::layup::auto::DEFAULT_TOLERANCE_DEG;
 use crate::layup::stack::{drape_layup, resolve_warp};
-use crate::layup::{Layup, Orientation, Ply, Refinement, Start};
+use crate::layup::{AutoModel, Layup, Orientation, Ply, Refinement};
 use crate::material::TensionLaw;
 use crate::mechanics::ContactMode;
 use serde::{Deserialize, Serialize};
@@ -46,6 +48,9 @@ pub struct CaseResult {
     /// Solver iterations.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub iterations: Option<usize>,
+    /// For an `auto` case: what it chose and why.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub choice: Option<MethodChoice>,
     /// The cell shear over fabric coordinates, when the case keeps it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub field: Option<ShearField>,
@@ -66,6 +71,7 @@ impl CaseResult {
             where_: BTreeMap::new(),
             converged: None,
             iterations: None,
+            choice: None,
             field: None,
         }
     }
@@ -85,20 +91,17 @@ const BEYOND_EDGE: f64 = 1e-6;
 /// case's tool.
 pub fn case_ply(base: &Ply, layup: &Layup, v: &Variant, tool: &ToolSurface) -> Result<Ply, String> {
     let mut ply = base.clone();
+    ply.settings = base.settings.at_spacing(v.spacing);
     let s = &mut ply.settings;
-    let d0 = s.spacing;
-    if let Extent::Grid { nu, nv, origin_node } = s.extent {
-        let o = origin_node.unwrap_or((nu / 2, nv / 2));
-        let r = d0 / v.spacing;
-        let (i0, j0) = ((o.0 as f64 * r).round() as usize, (o.1 as f64 * r).round() as usize);
-        let nu2 = i0 + ((nu - 1 - o.0) as f64 * r).round() as usize + 1;
-        let nv2 = j0 + ((nv - 1 - o.1) as f64 * r).round() as usize + 1;
-        let cap = if v.method.is_mechanical() { MAX_MECHANICAL_NODES } else { MAX_KINEMATIC_NODES };
-        if nu2.saturating_mul(nv2) > cap {
-            return Err(format!("skipped: {nu2} x {nv2} nodes is more than the {cap} a study case may have"));
+    if let Extent::Grid { nu, nv, .. } = s.extent {
+        let cap = if v.method.may_run_mechanics() { MAX_MECHANICAL_NODES } else { MAX_KINEMATIC_NODES };
+        if nu.saturating_mul(nv) > cap {
+            return Err(format!("skipped: {nu} x {nv} nodes is more than the {cap} a study case may have"));
         }
-        s.extent = Extent::Grid { nu: nu2, nv: nv2, origin_node: Some((i0, j0)) };
+    }
+    if let Extent::Grid { nu, nv, .. } = base.settings.extent {
         if v.seed_shift != [0.0, 0.0] {
+            let d0 = base.settings.spacing;
             let half = [0.5 * (nu - 1) as f64 * d0, 0.5 * (nv - 1) as f64 * d0];
             let foot = tool.closest_point(&s.origin);
             let warp = resolve_warp(base, &foot.point, &layup.reference, tool, layup.stack_side)?;
@@ -110,7 +113,6 @@ pub fn case_ply(base: &Ply, layup: &Layup, v: &Variant, tool: &ToolSurface) -> R
     } else if v.seed_shift != [0.0, 0.0] {
         return Err("refused: a seed shift needs a ply given by its grid".into());
     }
-    s.spacing = v.spacing;
     s.surface = v.surface;
     if let Some(a) = v.angle_deg {
         ply.orientation = Orientation::Angle(a.to_radians());
@@ -124,14 +126,21 @@ pub fn case_ply(base: &Ply, layup: &Layup, v: &Variant, tool: &ToolSurface) -> R
     match v.method {
         StudyMethod::KinematicGeodesic => s.generators = GeneratorKind::Geodesic,
         StudyMethod::KinematicMinShear => s.generators = GeneratorKind::MinShear,
-        StudyMethod::KinematicSteered | StudyMethod::MechanicalPressed | StudyMethod::MechanicalFree => {}
+        StudyMethod::KinematicSteered
+        | StudyMethod::MechanicalPressed
+        | StudyMethod::MechanicalFree
+        | StudyMethod::Auto => {}
     }
     ply.refinement = match v.method {
-        StudyMethod::MechanicalPressed => Some(pressed_refinement(base)?),
+        StudyMethod::MechanicalPressed | StudyMethod::Auto => Some(pressed_refinement(base)?),
         StudyMethod::MechanicalFree => match &base.refinement {
             Some(r) if r.mode == ContactMode::Free => Some(r.clone()),
             _ => return Err("refused: the ply is not a free drape".into()),
         },
+        _ => None,
+    };
+    ply.auto = match v.method {
+        StudyMethod::Auto => Some(base.auto.unwrap_or(AutoModel { tolerance_deg: DEFAULT_TOLERANCE_DEG })),
         _ => None,
     };
     if let Some(r) = &mut ply.refinement {
@@ -151,16 +160,7 @@ fn pressed_refinement(ply: &Ply) -> Result<Refinement, String> {
         }
     }
     let m = ply.material.as_ref().ok_or("refused: the ply has no material card for the mechanical stage")?;
-    Ok(Refinement {
-        material: m.card.clone(),
-        material_path: m.path.clone(),
-        mode: ContactMode::Pressed,
-        start: Start::Kinematic,
-        load_steps: 1,
-        max_iterations: crate::layup::ply::DEFAULT_SOLVER_ITERATIONS,
-        sheet: Default::default(),
-        stick: false,
-    })
+    Ok(Refinement::pressed(m.card.clone(), m.path.clone()))
 }
 
 fn scale_tension(law: &mut TensionLaw, f: f64) {
@@ -208,6 +208,7 @@ pub fn run_case(base: &Ply, layup: &Layup, case: &Case, tool: &ToolSurface) -> C
     out.tool_triangles = triangles;
     out.time_s = median(&mut times.clone());
     out.times_s = times;
+    out.choice = result.choice.clone();
     if let Some(rec) = &net.meta.solver {
         out.converged = Some(rec.converged);
         out.iterations = Some(rec.iterations);
@@ -327,6 +328,7 @@ pub fn summarise(net: &DrapeNet, tool: &ToolSurface, keep_field: bool) -> CaseRe
         where_,
         converged: None,
         iterations: None,
+        choice: None,
         field: keep_field.then_some(field),
     }
 }

@@ -46,6 +46,9 @@ pub enum StudyMethod {
     MechanicalPressed,
     /// The ply's free (gravity) drape.
     MechanicalFree,
+    /// `method = "auto"`: the kinematic net, or the pressed drape where it is not within the
+    /// ply's tolerance (default [`crate::layup::auto::DEFAULT_TOLERANCE_DEG`]).
+    Auto,
 }
 
 impl StudyMethod {
@@ -57,7 +60,13 @@ impl StudyMethod {
             StudyMethod::KinematicSteered => "kinematic-steered",
             StudyMethod::MechanicalPressed => "mechanical-pressed",
             StudyMethod::MechanicalFree => "mechanical-free",
+            StudyMethod::Auto => "auto",
         }
+    }
+    /// Whether the method may run the mechanical stage, so it runs at the mechanical spacings
+    /// and node limit.
+    pub fn may_run_mechanics(self) -> bool {
+        self.is_mechanical() || self == StudyMethod::Auto
     }
     /// Whether the method runs the mechanical stage.
     pub fn is_mechanical(self) -> bool {

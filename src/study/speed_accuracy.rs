@@ -64,6 +64,7 @@ pub fn methods_for(ply: &Ply) -> Vec<StudyMethod> {
     }
     if ply.material.is_some() || ply.refinement.is_some() {
         m.push(StudyMethod::MechanicalPressed);
+        m.push(StudyMethod::Auto);
     }
     m
 }
@@ -88,9 +89,10 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
     let mut cases = Vec::new();
     for method in methods_for(ply) {
         let (ds, ts, repeats) =
-            if method.is_mechanical() { (&mech, &tools[..1], 1) } else { (&kin, &tools[..], opts.repeats.max(1)) };
+            if method.may_run_mechanics() { (&mech, &tools[..1], 1) } else { (&kin, &tools[..], opts.repeats.max(1)) };
         // The kinematic methods step on the facets and on the smooth surface over them.
-        let surfaces: &[SurfaceKind] = if method.is_mechanical() { &[SurfaceKind::Facets] } else { &SurfaceKind::ALL };
+        let surfaces: &[SurfaceKind] =
+            if method.may_run_mechanics() { &[SurfaceKind::Facets] } else { &SurfaceKind::ALL };
         for (tool, &surface) in ts.iter().flat_map(|t| surfaces.iter().map(move |s| (t, s))) {
             for &spacing in ds {
                 let variant = Variant { surface, ..Variant::baseline(method, tool.clone(), spacing) };
@@ -161,6 +163,33 @@ pub struct SpeedPoint {
     pub outcome: String,
     /// On the Pareto front: no other successful run is both faster and more accurate.
     pub pareto: bool,
+    /// For an `auto` run: the method it ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chosen: Option<String>,
+}
+
+/// What `method = "auto"` saved at one spacing: its result against the reference and its cost
+/// against always running mechanics there.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AutoCost {
+    /// Fibre spacing d asked for, m.
+    pub spacing: f64,
+    /// The tolerance, degrees.
+    pub tolerance_deg: f64,
+    /// What it ran.
+    pub chosen: String,
+    /// Why.
+    pub reason: String,
+    /// Its largest error against the reference, degrees (absent without a reference point).
+    pub error_max_deg: Option<f64>,
+    /// Whether that error is within the tolerance.
+    pub within_tolerance: Option<bool>,
+    /// Its time, s (the indicators included).
+    pub time_s: f64,
+    /// The pressed mechanical drape's time at the same spacing, s.
+    pub mechanical_time_s: Option<f64>,
+    /// `time_s` over `mechanical_time_s`.
+    pub cost_ratio: Option<f64>,
 }
 
 /// `speed_accuracy.json`.
@@ -175,6 +204,9 @@ pub struct SpeedAccuracy {
     pub limits: Vec<OwnLimit>,
     /// Every run.
     pub points: Vec<SpeedPoint>,
+    /// The `auto` runs: error kept and cost saved against mechanics.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub auto: Vec<AutoCost>,
 }
 
 /// Cell centres of `f` and the values of the other fields there, where all have one.
@@ -276,6 +308,7 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
             compared: 0,
             outcome: r.result.outcome.clone(),
             pareto: false,
+            chosen: r.result.choice.as_ref().map(|c| c.chosen.clone()),
         })
         .collect();
     let reference = if let Some(m) = mech {
@@ -327,7 +360,37 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
         }
     };
     mark_pareto(&mut points);
-    SpeedAccuracy { ply: plan.ply.clone(), reference, limits, points }
+    let auto = auto_costs(records, &points);
+    SpeedAccuracy { ply: plan.ply.clone(), reference, limits, points, auto }
+}
+
+/// Each `auto` run against the pressed mechanical run at the same spacing and tool.
+fn auto_costs(records: &[CaseRecord], points: &[SpeedPoint]) -> Vec<AutoCost> {
+    let mechanical = |r: &CaseRecord| {
+        records.iter().zip(points).find(|(m, _)| {
+            let (a, b) = (&m.case.variant, &r.case.variant);
+            a.method == StudyMethod::MechanicalPressed && a.spacing == b.spacing && a.tool == b.tool
+        })
+    };
+    records
+        .iter()
+        .zip(points)
+        .filter_map(|(r, p)| {
+            let c = r.result.choice.as_ref()?;
+            let mech_time = mechanical(r).map(|(m, _)| m.result.time_s).filter(|t| *t > 0.0);
+            Some(AutoCost {
+                spacing: p.spacing,
+                tolerance_deg: c.tolerance_deg,
+                chosen: c.chosen.clone(),
+                reason: c.reason.clone(),
+                error_max_deg: p.error_max_deg,
+                within_tolerance: p.error_max_deg.map(|e| e <= c.tolerance_deg),
+                time_s: p.time_s,
+                mechanical_time_s: mech_time,
+                cost_ratio: mech_time.map(|m| p.time_s / m),
+            })
+        })
+        .collect()
 }
 
 /// Mark the runs no other successful run beats on both time and error.

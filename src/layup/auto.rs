@@ -1,0 +1,186 @@
+//! `method = "auto"`: the least model that keeps a ply's cell shear within its tolerance.
+//!
+//! The kinematic net is drawn first, as always. Three cheap measurements on it decide whether it
+//! is the answer or mechanics must run, and at what spacing:
+//! - **the model**: one step of the mechanical model (the ply's card, pressed) from the
+//!   kinematic net. The net's out-of-balance forces divided by the model's stiffness are how far
+//!   equilibrium lies, and that step's largest cell-shear change says it in degrees. Above the
+//!   model's share of the tolerance ([`SPACING_SHARE`]), mechanics runs;
+//! - **locking**: the share of the draped area sheared past the locking angle is recorded, and
+//!   the reason warns when it passes [`LOCKED_NOTE_SHARE`]: the fabric wrinkles there. It does not
+//!   by itself call for mechanics: a pressed ply's shear is set by the tool's shape, and on the
+//!   bundled hemisphere (17% past the glass card's 30 deg) the pressed drape moved the first
+//!   ply's shear by 0.07 deg. Where locking does change the answer, the stiff shear shows in the
+//!   step above.
+//! - **the spacing**: the net at twice the spacing, compared at the same fabric points, gives
+//!   the error of the ply's spacing by Richardson's estimate (difference over 2^p - 1, the
+//!   fishnet being second order). Above the spacing's share of the tolerance a kinematic ply is
+//!   draped again at a spacing d / k (k whole, so the grid keeps its nodes, at most
+//!   [`MAX_REFINEMENT`]). A mechanical ply runs at its own spacing (mechanics at d / k costs
+//!   k^2 times the nodes and more iterations: the four-ply double dome at d/3 took 43 minutes on
+//!   the loaded 2-core machine), and the spacing the kinematic net would need is reported.
+//!
+//! The choice, its reason and the measurements are recorded ([`MethodChoice`]) in the net's meta
+//! and in `layup.json`, and shown in the layup table and the report.
+use super::{AutoModel, Refinement};
+use crate::geometry::ToolSurface;
+use crate::kinematic::fabric_field::ShearField;
+use crate::kinematic::fishnet::DrapeError;
+use crate::kinematic::{drape, ChoiceIndicators, DrapeNet, KinematicSettings, MethodChoice};
+use crate::mechanics::refine::{cell_changes, refine};
+use crate::mechanics::SolverSettings;
+use std::time::Instant;
+
+/// Tolerance of `method = "auto"` when the ply gives none, degrees of cell shear.
+pub const DEFAULT_TOLERANCE_DEG: f64 = 1.0;
+/// Share of the tolerance the spacing may take; the rest is the model's (the kinematic net's
+/// distance from mechanical equilibrium).
+pub const SPACING_SHARE: f64 = 0.5;
+/// Share of the draped area past the locking angle above which the reason warns of it.
+pub const LOCKED_NOTE_SHARE: f64 = 0.01;
+/// Order of convergence of the fishnet in the spacing (observed 1.8 on the smooth sphere, the
+/// formal order 2; see `study::speed_accuracy`).
+pub const FISHNET_ORDER: f64 = 2.0;
+/// Most the spacing is divided by to meet the tolerance (the nodes grow by its square).
+pub const MAX_REFINEMENT: usize = 4;
+
+/// A ply draped by `method = "auto"` up to the choice: the kinematic net at the spacing chosen,
+/// which the caller refines when `choice.chosen` is `mechanical`.
+#[derive(Debug, Clone)]
+pub struct AutoDrape {
+    /// The kinematic net.
+    pub net: DrapeNet,
+    /// What was chosen and why.
+    pub choice: MethodChoice,
+}
+
+impl AutoDrape {
+    /// Whether mechanics must run.
+    pub fn mechanical(&self) -> bool {
+        self.choice.chosen == "mechanical"
+    }
+}
+
+/// Drape `settings` on `surface` and choose its model (see the module doc). `refinement` is the
+/// mechanical stage that runs if chosen (pressed), `locking_angle` the ply's, radians.
+pub fn choose(
+    surface: &ToolSurface,
+    settings: &KinematicSettings,
+    refinement: &Refinement,
+    locking_angle: f64,
+    auto: AutoModel,
+) -> Result<AutoDrape, DrapeError> {
+    let t = Instant::now();
+    let tolerance = auto.tolerance_deg;
+    let net = drape(surface, settings)?;
+    let d = settings.spacing;
+    let discretisation = discretisation_error(surface, settings, &net);
+    let stats = net.shear_stats(locking_angle);
+    let locking_share = if stats.area > 0.0 { stats.area_over_locking / stats.area } else { 0.0 };
+    let step = equilibrium_step(surface, &net, refinement);
+    let spacing_budget = SPACING_SHARE * tolerance;
+    let model_budget = tolerance - spacing_budget;
+    let spacing_needed =
+        discretisation.filter(|e| *e > spacing_budget).map(|e| d * (spacing_budget / e).powf(1.0 / FISHNET_ORDER));
+    let mut indicators = ChoiceIndicators {
+        spacing_m: d,
+        discretisation_deg: discretisation,
+        spacing_needed_m: spacing_needed,
+        equilibrium_step_deg: step.as_ref().ok().map(|s| s.0),
+        residual_after_step: step.as_ref().ok().map(|s| s.1),
+        locking_share,
+        time_ms: 0.0,
+    };
+    let locking_deg = locking_angle.to_degrees();
+    let (mechanical, mut reason) = match &step {
+        Ok((deg, _)) if *deg > model_budget => (
+            true,
+            format!(
+                "one step towards mechanical equilibrium changes the shear by up to {deg:.2} deg, more than the model's {model_budget:.2} deg of the {tolerance} deg tolerance"
+            ),
+        ),
+        Ok((deg, _)) => (
+            false,
+            format!(
+                "one step towards mechanical equilibrium changes the shear by at most {deg:.3} deg (the model's share of the {tolerance} deg tolerance is {model_budget:.2} deg): the kinematic net is kept"
+            ),
+        ),
+        Err(why) => (false, format!("the mechanical model could not take a step from the kinematic net ({why}): the kinematic net is kept")),
+    };
+    if locking_share > LOCKED_NOTE_SHARE {
+        reason.push_str(&format!(
+            "; {:.1}% of the draped area is sheared past the {locking_deg:.0} deg locking angle: the fabric would wrinkle there, which neither model of a ply on the tool shows",
+            100.0 * locking_share
+        ));
+    }
+    let mut net = net;
+    let mut spacing = d;
+    if let (Some(needed), true) = (spacing_needed, mechanical) {
+        // Mechanics at a finer spacing costs the square of the refinement in nodes and more
+        // iterations: it runs at the ply's spacing, and the estimate is reported.
+        reason.push_str(&format!(
+            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics runs at the ply's spacing",
+            discretisation.unwrap_or_default()
+        ));
+    } else if let Some(needed) = spacing_needed {
+        let k = ((d / needed).ceil() as usize).clamp(2, MAX_REFINEMENT);
+        let finer = settings.at_spacing(d / k as f64);
+        match drape(surface, &finer) {
+            Ok(n) => {
+                net = n;
+                spacing = finer.spacing;
+                reason.push_str(&format!(
+                    "; the spacing's error is estimated at {:.3} deg, more than its {spacing_budget:.2} deg, so the ply was draped at d/{k} = {:.4} m{}",
+                    discretisation.unwrap_or_default(),
+                    spacing,
+                    if d / k as f64 > needed { " (the finest allowed; still above the tolerance)" } else { "" }
+                ));
+            }
+            Err(e) => reason.push_str(&format!(
+                "; the spacing's error is estimated at {:.3} deg and needs d <= {needed:.4} m, but the finer net could not be draped ({e}): the ply's spacing is kept",
+                discretisation.unwrap_or_default()
+            )),
+        }
+    } else if let Some(e) = discretisation {
+        reason.push_str(&format!("; the spacing's error is estimated at {e:.3} deg (within {spacing_budget:.2} deg)"));
+    } else {
+        reason.push_str(
+            "; the spacing's error could not be estimated (the net at twice the spacing has no cell to compare)",
+        );
+    }
+    indicators.time_ms = t.elapsed().as_secs_f64() * 1e3;
+    let choice = MethodChoice {
+        requested: "auto".into(),
+        chosen: if mechanical { "mechanical" } else { "kinematic" }.into(),
+        tolerance_deg: tolerance,
+        spacing_m: spacing,
+        reason,
+        indicators,
+    };
+    Ok(AutoDrape { net, choice })
+}
+
+/// Richardson's estimate of the largest cell-shear error of `net` (drawn with `settings`) from
+/// its spacing, degrees: against the net at twice the spacing at `net`'s complete cell centres.
+fn discretisation_error(surface: &ToolSurface, settings: &KinematicSettings, net: &DrapeNet) -> Option<f64> {
+    let coarse = drape(surface, &settings.at_spacing(2.0 * settings.spacing)).ok()?;
+    let (fine, coarse) = (ShearField::of(net), ShearField::of(&coarse));
+    let largest = fine
+        .complete_cell_centres()
+        .into_iter()
+        .filter_map(|(u, v)| Some((fine.at(u, v)? - coarse.at(u, v)?).abs()))
+        .reduce(f64::max)?;
+    Some(largest / (2f64.powf(FISHNET_ORDER) - 1.0))
+}
+
+/// One step of the mechanical model from `net`: the largest cell-shear change, degrees, and
+/// |F - P| / |P| after it; or why no step could be taken.
+fn equilibrium_step(surface: &ToolSurface, net: &DrapeNet, r: &Refinement) -> Result<(f64, f64), String> {
+    let mut settings = r.settings();
+    settings.load_steps = 1;
+    settings.solver = SolverSettings { max_iterations: 1, ..settings.solver };
+    let refined = refine(net, surface, &r.material, &settings).map_err(|e| e.to_string())?;
+    let change =
+        cell_changes(net, &refined.net).into_iter().flatten().map(|(g, _)| g.abs().to_degrees()).fold(0.0, f64::max);
+    Ok((change, refined.steps.last().map_or(0.0, |s| s.residual)))
+}

@@ -1,0 +1,231 @@
+//! `method = "auto"` (issue 13, item 3): the kinematic net where it is within the tolerance of
+//! mechanics, mechanics where it is not; the choice, its reason and its indicators in layup.json,
+//! the net's meta, the CLI table and the report; the study's account of error kept and cost
+//! saved; bad input refused.
+use assert_cmd::Command;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn drape() -> Command {
+    Command::cargo_bin("drape").unwrap()
+}
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+fn read_json(p: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// Largest |shear difference| between two nets of the same grid, degrees.
+fn largest_shear_difference(a: &drape::kinematic::DrapeNet, b: &drape::kinematic::DrapeNet) -> f64 {
+    assert_eq!((a.nu, a.nv), (b.nu, b.nv));
+    let mut largest: f64 = 0.0;
+    for i in 0..a.nu - 1 {
+        for j in 0..a.nv - 1 {
+            if let (Some(x), Some(y)) = (a.cell_shear(i, j), b.cell_shear(i, j)) {
+                largest = largest.max((x - y).abs().to_degrees());
+            }
+        }
+    }
+    largest
+}
+
+fn scene(dir: &Path, tool: &str, material: &str, ply: &str) -> PathBuf {
+    let text = format!(
+        "units = \"m\"\ntool = \"{}\"\n[materials]\ncard = \"{}\"\n[[ply]]\n{ply}\n",
+        repo(tool).display(),
+        repo(material).display()
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// On a developable tool the kinematic net is an equilibrium: auto keeps it, says why, and
+/// records its indicators everywhere the result is shown.
+#[test]
+fn auto_keeps_the_kinematic_net_on_a_developable_tool() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scene(
+        dir.path(),
+        "geometries/cylinder/cylinder.obj",
+        "materials/glass-plain-weave.toml",
+        "name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [0.0, 1.0, 0.0]\nspacing = 0.004\ngrid = [41, 41]\nmaterial = \"card\"\nmethod = \"auto\"",
+    );
+    let out = dir.path().join("run");
+    let run = drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    assert!(stdout.contains("auto: kinematic"), "{stdout}");
+    assert!(stdout.contains("auto: ply 'p0' ran kinematic: one step towards mechanical equilibrium"), "{stdout}");
+    let table = read_json(&out.join("layup.json"));
+    let row = &table["plies"][0];
+    assert_eq!(row["method"], "kinematic");
+    let choice = &row["method_choice"];
+    assert_eq!(choice["requested"], "auto");
+    assert_eq!(choice["chosen"], "kinematic");
+    assert_eq!(choice["tolerance_deg"], 1.0);
+    assert_eq!(choice["spacing_m"], 0.004);
+    // Zero shear, so nothing for mechanics to move and no spacing error.
+    let ind = &choice["indicators"];
+    assert!(ind["equilibrium_step_deg"].as_f64().unwrap() < 1e-3, "{ind}");
+    assert!(ind["discretisation_deg"].as_f64().unwrap() < 1e-6, "{ind}");
+    assert_eq!(ind["locking_share"], 0.0);
+    let net = read_json(&out.join("p0.drape.json"));
+    assert_eq!(net["meta"]["method_choice"], *choice);
+    assert!(net["meta"].get("solver").is_none(), "no mechanics ran");
+
+    // The report shows the choice and its reason.
+    drape().arg("report").arg(&out).assert().success();
+    let html = std::fs::read_to_string(out.join("report").join("index.html")).unwrap();
+    assert!(html.contains("<code>method = \"auto\"</code> (±1°) ran <strong>kinematic</strong>"), "report");
+
+    // `drape kinematic --method auto` makes the same choice for the same ply.
+    let single = dir.path().join("single");
+    let k = drape()
+        .args(["kinematic", "--tool"])
+        .arg(repo("geometries/cylinder/cylinder.obj"))
+        .args(["--origin", "0,0,0.1", "--warp", "0,1,0", "--spacing", "0.004", "--grid", "41,41"])
+        .args(["--method", "auto", "--material"])
+        .arg(repo("materials/glass-plain-weave.toml"))
+        .arg("--out")
+        .arg(&single)
+        .assert()
+        .success();
+    assert!(String::from_utf8_lossy(&k.get_output().stdout).contains("auto: ran kinematic"));
+    let net = read_json(&single.join("ply.drape.json"));
+    assert_eq!(net["meta"]["method_choice"]["chosen"], "kinematic");
+    assert_eq!(net["method"], "kinematic");
+}
+
+/// The double dome's first ply is far from equilibrium on the kinematic net (one step of the
+/// model moves its shear by about 2 deg): auto runs mechanics, at the ply's own spacing, and the
+/// result is the pressed drape's.
+#[test]
+fn auto_runs_mechanics_where_the_kinematic_net_is_far_from_equilibrium() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scene(
+        dir.path(),
+        "geometries/double-dome/double-dome.obj",
+        "materials/carbon-twill.toml",
+        "name = \"p0\"\norigin = [0.0, 0.0, 0.06]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.005\ngrid = [101, 81]\nmaterial = \"card\"\nmethod = \"auto\"",
+    );
+    let out = dir.path().join("run");
+    drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
+    let row = &read_json(&out.join("layup.json"))["plies"][0];
+    assert_eq!(row["method"], "mechanical");
+    assert_eq!(row["converged"], true);
+    let choice = &row["method_choice"];
+    assert_eq!(choice["chosen"], "mechanical");
+    assert!(choice["indicators"]["equilibrium_step_deg"].as_f64().unwrap() > 0.5, "{choice}");
+    assert!(choice["reason"].as_str().unwrap().starts_with("one step towards mechanical equilibrium changes"));
+    // Mechanics stays at the ply's spacing, whatever the kinematic spacing error.
+    assert_eq!(choice["spacing_m"], 0.005);
+    let net = read_json(&out.join("p0.drape.json"));
+    assert_eq!(net["method"], "mechanical");
+    assert_eq!(net["meta"]["solver"]["converged"], true);
+    assert_eq!(net["meta"]["method_choice"], *choice);
+}
+
+/// What auto keeps is within its tolerance of what mechanics gives: the hemisphere's first ply,
+/// which auto drapes kinematically, against the same ply pressed.
+#[test]
+fn the_kinematic_net_auto_keeps_is_within_the_tolerance_of_mechanics() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = |method: &str| {
+        format!("name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.004\ngrid = [61, 61]\nmaterial = \"card\"\nmethod = \"{method}\"")
+    };
+    let mut nets = Vec::new();
+    for method in ["auto", "mechanical"] {
+        let sub = dir.path().join(method);
+        std::fs::create_dir_all(&sub).unwrap();
+        let path =
+            scene(&sub, "geometries/hemisphere/hemisphere-20k.obj", "materials/glass-plain-weave.toml", &ply(method));
+        drape().arg("run").arg(&path).arg("--out").arg(sub.join("run")).assert().success();
+        nets.push(drape::io::read_net(&sub.join("run").join("p0.drape.json")).unwrap());
+    }
+    let choice = nets[0].meta.method_choice.clone().expect("auto records its choice");
+    assert_eq!(choice.chosen, "kinematic", "{}", choice.reason);
+    assert!(choice.reason.contains("past the 30 deg locking angle"), "the locked share is named: {}", choice.reason);
+    let difference = largest_shear_difference(&nets[0], &nets[1]);
+    assert!(difference <= choice.tolerance_deg, "{difference} deg from the pressed drape");
+    // The one-step indicator did not understate the change by more than its safety margin.
+    assert!(difference <= 2.0 * choice.indicators.equilibrium_step_deg.unwrap() + 0.05, "{difference}");
+}
+
+/// The speed-accuracy study runs auto beside the other methods and accounts for it: error
+/// against the mechanical reference, within the tolerance, at a fraction of the cost.
+#[test]
+fn the_study_reports_the_error_auto_keeps_and_the_cost_it_saves() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scene(
+        dir.path(),
+        "geometries/hemisphere/hemisphere-20k.obj",
+        "materials/glass-plain-weave.toml",
+        "name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.004\ngrid = [41, 41]\nmaterial = \"card\"",
+    );
+    let out = dir.path().join("study");
+    let run = drape()
+        .args(["study", "speed-accuracy"])
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--spacings", "0.004", "--mechanical-spacings", "0.004,0.002", "--repeats", "1", "--jobs", "1"])
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    let sa: drape::study::speed_accuracy::SpeedAccuracy =
+        serde_json::from_str(&std::fs::read_to_string(out.join("speed_accuracy.json")).unwrap()).unwrap();
+    assert_eq!(sa.reference.kind, "mechanical");
+    assert_eq!(sa.reference.spacing, 0.002);
+    assert_eq!(sa.auto.len(), 2, "auto at both mechanical spacings");
+    let at = sa.auto.iter().find(|a| a.spacing == 0.004).unwrap();
+    assert_eq!(at.chosen, "kinematic", "{}", at.reason);
+    assert!(at.within_tolerance == Some(true), "{:?}", at.error_max_deg);
+    // Its error is the kinematic net's at that spacing, against the same reference.
+    let kinematic = sa
+        .points
+        .iter()
+        .find(|p| p.method == "kinematic-geodesic" && p.surface == "facets" && p.spacing == 0.004)
+        .unwrap();
+    assert!((at.error_max_deg.unwrap() - kinematic.error_max_deg.unwrap()).abs() < 1e-9);
+    assert!(at.cost_ratio.unwrap() < 1.0, "auto cost {:?} of mechanics", at.cost_ratio);
+    assert!(stdout.contains("auto at d = 0.00400 m ran kinematic"), "{stdout}");
+}
+
+fn refused(ply_extra: &str, needle: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scene(
+        dir.path(),
+        "geometries/cylinder/cylinder.obj",
+        "materials/glass-plain-weave.toml",
+        &format!("name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [0.0, 1.0, 0.0]\nspacing = 0.004\ngrid = [11, 11]\n{ply_extra}"),
+    );
+    let a = drape().arg("run").arg(&path).arg("--out").arg(dir.path().join("o")).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains(needle), "{err}");
+    assert!(!dir.path().join("o").exists(), "nothing written for bad input");
+}
+
+#[test]
+fn bad_auto_input_is_refused_with_what_to_do() {
+    refused("method = \"auto\"", "method = \"auto\" weighs the kinematic net under the ply's material card");
+    refused("method = \"auto\"\nmaterial = \"card\"\ntolerance_deg = 0.0", "`tolerance_deg`");
+    refused(
+        "method = \"auto\"\nmaterial = \"card\"\nmode = \"free\"",
+        "a free (hanging) drape has no kinematic counterpart",
+    );
+    refused("material = \"card\"\ntolerance_deg = 1.0", "only a ply with method = \"auto\" uses it");
+    refused("method = \"guess\"", "use \"kinematic\", \"mechanical\" or \"auto\"");
+    let dir = tempfile::tempdir().unwrap();
+    let a = drape()
+        .args(["kinematic", "--tool"])
+        .arg(repo("geometries/cylinder/cylinder.obj"))
+        .args(["--origin", "0,0,0.1", "--warp", "0,1,0", "--spacing", "0.004", "--grid", "11,11", "--method", "auto"])
+        .arg("--out")
+        .arg(dir.path().join("o"))
+        .assert()
+        .code(2);
+    assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("give --material CARD.toml"));
+}
