@@ -161,18 +161,18 @@ impl Reduction {
         let mut diag = vec![usize::MAX; n];
         let sources = std::mem::take(&mut self.sources);
         let mut sources = sources.into_iter();
-        for c in 0..n {
+        for (c, dc) in diag.iter_mut().enumerate() {
             let mut has = false;
             for k in self.colptr[c]..self.colptr[c + 1] {
                 if self.rowval[k] == c {
                     has = true;
-                    diag[c] = new_rowval.len();
+                    *dc = new_rowval.len();
                 }
                 new_rowval.push(self.rowval[k]);
                 new_sources.push(sources.next().expect("one source list per entry"));
             }
             if !has {
-                diag[c] = new_rowval.len();
+                *dc = new_rowval.len();
                 new_rowval.push(c);
                 new_sources.push(Vec::new());
             }
