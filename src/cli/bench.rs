@@ -113,6 +113,19 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
             total * 1e3 / iterations.len().max(1) as f64,
             refined.steps.last().map_or(0.0, |s| s.residual)
         );
+        for i in &iterations {
+            println!(
+                "  iteration {:>3}: |F-P|/|P| {:.1e}, shift {:.0e}, step {:.2} spacings, {} subproblem(s), {:.0} ms (models {:.0}, Clarabel {:.0}, trial steps {:.0})",
+                i.iteration, i.residual, i.shift, i.step, i.subproblems, i.time_ms, i.model_ms, i.solve_ms, i.trial_ms
+            );
+        }
+        let sum = |f: fn(&&crate::mechanics::solver::IterationLog) -> f64| iterations.iter().map(f).sum::<f64>() / 1e3;
+        println!(
+            "  of which: models {:.2} s (energy, Hessian, contact, reduction), Clarabel {:.2} s, trial steps {:.2} s",
+            sum(|i| i.model_ms),
+            sum(|i| i.solve_ms),
+            sum(|i| i.trial_ms)
+        );
     }
     if let Some(kb) = peak_memory_kb() {
         println!("peak memory (VmHWM): {:.0} MB", kb as f64 / 1024.0);

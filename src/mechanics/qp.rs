@@ -9,6 +9,7 @@
 use super::contact::NodeBasis;
 use crate::geometry::Vector;
 use clarabel::algebra::CscMatrix;
+use clarabel::solver::traits::KKTSystem;
 use clarabel::solver::{
     DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
@@ -29,13 +30,24 @@ const PARALLEL_FACTORISATION_MIN: usize = 20_000;
 
 /// The reduced variables: node k's components start at `offset[rep[k]]` and number
 /// `dofs[rep[k]]`, in the directions of its basis.
+///
+/// The sparsity pattern is built for a capacity of slots per node (`cap`, at least `dofs`):
+/// a node whose freedoms shrink (a pressed node held by an open edge, a free node touching the
+/// tool) keeps its slots, the ones beyond its `dofs` pinned (a unit diagonal, no coupling, no
+/// force: their value is zero). The pattern, and with it Clarabel's solver and its symbolic
+/// factorisation, then outlives changes of the active set ([`Reduction::set_dofs`]); only a
+/// node gaining freedoms beyond its slots needs a new one.
 pub struct Reduction {
     /// Per node: the node whose variables it uses (itself unless stitched to another).
     rep: Vec<usize>,
     /// Per node: its number of variables (0 for non-representatives).
     dofs: Vec<u8>,
+    /// Per node: its slots in the pattern (`>= dofs`).
+    cap: Vec<u8>,
     offset: Vec<usize>,
     n: usize,
+    /// Live (not pinned) variables.
+    live: usize,
     /// Upper-triangular CSC pattern over the reduced variables.
     colptr: Vec<usize>,
     rowval: Vec<usize>,
@@ -47,20 +59,23 @@ pub struct Reduction {
 }
 
 impl Reduction {
-    /// The reduction for node bases with `dofs` directions each (representatives only),
-    /// `rep` the representative of each node, over the coupled node pairs `pairs`.
-    pub fn new(dofs: Vec<u8>, rep: Vec<usize>, pairs: &[(usize, usize)]) -> Self {
-        let mut offset = vec![0; dofs.len()];
+    /// The reduction for node bases with `dofs` directions each (representatives only) in a
+    /// pattern of `cap` slots per node (each at least `dofs`), `rep` the representative of each
+    /// node, over the coupled node pairs `pairs`.
+    pub fn new(cap: Vec<u8>, dofs: Vec<u8>, rep: Vec<usize>, pairs: &[(usize, usize)]) -> Self {
+        assert!(Self::fits_in(&cap, &dofs), "a node has more freedoms than slots");
+        let mut offset = vec![0; cap.len()];
         let mut n = 0;
-        for (k, &d) in dofs.iter().enumerate() {
+        for (k, &d) in cap.iter().enumerate() {
             offset[k] = n;
             n += d as usize;
         }
+        let live = dofs.iter().map(|&d| d as usize).sum();
         let mut columns: Vec<Vec<(usize, Source)>> = vec![Vec::new(); n];
         for &(a, b) in pairs {
             let (ra, rb) = (rep[a], rep[b]);
-            for p in 0..dofs[ra] as usize {
-                for q in 0..dofs[rb] as usize {
+            for p in 0..cap[ra] as usize {
+                for q in 0..cap[rb] as usize {
                     let (r, c) = (offset[ra] + p, offset[rb] + q);
                     // Each grid pair is listed once (a <= b). Within one node's diagonal
                     // block the upper triangle keeps p <= q; a pair of distinct nodes sharing a
@@ -98,60 +113,90 @@ impl Reduction {
             colptr.push(rowval.len());
         }
         // Every variable gets a diagonal slot (the shift goes there even without coupling).
-        if diag.contains(&usize::MAX) {
-            return Self::with_diagonals(dofs, rep, offset, n, colptr, rowval, sources);
+        let mut red = Reduction { rep, dofs, cap, offset, n, live, colptr, rowval, sources, diag };
+        if red.diag.contains(&usize::MAX) {
+            red.add_missing_diagonals();
         }
-        Reduction { rep, dofs, offset, n, colptr, rowval, sources, diag }
+        red
     }
 
-    /// Rebuilds the pattern with a diagonal entry added to every column that lacks one.
-    #[allow(clippy::too_many_arguments)]
-    fn with_diagonals(
-        dofs: Vec<u8>,
-        rep: Vec<usize>,
-        offset: Vec<usize>,
-        n: usize,
-        colptr: Vec<usize>,
-        rowval: Vec<usize>,
-        sources: Vec<Vec<Source>>,
-    ) -> Self {
+    fn fits_in(cap: &[u8], dofs: &[u8]) -> bool {
+        cap.len() == dofs.len() && cap.iter().zip(dofs).all(|(c, d)| d <= c)
+    }
+
+    /// Whether every node's `dofs` fit in its slots ([`Reduction::set_dofs`] can take them).
+    pub fn fits(&self, dofs: &[u8]) -> bool {
+        Self::fits_in(&self.cap, dofs)
+    }
+
+    /// New numbers of freedoms per node within the same pattern (they must fit).
+    pub fn set_dofs(&mut self, dofs: Vec<u8>) {
+        assert!(self.fits(&dofs), "a node has more freedoms than slots");
+        self.live = dofs.iter().map(|&d| d as usize).sum();
+        self.dofs = dofs;
+    }
+
+    /// The slots of each node.
+    pub fn capacity(&self) -> &[u8] {
+        &self.cap
+    }
+
+    /// The number of freedoms of each node.
+    pub fn dofs(&self) -> &[u8] {
+        &self.dofs
+    }
+
+    /// Whether slot `p` of node `r` (a representative) is pinned.
+    #[inline]
+    fn pinned(&self, r: usize, p: usize) -> bool {
+        p >= self.dofs[r] as usize
+    }
+
+    /// Adds a diagonal entry to every column that lacks one.
+    fn add_missing_diagonals(&mut self) {
+        let n = self.n;
         let mut new_colptr = vec![0];
-        let mut new_rowval = Vec::with_capacity(rowval.len() + n);
-        let mut new_sources = Vec::with_capacity(rowval.len() + n);
+        let mut new_rowval = Vec::with_capacity(self.rowval.len() + n);
+        let mut new_sources = Vec::with_capacity(self.rowval.len() + n);
         let mut diag = vec![usize::MAX; n];
-        for c in 0..n {
+        let sources = std::mem::take(&mut self.sources);
+        let mut sources = sources.into_iter();
+        for (c, dc) in diag.iter_mut().enumerate() {
             let mut has = false;
-            for k in colptr[c]..colptr[c + 1] {
-                if rowval[k] == c {
+            for k in self.colptr[c]..self.colptr[c + 1] {
+                if self.rowval[k] == c {
                     has = true;
-                    diag[c] = new_rowval.len();
+                    *dc = new_rowval.len();
                 }
-                new_rowval.push(rowval[k]);
-                new_sources.push(sources[k].clone());
+                new_rowval.push(self.rowval[k]);
+                new_sources.push(sources.next().expect("one source list per entry"));
             }
             if !has {
-                diag[c] = new_rowval.len();
+                *dc = new_rowval.len();
                 new_rowval.push(c);
                 new_sources.push(Vec::new());
             }
             new_colptr.push(new_rowval.len());
         }
-        Reduction { rep, dofs, offset, n, colptr: new_colptr, rowval: new_rowval, sources: new_sources, diag }
+        self.colptr = new_colptr;
+        self.rowval = new_rowval;
+        self.sources = new_sources;
+        self.diag = diag;
     }
 
-    /// Number of reduced variables.
+    /// Number of reduced variables (slots, pinned ones included).
     pub fn len(&self) -> usize {
         self.n
     }
 
     /// Whether there is nothing to move.
     pub fn is_empty(&self) -> bool {
-        self.n == 0
+        self.live == 0
     }
 
     /// The key of the sparsity pattern (equal keys, equal patterns).
     pub fn key(&self) -> &[u8] {
-        &self.dofs
+        &self.cap
     }
 
     /// The representative of node `k`.
@@ -165,15 +210,21 @@ impl Reduction {
         (self.offset[r], self.dofs[r] as usize)
     }
 
-    /// Reduced matrix values B^T H B (upper triangle, in the pattern's order).
+    /// Reduced matrix values B^T H B (upper triangle, in the pattern's order); pinned slots get
+    /// a unit diagonal and nothing else.
     pub fn values(&self, h: &dyn HessianBlocks, bases: &[NodeBasis]) -> Vec<f64> {
         use rayon::prelude::*;
-        self.sources
+        let mut out: Vec<f64> = self
+            .sources
             .par_iter()
             .map(|srcs| {
                 let mut v = 0.0;
                 let mut cache: Option<((u32, u32), Matrix3<f64>)> = None;
                 for &(a, b, p, q) in srcs {
+                    let (ra, rb) = (self.rep[a as usize], self.rep[b as usize]);
+                    if self.pinned(ra, p as usize) || self.pinned(rb, q as usize) {
+                        continue;
+                    }
                     let blk = match cache {
                         Some((key, m)) if key == (a, b) => m,
                         _ => {
@@ -192,7 +243,13 @@ impl Reduction {
                 }
                 v
             })
-            .collect()
+            .collect();
+        for (r, &o) in self.offset.iter().enumerate() {
+            for p in self.dofs[r] as usize..self.cap[r] as usize {
+                out[self.diag[o + p]] = 1.0;
+            }
+        }
+        out
     }
 
     /// Adds `s * weight[k]` to the diagonal of every variable of node k (representatives: the
@@ -224,12 +281,18 @@ impl Reduction {
         }
     }
 
-    /// The mean absolute diagonal entry of `values`.
+    /// The mean absolute diagonal entry of `values` over the live variables.
     pub fn mean_diagonal(&self, values: &[f64]) -> f64 {
-        if self.n == 0 {
+        if self.live == 0 {
             return 0.0;
         }
-        self.diag.iter().map(|&k| values[k].abs()).sum::<f64>() / self.n as f64
+        let mut s = 0.0;
+        for (r, &o) in self.offset.iter().enumerate() {
+            for p in 0..self.dofs[r] as usize {
+                s += values[self.diag[o + p]].abs();
+            }
+        }
+        s / self.live as f64
     }
 
     /// Per-node vectors reduced onto the free directions (summed over stitched nodes).
@@ -252,6 +315,13 @@ impl Reduction {
                 (0..self.dofs[r] as usize).fold(Vector::zeros(), |s, p| s + bases[r].dir(p) * y[self.offset[r] + p])
             })
             .collect()
+    }
+
+    /// Sets the pinned slots of `y` to zero (the value they have, up to rounding).
+    fn clear_pinned(&self, y: &mut [f64]) {
+        for (r, &o) in self.offset.iter().enumerate() {
+            y[o + self.dofs[r] as usize..o + self.cap[r] as usize].fill(0.0);
+        }
     }
 
     /// y^T P y for the upper-triangular `values`.
@@ -285,6 +355,12 @@ pub enum QpFailure {
 #[derive(Default)]
 pub struct QpEngine {
     cached: Option<(Vec<u8>, DefaultSolver<f64>)>,
+    /// The matrix values the cached solver's KKT system holds factorised (the last subproblem
+    /// it solved at its starting point, with no interior-point iterations): a subproblem with
+    /// the same matrix (a second-order correction) only needs new triangular solves.
+    factored: Option<Vec<f64>>,
+    /// Subproblems solved with the factorisation of the one before.
+    pub reused_factorisations: u32,
     /// Time spent in Clarabel (set-up, updates and solves), ms.
     pub time_ms: f64,
 }
@@ -327,6 +403,22 @@ impl QpEngine {
 
     fn solve_timed(&mut self, red: &Reduction, values: &[f64], q: &[f64], n: usize) -> Result<Vec<f64>, QpFailure> {
         let reuse = matches!(&self.cached, Some((key, _)) if key.as_slice() == red.key());
+        if reuse && self.factored.as_deref() == Some(values) {
+            // The same matrix: Clarabel's own starting-point solve (the step its full solve
+            // takes at iteration 0, iterative refinement included) on the factorisation it holds.
+            let (_, solver) = self.cached.as_mut().expect("checked");
+            solver.update_q(&q.to_vec()).map_err(|_| QpFailure::Setup)?;
+            let settings = Self::settings(n);
+            let ok = solver.kktsystem.solve_initial_point(&mut solver.variables, &solver.data, &settings);
+            let mut y = solver.variables.x.clone();
+            if ok && y.iter().all(|v| v.is_finite()) {
+                self.reused_factorisations += 1;
+                red.clear_pinned(&mut y);
+                return Ok(y);
+            }
+            // Fall through to a full solve.
+        }
+        self.factored = None;
         if reuse {
             let (_, solver) = self.cached.as_mut().expect("checked");
             solver.update_P(&values.to_vec()).map_err(|_| QpFailure::Setup)?;
@@ -342,7 +434,11 @@ impl QpEngine {
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                let y = solver.solution.x.clone();
+                if solver.info.iterations == 0 {
+                    self.factored = Some(values.to_vec());
+                }
+                let mut y = solver.solution.x.clone();
+                red.clear_pinned(&mut y);
                 if y.iter().all(|v| v.is_finite()) {
                     Ok(y)
                 } else {

@@ -312,7 +312,13 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     };
     let movable = |k: usize| cons.freedom[rep[k]].dofs() > 0;
     let load = (0..n).filter(|&k| movable(k)).map(|k| state.eval.external[k].norm_squared()).sum::<f64>().sqrt();
-    let mut red = Reduction::new(dofs_of(&state.bases, &rep), rep.clone(), &pairs);
+    // The pattern's slots: every freedom of the nodes that can move now (a node losing some to
+    // the tool keeps its slots, pinned), none for those held now (a node stuck on a table
+    // gains its slots only when it comes off: a new pattern).
+    let full: Vec<u8> = (0..n).map(|k| if rep[k] == k { cons.freedom[k].dofs() as u8 } else { 0 }).collect();
+    let dofs0 = dofs_of(&state.bases, &rep);
+    let cap0 = full.iter().zip(&dofs0).map(|(&f, &d)| if d > 0 { f.max(d) } else { 0 }).collect();
+    let mut red = Reduction::new(cap0, dofs0, rep.clone(), &pairs);
     let force_scale = if load > 0.0 {
         load
     } else {
@@ -478,8 +484,16 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 let (bases, sliding) = bases_at(cons, &rep, &eval, &feet);
                 state = State { eval, feet, bases, sliding };
                 let dofs = dofs_of(&state.bases, &rep);
-                if dofs.as_slice() != red.key() {
-                    red = Reduction::new(dofs, rep.clone(), &pairs);
+                if dofs.as_slice() != red.dofs() {
+                    if red.fits(&dofs) {
+                        red.set_dofs(dofs);
+                    } else {
+                        // Slots for the nodes that outgrew theirs: all their freedoms.
+                        let cap = (red.capacity().iter().zip(&dofs).zip(&full))
+                            .map(|((&c, &d), &f)| if d > c { f.max(d) } else { c })
+                            .collect();
+                        red = Reduction::new(cap, dofs, rep.clone(), &pairs);
+                    }
                 }
                 if ratio >= GOOD_RATIO && !corrected {
                     shift = (shift / 8.0).max(MIN_SHIFT);
