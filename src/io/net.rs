@@ -94,13 +94,13 @@ pub fn write_net(net: &DrapeNet, dir: &Path, formats: &[Format]) -> Result<Vec<P
         return Ok(Vec::new());
     }
     check::check_name(net)?;
-    check::check_net(net, formats.iter().any(|f| *f != Format::Json))?;
+    let shears = check::check_net_shears(net, formats.iter().any(|f| *f != Format::Json))?;
     std::fs::create_dir_all(dir).map_err(|source| ExportError::CreateDir { path: dir.to_path_buf(), source })?;
     let mut written = Vec::with_capacity(formats.len());
     for &f in formats {
         let path = f.path(dir, &net.name);
         match f {
-            Format::Json => write_json_checked(net, &path)?,
+            Format::Json => write_json_checked(net, &shears, &path)?,
             Format::Vtu => write_vtu(net, &path)?,
             Format::Csv => write_csv(net, &path)?,
         }
