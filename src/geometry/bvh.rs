@@ -114,13 +114,13 @@ impl TriangleBvh {
     /// The hierarchy of `triangles` (corner indices into `vertices`, all valid).
     pub(crate) fn new(vertices: &[Point], triangles: &[[u32; 3]]) -> TriangleBvh {
         use rayon::prelude::*;
-        let boxes: Vec<Box3> = triangles
+        let boxes: Vec<Box3> =
+            triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect();
+        let centroids: Vec<[f64; 3]> = boxes
             .par_iter()
             .with_min_len(PARALLEL)
-            .map(|t| Box3::of(&t.map(|i| vertices[i as usize])))
+            .map(|b| std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a])))
             .collect();
-        let centroids: Vec<[f64; 3]> =
-            boxes.par_iter().with_min_len(PARALLEL).map(|b| std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a]))).collect();
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
         split(&mut order, &centroids);
 
@@ -366,7 +366,8 @@ mod tests {
         for q in 0..400 {
             let f = q as f64;
             // Points above the flat half tie between facets sharing the foot; others do not.
-            let p = Point::new((f * 0.618).fract() * 1.2 - 0.1, (f * 0.377).fract() * 1.2 - 0.1, (f * 0.29).fract() - 0.3);
+            let p =
+                Point::new((f * 0.618).fract() * 1.2 - 0.1, (f * 0.377).fract() * 1.2 - 0.1, (f * 0.29).fract() - 0.3);
             let brute = (0..tris.len() as u32)
                 .map(|t| (t, d2(t, &p)))
                 .fold(None, |b: Option<(u32, f64)>, (t, d)| match b {

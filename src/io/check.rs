@@ -36,8 +36,8 @@ pub(crate) fn check_net(net: &DrapeNet, frames: bool) -> Result<(), ExportError>
     check_net_shears(net, frames).map(|_| ())
 }
 
-/// [`check_net`], giving back each cell's shear ([`cell_shears`]) that the check computed, for
-/// a writer to use instead of computing them again.
+/// [`check_net`], giving back each cell's shear ([`DrapeNet::cell_shears`]) that the check
+/// computed, for the writers and the statistics to use instead of computing them again.
 pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Option<f64>>, ExportError> {
     let bad = |reason: String| Err(ExportError::BadNet { ply: net.name.clone(), reason });
     if net.nu == 0 || net.nv == 0 {
@@ -79,7 +79,7 @@ pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Optio
         return bad(format!("node ({}, {}) is placed but its position is ({}, {}, {})", k / nv, k % nv, p.x, p.y, p.z));
     }
     let cv = nv - 1;
-    let shears = cell_shears(net);
+    let shears = net.cell_shears();
     let bad_cell = (0..shears.len())
         .into_par_iter()
         .with_min_len(1 << 13)
@@ -88,14 +88,6 @@ pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Optio
         return bad(reason);
     }
     Ok(shears)
-}
-
-/// Each cell's shear in radians ([`DrapeNet::cell_shear`]), in file order, `None` for a cell
-/// lacking a placed corner: computed in parallel, each value a function of its cell alone, so
-/// the same whatever the thread count. The grid must have been checked (array lengths).
-pub(crate) fn cell_shears(net: &DrapeNet) -> Vec<Option<f64>> {
-    let cv = net.nv.saturating_sub(1);
-    (0..cell_count(net)).into_par_iter().with_min_len(1 << 12).map(|k| net.cell_shear(k / cv, k % cv)).collect()
 }
 
 /// What is wrong with cell (i, j) of shear `shear` (its [`DrapeNet::cell_shear`]), if anything:

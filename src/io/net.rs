@@ -90,8 +90,19 @@ impl std::fmt::Display for Format {
 /// `<ply>.vtu`, `<ply>.cells.csv`; returns the paths written, in the order of `formats`.
 /// The net is checked before any file is opened, so a bad net writes nothing.
 pub fn write_net(net: &DrapeNet, dir: &Path, formats: &[Format]) -> Result<Vec<PathBuf>, ExportError> {
+    write_net_shears(net, dir, formats).map(|(paths, _)| paths)
+}
+
+/// [`write_net`], also giving back each cell's shear ([`DrapeNet::cell_shears`]) that the
+/// checks computed (`None` when `formats` is empty and nothing was checked), for
+/// [`DrapeNet::shear_stats_from`].
+pub fn write_net_shears(
+    net: &DrapeNet,
+    dir: &Path,
+    formats: &[Format],
+) -> Result<(Vec<PathBuf>, Option<Vec<Option<f64>>>), ExportError> {
     if formats.is_empty() {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     }
     check::check_name(net)?;
     let shears = check::check_net_shears(net, formats.iter().any(|f| *f != Format::Json))?;
@@ -106,7 +117,7 @@ pub fn write_net(net: &DrapeNet, dir: &Path, formats: &[Format]) -> Result<Vec<P
         }
         written.push(path);
     }
-    Ok(written)
+    Ok((written, Some(shears)))
 }
 
 #[cfg(test)]

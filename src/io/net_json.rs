@@ -27,7 +27,7 @@ pub fn write_json(net: &DrapeNet, path: &Path) -> Result<(), ExportError> {
 }
 
 /// [`write_json`] of a net that `check_net` has passed, with the cell shears it computed
-/// (`check::cell_shears`).
+/// ([`DrapeNet::cell_shears`]).
 pub(crate) fn write_json_checked(net: &DrapeNet, shears: &[Option<f64>], path: &Path) -> Result<(), ExportError> {
     write_atomic(path, |w| write_json_to(net, shears, w))
 }
@@ -77,10 +77,8 @@ fn write_items<W: Write + Send>(
         std::mem::swap(&mut bufs.written, &mut bufs.formatted);
         first += PIECES_AT_ONCE;
         let (to_write, to_format) = (&bufs.written[..ready], &mut bufs.formatted);
-        let (written, next) = rayon::join(
-            || to_write.iter().try_for_each(|b| w.write_all(b)),
-            || format(to_format, first),
-        );
+        let (written, next) =
+            rayon::join(|| to_write.iter().try_for_each(|b| w.write_all(b)), || format(to_format, first));
         written?;
         ready = next;
     }
