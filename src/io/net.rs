@@ -93,6 +93,9 @@ pub fn write_net(net: &DrapeNet, dir: &Path, formats: &[Format]) -> Result<Vec<P
     write_net_shears(net, dir, formats).map(|(paths, _)| paths)
 }
 
+/// Each cell's shear in file order, `None` for an incomplete cell ([`DrapeNet::cell_shears`]).
+pub type CellShears = Vec<Option<f64>>;
+
 /// [`write_net`], also giving back each cell's shear ([`DrapeNet::cell_shears`]) that the
 /// checks computed (`None` when `formats` is empty and nothing was checked), for
 /// [`DrapeNet::shear_stats_from`].
@@ -100,7 +103,7 @@ pub fn write_net_shears(
     net: &DrapeNet,
     dir: &Path,
     formats: &[Format],
-) -> Result<(Vec<PathBuf>, Option<Vec<Option<f64>>>), ExportError> {
+) -> Result<(Vec<PathBuf>, Option<CellShears>), ExportError> {
     if formats.is_empty() {
         return Ok((Vec::new(), None));
     }
