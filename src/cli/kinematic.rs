@@ -1,9 +1,9 @@
 //! `drape kinematic`: one ply from command-line arguments.
-use super::summary::summary;
+use super::summary::summary_with;
 use super::{input, parse_pair, parse_vec3, Failure};
 use crate::geometry::{Point, ToolSurface, Vector};
 use crate::io::points::read_points;
-use crate::io::{write_net, Format};
+use crate::io::{write_net_shears, Format};
 use crate::kinematic::fishnet::check_settings;
 use crate::kinematic::{drape, Extent, KinematicSettings, SurfaceKind};
 use crate::layup::auto::{choose, DEFAULT_TOLERANCE_DEG};
@@ -155,9 +155,15 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     net.meta.tool = Some(a.tool.display().to_string());
     net.meta.tool_scale = Some(scale);
     let t_write = Instant::now();
-    let written = write_net(&net, &a.out, &formats).map_err(super::write_failure)?;
+    let (written, shears) = write_net_shears(&net, &a.out, &formats).map_err(super::write_failure)?;
     let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
-    println!("{}", summary(&net, locking_angle.to_radians(), load_ms, write_ms));
+    let locking = locking_angle.to_radians();
+    // The statistics from the shears the writer's checks computed (the same figures).
+    let stats = match &shears {
+        Some(s) => net.shear_stats_from(s, locking),
+        None => net.shear_stats(locking),
+    };
+    println!("{}", summary_with(&net, &stats, locking, load_ms, write_ms));
     for p in written {
         println!("  wrote {}", p.display());
     }

@@ -1,14 +1,19 @@
 //! The short summary printed after a drape.
+use crate::kinematic::net::ShearStats;
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
 /// One block of text: nodes placed and failed by reason, shear statistics, time per stage.
 pub fn summary(net: &DrapeNet, locking_angle: f64, load_ms: f64, write_ms: f64) -> String {
+    summary_with(net, &net.shear_stats(locking_angle), locking_angle, load_ms, write_ms)
+}
+
+/// [`summary`] with the net's shear statistics already computed.
+pub fn summary_with(net: &DrapeNet, stats: &ShearStats, locking_angle: f64, load_ms: f64, write_ms: f64) -> String {
     let counts = net.status_counts();
     let total = net.nu * net.nv;
     let placed = counts.iter().find(|(s, _)| *s == NodeStatus::Placed).map_or(0, |c| c.1);
     let failed: Vec<String> =
         counts.iter().filter(|(s, _)| *s != NodeStatus::Placed).map(|(s, c)| format!("{} {c}", s.name())).collect();
-    let stats = net.shear_stats(locking_angle);
     let mut out = format!("ply {}: {} x {} nodes, spacing {} m\n", net.name, net.nu, net.nv, net.spacing);
     out += &format!(
         "  nodes placed {placed} of {total}{}\n",

@@ -1,5 +1,6 @@
 //! Tool surfaces: mesh checks and repairs, the queryable [`ToolSurface`], smooth patches over
 //! its facets, straightest geodesics and offset surfaces.
+mod bvh;
 pub mod check;
 pub mod geodesic;
 pub mod hemisphere;

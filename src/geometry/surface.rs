@@ -1,11 +1,9 @@
-//! [`ToolSurface`]: a checked triangle mesh with a BVH (parry3d), edge adjacency and per-triangle
-//! frames, answering the geometric queries the drape engine needs.
+//! [`ToolSurface`]: a checked triangle mesh with a BVH ([`super::bvh`]), edge adjacency and
+//! per-triangle frames, answering the geometric queries the drape engine needs.
+use super::bvh::TriangleBvh;
 use super::check::{mend, MendedMesh, NO_NEIGHBOUR};
 use super::mesh::{MeshReport, ToolError, TriangleMesh};
 use super::{Point, Vector};
-use parry3d_f64::bounding_volume::Aabb;
-use parry3d_f64::query::PointQueryWithLocation;
-use parry3d_f64::shape::TriMesh;
 use std::path::Path;
 
 /// Vertices closer than this fraction of the mesh's bounding-box diagonal are welded.
@@ -78,7 +76,7 @@ pub struct ToolSurface {
     frames: Vec<TriangleFrame>,
     /// Bounding sphere of each triangle (centre, radius), for cheap ball tests.
     spheres: Vec<(Point, f64)>,
-    mesh: TriMesh,
+    bvh: TriangleBvh,
     report: MeshReport,
     diagonal: f64,
 }
@@ -128,11 +126,11 @@ impl ToolSurface {
         if triangles.is_empty() {
             return Err(ToolError::AllDegenerate { path: path.into() });
         }
-        // parry's BVH build is the slowest step of loading a tool and needs only the triangles:
-        // it runs beside the per-triangle frames and spheres (each a pure function of its
-        // triangle, so the same whatever the thread count).
-        let (mesh, (frames, spheres)) = rayon::join(
-            || TriMesh::new(vertices.clone(), triangles.clone()),
+        // The BVH (built in parallel; its answers do not depend on its shape, see
+        // `geometry::bvh`) beside the per-triangle frames and spheres (each a pure function of
+        // its triangle, so the same whatever the thread count).
+        let (bvh, (frames, spheres)) = rayon::join(
+            || TriangleBvh::new(&vertices, &triangles),
             || {
                 use rayon::prelude::*;
                 let frames: Vec<TriangleFrame> = triangles
@@ -161,13 +159,9 @@ impl ToolSurface {
                 (frames, spheres)
             },
         );
-        let mesh = mesh.map_err(|e| ToolError::Parse {
-            path: path.into(),
-            reason: format!("mesh rejected by the geometry kernel: {e}"),
-        })?;
         report.triangles = triangles.len();
         report.vertices = vertices.len();
-        Ok(ToolSurface { vertices, triangles, neighbours, frames, spheres, mesh, report, diagonal })
+        Ok(ToolSurface { vertices, triangles, neighbours, frames, spheres, bvh, report, diagonal })
     }
 
     /// What the checks found and mended.
@@ -212,20 +206,26 @@ impl ToolSurface {
         self.neighbours[t as usize]
     }
 
-    /// The closest point of the tool to `p`.
+    /// The closest point of the tool to `p`: on the facet nearest to `p`, and among facets at
+    /// exactly the same distance the one of lowest index (whatever the BVH's shape).
     pub fn closest_point(&self, p: &Point) -> SurfacePoint {
-        let (proj, (triangle, _)) = self.mesh.project_local_point_and_get_location(p, false);
-        let _ = proj;
-        // Project onto our own frame so the point and the triangle agree exactly.
+        let (triangle, _) = self
+            .bvh
+            .closest(p, |t| (self.project_to_triangle(t, p) - p).norm_squared())
+            .expect("a tool surface has triangles");
         let point = self.project_to_triangle(triangle, p);
         SurfacePoint { point, triangle, normal: self.normal(triangle), distance: (point - p).norm() }
     }
 
     /// Distance along the unit direction `dir` from `origin` to the first facet it meets, if
-    /// any (parry's ray cast on the mesh).
+    /// any (the smallest of parry's ray casts on each facet).
     pub fn cast_ray(&self, origin: &Point, dir: &Vector) -> Option<f64> {
         use parry3d_f64::query::{Ray, RayCast};
-        self.mesh.cast_local_ray(&Ray::new(*origin, *dir), f64::MAX, false)
+        let ray = Ray::new(*origin, *dir);
+        self.bvh.first_hit(origin, dir, |t| {
+            let [a, b, c] = self.corners(t);
+            parry3d_f64::shape::Triangle::new(a, b, c).cast_local_ray(&ray, f64::MAX, false)
+        })
     }
 
     /// Closest point of triangle `t` to `p`.
@@ -298,20 +298,18 @@ impl ToolSurface {
         [1.0 - l1 - l2, l1, l2]
     }
 
-    /// Triangles whose bounding box meets the ball (`center`, `radius`), from the BVH.
+    /// Triangles whose bounding box meets the box around the ball (`center`, `radius`), from
+    /// the BVH, by increasing index.
     pub fn triangles_near(&self, center: &Point, radius: f64) -> Vec<u32> {
         let r = Vector::repeat(radius);
-        let aabb = Aabb::new(center - r, center + r);
-        self.mesh.bvh().intersect_aabb(&aabb).collect()
+        self.bvh.meeting(&(center - r), &(center + r))
     }
 
     /// Whether any facet's bounding box comes within `radius` of `center` (a cheap test before a
     /// closest-point search).
     pub fn any_triangle_near(&self, center: &Point, radius: f64) -> bool {
         let r = Vector::repeat(radius);
-        let aabb = Aabb::new(center - r, center + r);
-        let hit = self.mesh.bvh().intersect_aabb(&aabb).next().is_some();
-        hit
+        self.bvh.any_meeting(&(center - r), &(center + r))
     }
 
     /// Whether triangle `t` may come within `radius` of `center` (bounding-sphere test).

@@ -33,6 +33,12 @@ pub(crate) fn check_name(net: &DrapeNet) -> Result<(), ExportError> {
 /// Consistency and finiteness of everything a writer reads. `frames`: also check each complete
 /// cell's fibre frame (VTU, CSV).
 pub(crate) fn check_net(net: &DrapeNet, frames: bool) -> Result<(), ExportError> {
+    check_net_shears(net, frames).map(|_| ())
+}
+
+/// [`check_net`], giving back each cell's shear ([`DrapeNet::cell_shears`]) that the check
+/// computed, for the writers and the statistics to use instead of computing them again.
+pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Option<f64>>, ExportError> {
     let bad = |reason: String| Err(ExportError::BadNet { ply: net.name.clone(), reason });
     if net.nu == 0 || net.nv == 0 {
         return bad(format!("the grid is empty ({} x {} nodes)", net.nu, net.nv));
@@ -73,20 +79,21 @@ pub(crate) fn check_net(net: &DrapeNet, frames: bool) -> Result<(), ExportError>
         return bad(format!("node ({}, {}) is placed but its position is ({}, {}, {})", k / nv, k % nv, p.x, p.y, p.z));
     }
     let cv = nv - 1;
-    let bad_cell = (0..cell_count(net))
+    let shears = net.cell_shears();
+    let bad_cell = (0..shears.len())
         .into_par_iter()
         .with_min_len(1 << 13)
-        .find_first(|&k| cell_problem(net, k / cv, k % cv, frames).is_some());
-    if let Some(reason) = bad_cell.and_then(|k| cell_problem(net, k / cv, k % cv, frames)) {
+        .find_first(|&k| cell_problem(net, k / cv, k % cv, shears[k], frames).is_some());
+    if let Some(reason) = bad_cell.and_then(|k| cell_problem(net, k / cv, k % cv, shears[k], frames)) {
         return bad(reason);
     }
-    Ok(())
+    Ok(shears)
 }
 
-/// What is wrong with cell (i, j), if anything: a non-finite shear, or (`frames`) no finite
-/// fibre frame.
-fn cell_problem(net: &DrapeNet, i: usize, j: usize, frames: bool) -> Option<String> {
-    let g = net.cell_shear(i, j)?;
+/// What is wrong with cell (i, j) of shear `shear` (its [`DrapeNet::cell_shear`]), if anything:
+/// a non-finite shear, or (`frames`) no finite fibre frame.
+fn cell_problem(net: &DrapeNet, i: usize, j: usize, shear: Option<f64>, frames: bool) -> Option<String> {
+    let g = shear?;
     if !g.to_degrees().is_finite() {
         return Some(format!("cell ({i}, {j}) has a shear angle of {g} rad"));
     }

@@ -90,23 +90,37 @@ impl std::fmt::Display for Format {
 /// `<ply>.vtu`, `<ply>.cells.csv`; returns the paths written, in the order of `formats`.
 /// The net is checked before any file is opened, so a bad net writes nothing.
 pub fn write_net(net: &DrapeNet, dir: &Path, formats: &[Format]) -> Result<Vec<PathBuf>, ExportError> {
+    write_net_shears(net, dir, formats).map(|(paths, _)| paths)
+}
+
+/// Each cell's shear in file order, `None` for an incomplete cell ([`DrapeNet::cell_shears`]).
+pub type CellShears = Vec<Option<f64>>;
+
+/// [`write_net`], also giving back each cell's shear ([`DrapeNet::cell_shears`]) that the
+/// checks computed (`None` when `formats` is empty and nothing was checked), for
+/// [`DrapeNet::shear_stats_from`].
+pub fn write_net_shears(
+    net: &DrapeNet,
+    dir: &Path,
+    formats: &[Format],
+) -> Result<(Vec<PathBuf>, Option<CellShears>), ExportError> {
     if formats.is_empty() {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     }
     check::check_name(net)?;
-    check::check_net(net, formats.iter().any(|f| *f != Format::Json))?;
+    let shears = check::check_net_shears(net, formats.iter().any(|f| *f != Format::Json))?;
     std::fs::create_dir_all(dir).map_err(|source| ExportError::CreateDir { path: dir.to_path_buf(), source })?;
     let mut written = Vec::with_capacity(formats.len());
     for &f in formats {
         let path = f.path(dir, &net.name);
         match f {
-            Format::Json => write_json_checked(net, &path)?,
+            Format::Json => write_json_checked(net, &shears, &path)?,
             Format::Vtu => write_vtu(net, &path)?,
             Format::Csv => write_csv(net, &path)?,
         }
         written.push(path);
     }
-    Ok(written)
+    Ok((written, Some(shears)))
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 //! {"code": name}, node_codes [u8; nu*nv]}, `meta`, `nodes` [[x, y, z] | null; nu*nv],
 //! `cell_shear_deg` [f64 | null; (nu-1)*(nv-1)], `triangles` [u32 | null; nu*nv] (the tool
 //! triangle of each placed node; an extension, optional when reading).
-use super::check::{cell_count, cells, check_net};
+use super::check::{cell_count, cells, check_net_shears};
 use super::{write_atomic, ExportError};
 use crate::geometry::Point;
 use crate::kinematic::net::{Method, NodeStatus, Timing};
@@ -22,13 +22,14 @@ use std::path::Path;
 /// Write `net` to `path` (normally `DIR/<ply>.drape.json`) atomically. Fails, writing nothing,
 /// if a placed node or a cell shear is not finite.
 pub fn write_json(net: &DrapeNet, path: &Path) -> Result<(), ExportError> {
-    check_net(net, false)?;
-    write_json_checked(net, path)
+    let shears = check_net_shears(net, false)?;
+    write_json_checked(net, &shears, path)
 }
 
-/// [`write_json`] of a net that `check_net` has passed.
-pub(crate) fn write_json_checked(net: &DrapeNet, path: &Path) -> Result<(), ExportError> {
-    write_atomic(path, |w| write_json_to(net, w))
+/// [`write_json`] of a net that `check_net` has passed, with the cell shears it computed
+/// ([`DrapeNet::cell_shears`]).
+pub(crate) fn write_json_checked(net: &DrapeNet, shears: &[Option<f64>], path: &Path) -> Result<(), ExportError> {
+    write_atomic(path, |w| write_json_to(net, shears, w))
 }
 
 /// Items per piece of an array formatted on one thread.
@@ -36,30 +37,57 @@ const PIECE: usize = 1 << 12;
 /// Pieces formatted in parallel before they are written, in order (bounds the memory held).
 const PIECES_AT_ONCE: usize = 32;
 
+/// The byte buffers of [`write_items`], kept from one array to the next so that their memory is
+/// allocated (and faulted in) once: one set being written while the other is formatted.
+struct Pieces {
+    written: Vec<Vec<u8>>,
+    formatted: Vec<Vec<u8>>,
+}
+
+impl Pieces {
+    fn new() -> Self {
+        Pieces { written: vec![Vec::new(); PIECES_AT_ONCE], formatted: vec![Vec::new(); PIECES_AT_ONCE] }
+    }
+}
+
 /// Write items `0..n` of an array, each appended to a byte buffer by `item` (separator
 /// included): pieces of [`PIECE`] items are formatted in parallel into their own buffers and
-/// written in order, so the bytes are those of a serial loop whatever the thread count.
-fn write_items<W: Write>(w: &mut W, n: usize, item: impl Fn(&mut Vec<u8>, usize) + Sync) -> io::Result<()> {
+/// written in order (the next [`PIECES_AT_ONCE`] pieces formatted while the last are written),
+/// so the bytes are those of a serial loop whatever the thread count.
+fn write_items<W: Write + Send>(
+    w: &mut W,
+    bufs: &mut Pieces,
+    n: usize,
+    item: impl Fn(&mut Vec<u8>, usize) + Sync,
+) -> io::Result<()> {
     let pieces = n.div_ceil(PIECE);
-    for first in (0..pieces).step_by(PIECES_AT_ONCE) {
-        let buffers: Vec<Vec<u8>> = (first..pieces.min(first + PIECES_AT_ONCE))
-            .into_par_iter()
-            .map(|p| {
-                let items = p * PIECE..n.min((p + 1) * PIECE);
-                let mut buf = Vec::with_capacity(items.len() * 72);
-                items.for_each(|k| item(&mut buf, k));
-                buf
-            })
-            .collect();
-        for b in buffers {
-            w.write_all(&b)?;
-        }
+    // Format pieces first.. (at most PIECES_AT_ONCE of them) into `into`; how many.
+    let format = |into: &mut [Vec<u8>], first: usize| -> usize {
+        let count = pieces.saturating_sub(first).min(PIECES_AT_ONCE);
+        into[..count].par_iter_mut().enumerate().for_each(|(q, buf)| {
+            let p = first + q;
+            buf.clear();
+            (p * PIECE..n.min((p + 1) * PIECE)).for_each(|k| item(buf, k));
+        });
+        count
+    };
+    let mut ready = format(&mut bufs.formatted, 0);
+    let mut first = 0;
+    while ready > 0 {
+        std::mem::swap(&mut bufs.written, &mut bufs.formatted);
+        first += PIECES_AT_ONCE;
+        let (to_write, to_format) = (&bufs.written[..ready], &mut bufs.formatted);
+        let (written, next) =
+            rayon::join(|| to_write.iter().try_for_each(|b| w.write_all(b)), || format(to_format, first));
+        written?;
+        ready = next;
     }
     Ok(())
 }
 
 /// The JSON document of a checked net (see the module doc for the layout).
-fn write_json_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
+fn write_json_to<W: Write + Send>(net: &DrapeNet, shears: &[Option<f64>], w: &mut W) -> io::Result<()> {
+    let bufs = &mut Pieces::new();
     w.write_all(b"{\n\"ply\": ")?;
     write_value(w, &net.name)?;
     w.write_all(b",\n\"method\": ")?;
@@ -96,7 +124,7 @@ fn write_json_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
     }
     w.write_all(b"},\n  \"node_codes\": [")?;
     let nv = net.nv;
-    write_items(w, net.status.len(), |b, k| {
+    write_items(w, bufs, net.status.len(), |b, k| {
         b.extend_from_slice(separator(k, nv).as_bytes());
         push_u32(b, u32::from(net.status[k] as u8));
     })?;
@@ -104,7 +132,7 @@ fn write_json_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
     write_value(w, &net.meta.to_json())?;
 
     w.write_all(b",\n\"nodes\": [")?;
-    write_items(w, net.positions.len(), |b, k| {
+    write_items(w, bufs, net.positions.len(), |b, k| {
         b.extend_from_slice(if k > 0 { b",\n" } else { b"\n" });
         if net.status[k] == NodeStatus::Placed {
             let p = net.positions[k];
@@ -120,16 +148,16 @@ fn write_json_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
         }
     })?;
     w.write_all(b"],\n\"cell_shear_deg\": [")?;
-    let cv = nv.saturating_sub(1);
-    write_items(w, cell_count(net), |b, k| {
+    debug_assert_eq!(shears.len(), cell_count(net));
+    write_items(w, bufs, shears.len(), |b, k| {
         b.extend_from_slice(if k > 0 { b",\n" } else { b"\n" });
-        match net.cell_shear(k / cv, k % cv) {
+        match shears[k] {
             Some(g) => push_f64(b, g.to_degrees()),
             None => b.extend_from_slice(b"null"),
         }
     })?;
     w.write_all(b"],\n\"triangles\": [")?;
-    write_items(w, net.triangles.len(), |b, k| {
+    write_items(w, bufs, net.triangles.len(), |b, k| {
         b.extend_from_slice(separator(k, nv).as_bytes());
         if net.status[k] == NodeStatus::Placed {
             push_u32(b, net.triangles[k]);

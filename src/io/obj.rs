@@ -98,7 +98,7 @@ fn parse_with(bytes: &[u8], fast: bool) -> Result<ObjText, ObjSyntaxError> {
             // ASCII bytes are valid UTF-8, and every word boundary below is an ASCII byte.
             let line = std::str::from_utf8(content).unwrap_or_default();
             if !line.trim_end_matches(is_space).ends_with('\\') {
-                statement_ascii(line, number, &mut text)?;
+                statement(line, ascii_words(line), number, &mut text)?;
                 continue;
             }
         }
@@ -111,10 +111,10 @@ fn parse_with(bytes: &[u8], fast: bool) -> Result<ObjText, ObjSyntaxError> {
             continue;
         }
         line.push_str(&raw);
-        statement(&line, start, &mut text)?;
+        statement(&line, line.split_whitespace(), start, &mut text)?;
     }
     if let Some((start, line)) = joined {
-        statement(&line, start, &mut text)?;
+        statement(&line, line.split_whitespace(), start, &mut text)?;
     }
     Ok(text)
 }
@@ -153,10 +153,16 @@ fn ascii_words(line: &str) -> impl Iterator<Item = &str> {
     line.split([' ', '\t', '\x0b', '\x0c']).filter(|w| !w.is_empty())
 }
 
-/// [`statement`] for a line of ASCII text: the same statements and errors, read without
-/// allocating.
-fn statement_ascii(line: &str, number: usize, text: &mut ObjText) -> Result<(), ObjSyntaxError> {
-    let mut words = ascii_words(line);
+/// Add one statement to `text`: `line` (a whole line, continuations joined) split into `words`,
+/// either at ASCII white space ([`ascii_words`], a line of ASCII text read from the bytes) or at
+/// any white space (`str::split_whitespace`, the text path), which split an ASCII line alike:
+/// one reading of the statements for both paths, without allocating.
+fn statement<'a>(
+    line: &str,
+    mut words: impl Iterator<Item = &'a str>,
+    number: usize,
+    text: &mut ObjText,
+) -> Result<(), ObjSyntaxError> {
     match words.next() {
         Some("v") => {
             let mut numbers = [0.0; 6];
@@ -272,39 +278,6 @@ fn resolve(i: i64, text: &ObjText, number: usize) -> Result<u64, ObjSyntaxError>
             ),
         }),
     }
-}
-
-/// Add one statement (a whole line, continuations joined) to `text`.
-fn statement(line: &str, number: usize, text: &mut ObjText) -> Result<(), ObjSyntaxError> {
-    let mut words = line.split_whitespace();
-    match words.next() {
-        Some("v") => {
-            let numbers: Option<Vec<f64>> = words.map(|w| w.parse::<f64>().ok()).collect();
-            let xyz = match numbers.as_deref() {
-                Some(&[x, y, z]) | Some(&[x, y, z, _, _, _]) => [x, y, z],
-                Some(&[x, y, z, w]) if w != 0.0 => [x / w, y / w, z / w],
-                _ => return Err(vertex_error(line, number)),
-            };
-            text.vertices.push((xyz, number));
-        }
-        Some("f") => {
-            let start = text.corners.len();
-            for word in words {
-                let parts: Vec<&str> = word.split('/').collect();
-                let well_formed = parts.len() <= 3 && parts.iter().all(|p| p.is_empty() || p.parse::<i64>().is_ok());
-                let Some(i) = parts[0].parse::<i64>().ok().filter(|_| well_formed) else {
-                    return Err(face_error(line, number));
-                };
-                let vertex = resolve(i, text, number)?;
-                text.corners.push(vertex);
-            }
-            text.faces.push(ObjFace { corners: start..text.corners.len(), line: number });
-        }
-        Some("l") => text.lines += 1,
-        Some("p") => text.points += 1,
-        _ => {}
-    }
-    Ok(())
 }
 
 /// A line, shortened for an error message.

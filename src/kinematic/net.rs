@@ -198,9 +198,31 @@ impl DrapeNet {
         Some(0.5 * (p11 - p00).cross(&(p01 - p10)).norm())
     }
 
+    /// Each cell's shear in radians ([`DrapeNet::cell_shear`]), in file order (index
+    /// i * (nv - 1) + j), `None` for a cell lacking a placed corner: computed in parallel, each
+    /// value a function of its cell alone, so the same whatever the thread count.
+    pub fn cell_shears(&self) -> Vec<Option<f64>> {
+        use rayon::prelude::*;
+        let cv = self.nv.saturating_sub(1);
+        let n = self.nu.saturating_sub(1) * cv;
+        (0..n).into_par_iter().with_min_len(1 << 12).map(|k| self.cell_shear(k / cv, k % cv)).collect()
+    }
+
     /// Shear and area statistics over the complete cells, `locking_angle` in radians: the one
     /// computation behind the run summary, the layup table and the report.
     pub fn shear_stats(&self, locking_angle: f64) -> ShearStats {
+        self.stats_of(locking_angle, |i, j| self.cell_shear(i, j))
+    }
+
+    /// [`DrapeNet::shear_stats`] from the cells' shears as [`DrapeNet::cell_shears`] gives them
+    /// (the same figures, without computing the shears again).
+    pub fn shear_stats_from(&self, shears: &[Option<f64>], locking_angle: f64) -> ShearStats {
+        let cv = self.nv.saturating_sub(1);
+        assert_eq!(shears.len(), self.nu.saturating_sub(1) * cv, "one shear per cell");
+        self.stats_of(locking_angle, |i, j| shears[i * cv + j])
+    }
+
+    fn stats_of(&self, locking_angle: f64, shear: impl Fn(usize, usize) -> Option<f64> + Sync) -> ShearStats {
         use rayon::prelude::*;
         /// Cells whose shear and area are computed in parallel before they are summed.
         const BATCH: usize = 1 << 16;
@@ -214,7 +236,7 @@ impl DrapeNet {
             let values: Vec<Option<(f64, f64)>> = (start..n.min(start + BATCH))
                 .into_par_iter()
                 .with_min_len(1 << 12)
-                .map(|k| Some((self.cell_shear(k / cv, k % cv)?, self.cell_area(k / cv, k % cv)?)))
+                .map(|k| Some((shear(k / cv, k % cv)?, self.cell_area(k / cv, k % cv)?)))
                 .collect();
             for (g, area) in values.into_iter().flatten() {
                 s.cells += 1;

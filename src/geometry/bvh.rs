@@ -1,0 +1,422 @@
+//! [`TriangleBvh`]: the bounding-volume hierarchy of a tool's triangles, built in parallel, and
+//! the three queries [`super::ToolSurface`] asks of it (closest triangle, first ray hit,
+//! triangles whose box meets a box).
+//!
+//! The answers do not depend on the shape of the tree, so neither on the thread count nor on
+//! how the tree is built: the closest triangle is the one of smallest squared distance (as the
+//! caller computes it) and, among equal distances, of lowest index; the ray hit is the smallest
+//! distance over all triangles; the box query's triangles come sorted by index. Pruning keeps
+//! a slack far above rounding, so a box is only skipped when none of its triangles can tie.
+//!
+//! The tree: triangles ordered by recursive median splits of their centroids along the longest
+//! axis (ties by index), the two halves of each split ordered in parallel; node `k` covers a
+//! range of that order, its children are nodes `2k + 1` and `2k + 2` (the two halves), and a
+//! range of at most [`LEAF`] triangles is a leaf.
+use super::{Point, Vector};
+
+/// Most triangles in a leaf.
+const LEAF: usize = 4;
+/// Ranges at least this long are split in parallel.
+const PARALLEL: usize = 1 << 12;
+/// Deeper than any tree this builds (2^64 triangles): the traversal stacks' size.
+const STACK: usize = 64;
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy)]
+struct Box3 {
+    min: [f64; 3],
+    max: [f64; 3],
+}
+
+impl Box3 {
+    const EMPTY: Box3 = Box3 { min: [f64::INFINITY; 3], max: [f64::NEG_INFINITY; 3] };
+
+    fn of(points: &[Point]) -> Box3 {
+        let mut b = Box3::EMPTY;
+        for p in points {
+            for a in 0..3 {
+                b.min[a] = b.min[a].min(p[a]);
+                b.max[a] = b.max[a].max(p[a]);
+            }
+        }
+        b
+    }
+
+    fn union(&self, o: &Box3) -> Box3 {
+        Box3 {
+            min: std::array::from_fn(|a| self.min[a].min(o.min[a])),
+            max: std::array::from_fn(|a| self.max[a].max(o.max[a])),
+        }
+    }
+
+    /// Whether the boxes meet (touching counts).
+    fn meets(&self, o: &Box3) -> bool {
+        (0..3).all(|a| self.min[a] <= o.max[a] && o.min[a] <= self.max[a])
+    }
+
+    /// Squared distance from `p` to the box (0 inside).
+    fn distance2(&self, p: &Point) -> f64 {
+        (0..3)
+            .map(|a| {
+                let d = (self.min[a] - p[a]).max(p[a] - self.max[a]).max(0.0);
+                d * d
+            })
+            .sum()
+    }
+
+    /// Distance along the ray to where it enters the box grown by `slack` on every side, if it
+    /// meets it within `max`.
+    fn ray_entry(&self, origin: &Point, dir: &Vector, slack: f64, max: f64) -> Option<f64> {
+        let (mut t0, mut t1) = (0.0f64, max);
+        for a in 0..3 {
+            let (lo, hi) = (self.min[a] - slack, self.max[a] + slack);
+            if dir[a] == 0.0 {
+                if origin[a] < lo || origin[a] > hi {
+                    return None;
+                }
+                continue;
+            }
+            let inv = 1.0 / dir[a];
+            let (mut ta, mut tb) = ((lo - origin[a]) * inv, (hi - origin[a]) * inv);
+            if ta > tb {
+                std::mem::swap(&mut ta, &mut tb);
+            }
+            t0 = t0.max(ta);
+            t1 = t1.min(tb);
+            if !(t0 <= t1) {
+                return None;
+            }
+        }
+        Some(t0)
+    }
+}
+
+/// A node: the box of its triangles and their range in [`TriangleBvh::order`]; `used` is false
+/// for the slots of the heap layout below a leaf.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Box3,
+    lo: u32,
+    hi: u32,
+}
+
+/// The hierarchy (see the module documentation).
+#[derive(Debug, Clone)]
+pub(crate) struct TriangleBvh {
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+    boxes: Vec<Box3>,
+    /// Pruning slack, far above rounding: 1e-9 of the boxes' diagonal.
+    slack: f64,
+}
+
+impl TriangleBvh {
+    /// The hierarchy of `triangles` (corner indices into `vertices`, all valid).
+    pub(crate) fn new(vertices: &[Point], triangles: &[[u32; 3]]) -> TriangleBvh {
+        use rayon::prelude::*;
+        let boxes: Vec<Box3> =
+            triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect();
+        let centroids: Vec<[f64; 3]> = boxes
+            .par_iter()
+            .with_min_len(PARALLEL)
+            .map(|b| std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a])))
+            .collect();
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        split(&mut order, &centroids);
+
+        // Heap layout: node k has children 2k + 1 and 2k + 2; ranges first (top down), then
+        // boxes (bottom up).
+        let n = order.len();
+        let mut size = 1;
+        let mut longest = n;
+        while longest > LEAF {
+            longest = longest.div_ceil(2);
+            size = 2 * size + 1;
+        }
+        let empty = Node { bounds: Box3::EMPTY, lo: 0, hi: 0 };
+        let mut nodes = vec![empty; size];
+        nodes[0] = Node { bounds: Box3::EMPTY, lo: 0, hi: n as u32 };
+        for k in 0..size {
+            let Node { lo, hi, .. } = nodes[k];
+            if (hi - lo) as usize > LEAF {
+                let mid = lo + (hi - lo) / 2;
+                nodes[2 * k + 1] = Node { bounds: Box3::EMPTY, lo, hi: mid };
+                nodes[2 * k + 2] = Node { bounds: Box3::EMPTY, lo: mid, hi };
+            }
+        }
+        for k in (0..size).rev() {
+            let Node { lo, hi, .. } = nodes[k];
+            nodes[k].bounds = if hi == lo {
+                Box3::EMPTY
+            } else if (hi - lo) as usize <= LEAF {
+                order[lo as usize..hi as usize].iter().fold(Box3::EMPTY, |b, &t| b.union(&boxes[t as usize]))
+            } else {
+                nodes[2 * k + 1].bounds.union(&nodes[2 * k + 2].bounds)
+            };
+        }
+        let root = nodes[0].bounds;
+        let diagonal = (0..3).map(|a| (root.max[a] - root.min[a]).powi(2)).sum::<f64>().sqrt();
+        let slack = if diagonal.is_finite() { 1e-9 * diagonal } else { 0.0 };
+        TriangleBvh { nodes, order, boxes, slack }
+    }
+
+    fn is_leaf(&self, node: &Node) -> bool {
+        ((node.hi - node.lo) as usize) <= LEAF
+    }
+
+    fn leaf(&self, node: &Node) -> &[u32] {
+        &self.order[node.lo as usize..node.hi as usize]
+    }
+
+    /// The triangle of smallest `distance2(t)` (a squared distance from `p`, at least the
+    /// squared distance from `p` to the triangle's box up to rounding), the lowest index among
+    /// equal ones, and that value. `None` only for a tree without triangles.
+    pub(crate) fn closest(&self, p: &Point, distance2: impl Fn(u32) -> f64) -> Option<(u32, f64)> {
+        let mut best: Option<(u32, f64)> = None;
+        // Boxes farther than this squared distance cannot hold a triangle as close as the best.
+        let mut bound = f64::INFINITY;
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if node.hi == node.lo || node.bounds.distance2(p) > bound {
+                continue;
+            }
+            if self.is_leaf(node) {
+                for &t in self.leaf(node) {
+                    let d = distance2(t);
+                    let better = match best {
+                        None => true,
+                        Some((bt, bd)) => d < bd || (d == bd && t < bt),
+                    };
+                    if better {
+                        best = Some((t, d));
+                        let r = d.sqrt() + self.slack;
+                        bound = if r.is_nan() { f64::INFINITY } else { r * r };
+                    }
+                }
+            } else {
+                let k = stack[top] as usize;
+                let (l, r) = (2 * k + 1, 2 * k + 2);
+                // The nearer child on top, visited first.
+                let (near, far) = if self.nodes[l].bounds.distance2(p) <= self.nodes[r].bounds.distance2(p) {
+                    (l, r)
+                } else {
+                    (r, l)
+                };
+                stack[top] = far as u32;
+                stack[top + 1] = near as u32;
+                top += 2;
+            }
+        }
+        best
+    }
+
+    /// The smallest `hit(t)` over the triangles (a distance along the unit ray from `origin`
+    /// along `dir`, at least the distance to where the ray enters the triangle's box), if any.
+    pub(crate) fn first_hit(&self, origin: &Point, dir: &Vector, hit: impl Fn(u32) -> Option<f64>) -> Option<f64> {
+        let mut best: Option<f64> = None;
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let k = stack[top] as usize;
+            let node = &self.nodes[k];
+            let reach = best.map_or(f64::MAX, |b| b + self.slack);
+            if node.hi == node.lo || node.bounds.ray_entry(origin, dir, self.slack, reach).is_none() {
+                continue;
+            }
+            if self.is_leaf(node) {
+                for &t in self.leaf(node) {
+                    if let Some(d) = hit(t) {
+                        if best.is_none_or(|b| d < b) {
+                            best = Some(d);
+                        }
+                    }
+                }
+            } else {
+                stack[top] = (2 * k + 2) as u32;
+                stack[top + 1] = (2 * k + 1) as u32;
+                top += 2;
+            }
+        }
+        best
+    }
+
+    /// Visit the triangles whose box meets the box `min`..`max`, until `visit` returns false.
+    fn each_meeting(&self, min: &Point, max: &Point, mut visit: impl FnMut(u32) -> bool) {
+        let query = Box3 { min: [min.x, min.y, min.z], max: [max.x, max.y, max.z] };
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let k = stack[top] as usize;
+            let node = &self.nodes[k];
+            if node.hi == node.lo || !node.bounds.meets(&query) {
+                continue;
+            }
+            if self.is_leaf(node) {
+                for &t in self.leaf(node) {
+                    if self.boxes[t as usize].meets(&query) && !visit(t) {
+                        return;
+                    }
+                }
+            } else {
+                stack[top] = (2 * k + 2) as u32;
+                stack[top + 1] = (2 * k + 1) as u32;
+                top += 2;
+            }
+        }
+    }
+
+    /// The triangles whose box meets the box `min`..`max`, by increasing index.
+    pub(crate) fn meeting(&self, min: &Point, max: &Point) -> Vec<u32> {
+        let mut out = Vec::new();
+        self.each_meeting(min, max, |t| {
+            out.push(t);
+            true
+        });
+        out.sort_unstable();
+        out
+    }
+
+    /// Whether any triangle's box meets the box `min`..`max`.
+    pub(crate) fn any_meeting(&self, min: &Point, max: &Point) -> bool {
+        let mut any = false;
+        self.each_meeting(min, max, |_| {
+            any = true;
+            false
+        });
+        any
+    }
+}
+
+/// Order `order` by recursive median splits of the centroids (see the module documentation).
+fn split(order: &mut [u32], centroids: &[[f64; 3]]) {
+    if order.len() <= LEAF {
+        return;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &t in order.iter() {
+        let c = &centroids[t as usize];
+        for a in 0..3 {
+            lo[a] = lo[a].min(c[a]);
+            hi[a] = hi[a].max(c[a]);
+        }
+    }
+    let mut axis = 0;
+    for a in 1..3 {
+        if hi[a] - lo[a] > hi[axis] - lo[axis] {
+            axis = a;
+        }
+    }
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&s, &t| {
+        centroids[s as usize][axis].total_cmp(&centroids[t as usize][axis]).then(s.cmp(&t))
+    });
+    let (left, right) = order.split_at_mut(mid);
+    if left.len() + right.len() >= PARALLEL {
+        rayon::join(|| split(left, centroids), || split(right, centroids));
+    } else {
+        split(left, centroids);
+        split(right, centroids);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wavy grid of triangles with many exact ties (a flat part) and some far ones.
+    fn mesh(n: usize) -> (Vec<Point>, Vec<[u32; 3]>) {
+        let mut v = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                let z = if x < 0.5 { 0.0 } else { (7.0 * x).sin() * (5.0 * y).cos() * 0.1 };
+                v.push(Point::new(x, y, z));
+            }
+        }
+        let id = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        (v, t)
+    }
+
+    #[test]
+    fn queries_equal_brute_force_whatever_the_thread_count() {
+        let (v, tris) = mesh(60);
+        let d2 = |t: u32, p: &Point| {
+            let [a, b, c] = tris[t as usize].map(|i| v[i as usize]);
+            (super::super::surface::closest_point_on_triangle(p, &a, &b, &c) - p).norm_squared()
+        };
+        let trees: Vec<TriangleBvh> = [1, 2, 3]
+            .into_iter()
+            .map(|threads| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| TriangleBvh::new(&v, &tris))
+            })
+            .collect();
+        for q in 0..400 {
+            let f = q as f64;
+            // Points above the flat half tie between facets sharing the foot; others do not.
+            let p =
+                Point::new((f * 0.618).fract() * 1.2 - 0.1, (f * 0.377).fract() * 1.2 - 0.1, (f * 0.29).fract() - 0.3);
+            let brute = (0..tris.len() as u32)
+                .map(|t| (t, d2(t, &p)))
+                .fold(None, |b: Option<(u32, f64)>, (t, d)| match b {
+                    Some((bt, bd)) if bd < d || (bd == d && bt < t) => Some((bt, bd)),
+                    _ => Some((t, d)),
+                })
+                .unwrap();
+            let r = 0.05;
+            let (lo, hi) = (p - Vector::repeat(r), p + Vector::repeat(r));
+            let near: Vec<u32> = (0..tris.len() as u32)
+                .filter(|&t| {
+                    let b = Box3::of(&tris[t as usize].map(|i| v[i as usize]));
+                    b.meets(&Box3 { min: [lo.x, lo.y, lo.z], max: [hi.x, hi.y, hi.z] })
+                })
+                .collect();
+            for tree in &trees {
+                assert_eq!(tree.closest(&p, |t| d2(t, &p)), Some(brute), "point {p:?}");
+                assert_eq!(tree.meeting(&lo, &hi), near);
+                assert_eq!(tree.any_meeting(&lo, &hi), !near.is_empty());
+            }
+        }
+        // A point exactly above a vertex of the flat half: six facets at distance 0.25, the
+        // lowest index wins.
+        let p = Point::new(0.25, 0.5, 0.25);
+        let ties: Vec<u32> = (0..tris.len() as u32).filter(|&t| d2(t, &p) == 0.0625).collect();
+        assert!(ties.len() > 1, "{ties:?}");
+        for tree in &trees {
+            assert_eq!(tree.closest(&p, |t| d2(t, &p)).unwrap().0, ties[0]);
+        }
+    }
+
+    #[test]
+    fn ray_hit_is_the_nearest_over_all_triangles() {
+        let (v, tris) = mesh(30);
+        let tree = TriangleBvh::new(&v, &tris);
+        use parry3d_f64::query::{Ray, RayCast};
+        let hit = |t: u32, o: &Point, d: &Vector| {
+            let [a, b, c] = tris[t as usize].map(|i| v[i as usize]);
+            parry3d_f64::shape::Triangle::new(a, b, c).cast_local_ray(&Ray::new(*o, *d), f64::MAX, false)
+        };
+        for q in 0..200 {
+            let f = q as f64;
+            let o = Point::new((f * 0.618).fract(), (f * 0.377).fract(), 1.0);
+            let d = Vector::new((f * 0.11).fract() - 0.5, (f * 0.23).fract() - 0.5, -1.0).normalize();
+            let brute = (0..tris.len() as u32).filter_map(|t| hit(t, &o, &d)).reduce(f64::min);
+            assert_eq!(tree.first_hit(&o, &d, |t| hit(t, &o, &d)), brute);
+        }
+        // Straight down onto the flat half, along an axis (zero direction components).
+        let (o, d) = (Point::new(0.2, 0.3, 1.0), -Vector::z());
+        assert_eq!(tree.first_hit(&o, &d, |t| hit(t, &o, &d)), Some(1.0));
+    }
+}
