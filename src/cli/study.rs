@@ -259,6 +259,12 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                         a.mechanical_time_s.unwrap_or_default()
                     ))
                 );
+                if let Some(m) = a.mechanical_within_tolerance_s {
+                    println!(
+                        "  mechanics within the tolerance takes {m:.3} s at best: auto costs {:.0}% of that",
+                        100.0 * a.time_s / m
+                    );
+                }
             }
         }
         Finished::Stability(s) => {

@@ -70,6 +70,10 @@ pub struct MethodChoice {
     pub requested: String,
     /// What ran: `kinematic` or `mechanical`.
     pub chosen: String,
+    /// The surface the kinematic net lay on: `facets` or `smooth` (the ply's own, or the
+    /// smooth surface when that net was within the tolerance and the one on the facets not).
+    #[serde(default)]
+    pub surface: String,
     /// The largest cell-shear error the ply accepts, degrees.
     pub tolerance_deg: f64,
     /// The fibre spacing that ran, m (finer than the ply's when the discretisation needed it).
@@ -98,6 +102,10 @@ pub struct ChoiceIndicators {
     /// shear by the model's stiffness (absent when the step could not be taken).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub equilibrium_step_deg: Option<f64>,
+    /// The same step from the kinematic net on the smooth surface, degrees, when the ply lies
+    /// on the facets and the step from that net was above the model's share of the tolerance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smooth_equilibrium_step_deg: Option<f64>,
     /// |F - P| / |P| of the mechanical model after that step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual_after_step: Option<f64>,

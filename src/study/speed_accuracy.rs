@@ -190,6 +190,10 @@ pub struct AutoCost {
     pub mechanical_time_s: Option<f64>,
     /// `time_s` over `mechanical_time_s`.
     pub cost_ratio: Option<f64>,
+    /// The fastest pressed mechanical run within the tolerance of the reference, s: what
+    /// mechanics costs for the same accuracy.
+    #[serde(default)]
+    pub mechanical_within_tolerance_s: Option<f64>,
 }
 
 /// `speed_accuracy.json`.
@@ -388,6 +392,12 @@ fn auto_costs(records: &[CaseRecord], points: &[SpeedPoint]) -> Vec<AutoCost> {
                 time_s: p.time_s,
                 mechanical_time_s: mech_time,
                 cost_ratio: mech_time.map(|m| p.time_s / m),
+                mechanical_within_tolerance_s: points
+                    .iter()
+                    .filter(|m| m.method == StudyMethod::MechanicalPressed.name() && m.outcome == "ok")
+                    .filter(|m| m.error_max_deg.is_some_and(|e| e <= c.tolerance_deg) && m.time_s > 0.0)
+                    .map(|m| m.time_s)
+                    .reduce(f64::min),
             })
         })
         .collect()
