@@ -284,3 +284,34 @@ fn refining_a_converged_free_drape_again_moves_no_node() {
     assert!(moved <= 1e-3 * spacing, "a node moved {moved} m");
     assert_eq!(b["meta"]["solver"]["converged"], serde_json::json!(true));
 }
+
+#[test]
+fn every_ply_of_the_hemisphere_layup_presses_to_equilibrium_on_the_stack_below_it() {
+    // The bundled four-ply layup with every ply mechanical. Before the plies below ended in a
+    // ramp (geometry::offset::PLY_DROP_SLOPE), the third and fourth plies stopped on the cliff
+    // one facet wide at the edge of the stack (`LineSearchFailed`, `Stalled`).
+    let text = std::fs::read_to_string(repo("geometries/hemisphere/scene.toml"))
+        .unwrap()
+        .replace("\"hemisphere-20k.obj\"", "\"@/geometries/hemisphere/hemisphere-20k.obj\"")
+        .replace("\"hemisphere-2k.obj\"", "\"@/geometries/hemisphere/hemisphere-2k.obj\"")
+        .replace("../../materials", "@/materials")
+        .replace("method = \"mechanical\"", "")
+        .replace("grid = [79, 79]", "grid = [79, 79]\nmethod = \"mechanical\"");
+    let (tool, plies) = drape_text(&text);
+    assert_eq!(plies.len(), 4);
+    for r in &plies {
+        assert!(converged(r), "ply {}", r.net.name);
+        let refined = r.refined.as_ref().unwrap();
+        assert!(refined.steps[0].energy_end <= refined.steps[0].energy_start, "ply {}", r.net.name);
+        // Every placed node lies on or above the tool (the stack below lifts the upper plies).
+        let placed = r.net.positions.iter().zip(&r.net.status);
+        for p in placed.filter(|(_, s)| **s == drape::kinematic::NodeStatus::Placed).map(|(p, _)| p) {
+            let foot = tool.closest_point(p);
+            assert!(
+                (p - foot.point).dot(&tool.normal(foot.triangle)) > -1e-4,
+                "ply {}: node {p} under the tool",
+                r.net.name
+            );
+        }
+    }
+}

@@ -197,6 +197,62 @@ fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> (usize, 
     (touched.iter().filter(|&&t| t).count(), folded.len())
 }
 
+/// Steepest rise, across the tool, of the surface a ply lies on where the plies below it end: a
+/// ply bridges the drop at the edge of the plies under it instead of following a cliff one facet
+/// wide (1 in 10, a usual ply-drop ramp). Why: a step of a stack thickness over one facet is a
+/// kink the smooth surface of the pressed contact cannot follow; the upper ply's mechanical drape
+/// stalled on it (the hemisphere's third and fourth plies, `LineSearchFailed` and `Stalled`).
+pub const PLY_DROP_SLOPE: f64 = 0.1;
+
+/// The least field at or above `distance` that rises by at most `slope` per metre along the tool's
+/// edges: every fall steeper than `slope` (a ply drop) becomes a ramp of that slope outward from
+/// the higher side, and gentler variations (thickening with shear) stay as they are. A max-plus
+/// Dijkstra from the highest vertices; ties are taken by vertex index, so the result does not
+/// depend on the order of equal values.
+pub fn ramp_drops(tool: &ToolSurface, distance: &[f64], slope: f64) -> Vec<f64> {
+    use std::cmp::Ordering;
+    use std::collections::BinaryHeap;
+    #[derive(PartialEq)]
+    struct Entry(f64, u32);
+    impl Eq for Entry {}
+    impl PartialOrd for Entry {
+        fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+            Some(self.cmp(other))
+        }
+    }
+    impl Ord for Entry {
+        fn cmp(&self, other: &Self) -> Ordering {
+            self.0.total_cmp(&other.0).then_with(|| other.1.cmp(&self.1))
+        }
+    }
+    let vertices = tool.vertices();
+    let n = vertices.len();
+    let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for tri in tool.triangles() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            ring[a as usize].push(b);
+            ring[b as usize].push(a);
+        }
+    }
+    let mut value = distance.to_vec();
+    let mut heap: BinaryHeap<Entry> =
+        value.iter().enumerate().filter(|(_, h)| **h > 0.0).map(|(v, &h)| Entry(h, v as u32)).collect();
+    while let Some(Entry(h, v)) = heap.pop() {
+        if h < value[v as usize] {
+            continue; // a stale entry: the vertex was raised again since
+        }
+        for &w in &ring[v as usize] {
+            let reach = h - slope * (vertices[w as usize] - vertices[v as usize]).norm();
+            if reach > value[w as usize] {
+                value[w as usize] = reach;
+                heap.push(Entry(reach, w));
+            }
+        }
+    }
+    value
+}
+
 /// The tool's vertices moved by `distance[v]` along `dirs[v]`.
 pub fn offset_vertices(tool: &ToolSurface, dirs: &[Vector], distance: &[f64]) -> Vec<Point> {
     tool.vertices().iter().zip(dirs).zip(distance).map(|((p, m), &h)| p + m * h).collect()
@@ -209,6 +265,47 @@ mod tests {
 
     /// Offsets agree with the analytic ones to this (metres), rounding only.
     const TOL: f64 = 1e-12;
+
+    #[test]
+    fn a_ply_drop_becomes_a_ramp_and_gentle_variations_stay() {
+        // A flat 1 x 1 plate of 20 x 20 squares; the stack is 2 mm (rising gently with x) on
+        // x < 0.5 and nothing beyond: a cliff one facet wide.
+        let n = 21;
+        let h = 1.0 / (n - 1) as f64;
+        let vertices: Vec<Point> =
+            (0..n * n).map(|k| Point::new((k % n) as f64 * h, (k / n) as f64 * h, 0.0)).collect();
+        let mut tris = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = (j * n + i) as u32;
+                tris.push([a, a + 1, a + n as u32 + 1]);
+                tris.push([a, a + n as u32 + 1, a + n as u32]);
+            }
+        }
+        let tool = ToolSurface::from_triangles(vertices.clone(), tris).unwrap();
+        let given: Vec<f64> = vertices.iter().map(|p| if p.x < 0.5 { 0.002 + 0.0001 * p.x } else { 0.0 }).collect();
+        let slope = 0.001;
+        let ramped = ramp_drops(&tool, &given, slope);
+        for (v, p) in vertices.iter().enumerate() {
+            assert!(ramped[v] >= given[v], "never below the stack");
+            if p.x < 0.5 {
+                assert_eq!(ramped[v], given[v], "a gentle rise is kept at {p:?}");
+            } else {
+                // Outward from the last covered column (x = 0.45) at the given slope, to zero.
+                let top = 0.002 + 0.0001 * 0.45;
+                let expect = (top - slope * (p.x - 0.45)).max(0.0);
+                assert!((ramped[v] - expect).abs() < TOL, "ramp at {p:?}: {} against {expect}", ramped[v]);
+            }
+        }
+        // No edge rises faster than the slope.
+        for tri in tool.triangles() {
+            for k in 0..3 {
+                let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
+                let length = (vertices[a] - vertices[b]).norm();
+                assert!((ramped[a] - ramped[b]).abs() <= slope * length + TOL);
+            }
+        }
+    }
 
     #[test]
     fn a_sphere_offset_is_a_larger_sphere_over_the_facet_planes() {

@@ -4,7 +4,9 @@
 use super::auto::choose;
 use super::flat::ply_pattern;
 use super::{Layup, Orientation, Ply, Refinement, StackSide, Start};
-use crate::geometry::offset::{offset_along, offset_directions, offset_vertices, OffsetReport};
+use crate::geometry::offset::{
+    offset_along, offset_directions, offset_vertices, ramp_drops, OffsetReport, PLY_DROP_SLOPE,
+};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
@@ -239,7 +241,8 @@ pub fn drape_layup(
         let name = ply.settings.name.clone();
         let line = ply.line;
         // Where this ply lies: the tool offset by the stack below it (before bridging corners).
-        let signed: Vec<f64> = stack.iter().map(|h| sign * h).collect();
+        // The plies below end in a ramp, not a cliff (see `PLY_DROP_SLOPE`).
+        let signed: Vec<f64> = ramp_drops(tool, &stack, PLY_DROP_SLOPE).iter().map(|h| sign * h).collect();
         let under = offset_vertices(tool, &dirs, &signed);
         let (offset_tool, offset) = if k == 0 {
             (None, OffsetReport::default())
