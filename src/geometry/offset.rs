@@ -198,11 +198,14 @@ fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> (usize, 
 }
 
 /// Steepest rise, across the tool, of the surface a ply lies on where the plies below it end: a
-/// ply bridges the drop at the edge of the plies under it instead of following a cliff one facet
-/// wide (1 in 10, a usual ply-drop ramp). Why: a step of a stack thickness over one facet is a
-/// kink the smooth surface of the pressed contact cannot follow; the upper ply's mechanical drape
-/// stalled on it (the hemisphere's third and fourth plies, `LineSearchFailed` and `Stalled`).
-pub const PLY_DROP_SLOPE: f64 = 0.1;
+/// ply bridges the drop at the edge of the plies under it (1 in 4: a 2 mm stack over 8 mm)
+/// instead of following a cliff one facet wide. Why: a step of a stack thickness over one facet
+/// is a kink the smooth surface of the pressed contact cannot follow; the upper plies'
+/// mechanical drape stopped on it (the hemisphere's third and fourth plies, `LineSearchFailed`
+/// and `Stalled`). A gentler 1 in 10 also cured those, but widened the ramps over the double
+/// dome's corners enough that its third ply (pushed past the tool's open edge there) ran out of
+/// iterations: the shortest ramp that spans a few facets changes the least.
+pub const PLY_DROP_SLOPE: f64 = 0.25;
 
 /// The least field at or above `distance` that rises by at most `slope` per metre along the tool's
 /// edges: every fall steeper than `slope` (a ply drop) becomes a ramp of that slope outward from
