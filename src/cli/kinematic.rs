@@ -6,8 +6,7 @@ use crate::io::points::read_points;
 use crate::io::{write_net_shears, Format};
 use crate::kinematic::fishnet::check_settings;
 use crate::kinematic::{drape, Extent, KinematicSettings, SurfaceKind};
-use crate::layup::auto::{choose, DEFAULT_TOLERANCE_DEG};
-use crate::layup::stack::refine_ply;
+use crate::layup::auto::{drape_auto, DEFAULT_TOLERANCE_DEG};
 use crate::layup::{locking_angle_deg, AutoModel, Refinement};
 use crate::material::MaterialCard;
 use crate::pipeline::{parse_generators, unit_scale};
@@ -141,11 +140,9 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     let mut net = match &auto {
         None => drape(&tool, &settings).map_err(input)?,
         Some((model, refinement)) => {
-            let chosen = choose(&tool, &settings, refinement, locking_angle.to_radians(), *model).map_err(input)?;
-            let mut net = chosen.net;
-            if chosen.choice.chosen == "mechanical" {
-                net = refine_ply(&net, &tool, refinement).map_err(|e| input(anyhow::anyhow!("refinement: {e}")))?.0;
-            }
+            let chosen = drape_auto(&tool, &settings, refinement, locking_angle.to_radians(), *model)
+                .map_err(|e| input(anyhow::anyhow!("{e}")))?;
+            let mut net = chosen.refined.map_or(chosen.kinematic, |(refined, _)| refined);
             println!("auto: ran {}: {}", chosen.choice.chosen, chosen.choice.reason);
             net.meta.method_choice = Some(chosen.choice);
             net

@@ -324,11 +324,19 @@ pub fn drape(tool: &ToolSurface, settings: &KinematicSettings) -> Result<DrapeNe
             let start = Instant::now();
             let smooth = SmoothSurface::new(tool);
             let build_ms = ms(start);
-            let mut net = drape_on(&smooth, settings)?;
+            let mut net = drape_smooth(&smooth, settings)?;
             net.timing.total_ms += build_ms;
             Ok(net)
         }
     }
+}
+
+/// Drape one ply on a smooth surface already built (for callers that drape several nets on
+/// it), with the checks [`drape`] makes.
+pub fn drape_smooth(smooth: &SmoothSurface, settings: &KinematicSettings) -> Result<DrapeNet, DrapeError> {
+    check_settings(settings)?;
+    check_spacing_on_tool(smooth.tool(), settings.spacing)?;
+    drape_on(smooth, settings)
 }
 
 /// Drape one ply on `surface` (whatever `settings.surface` says; the net's provenance records

@@ -25,13 +25,16 @@
 //!
 //! The choice, its reason and the measurements are recorded ([`MethodChoice`]) in the net's meta
 //! and in `layup.json`, and shown in the layup table and the report.
+use super::stack::refine_ply_on;
 use super::{AutoModel, Refinement};
+use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::ToolSurface;
 use crate::kinematic::fabric_field::ShearField;
-use crate::kinematic::fishnet::DrapeError;
-use crate::kinematic::{drape, ChoiceIndicators, DrapeNet, KinematicSettings, MethodChoice, SurfaceKind};
-use crate::mechanics::refine::{cell_changes, refine};
+use crate::kinematic::fishnet::{drape_on, drape_smooth, DrapeError};
+use crate::kinematic::{ChoiceIndicators, DrapeNet, KinematicSettings, MethodChoice, SurfaceKind};
+use crate::mechanics::refine::{cell_changes, refine_on, PressedSurface, RefineError, Refined};
 use crate::mechanics::SolverSettings;
+use std::cell::OnceCell;
 use std::time::Instant;
 
 /// Tolerance of `method = "auto"` when the ply gives none, degrees of cell shear.
@@ -64,10 +67,83 @@ impl AutoDrape {
     }
 }
 
-/// Drape `settings` on `surface` and choose its model (see the module doc). `refinement` is the
+/// A ply's tool and its smooth surface, built the first time a step needs it and shared by
+/// every drape and mechanical step after (the choice drapes up to four nets and takes up to
+/// two steps on one tool).
+pub struct Surfaces<'a> {
+    tool: &'a ToolSurface,
+    smooth: OnceCell<SmoothSurface<'a>>,
+}
+
+impl<'a> Surfaces<'a> {
+    /// The tool, its smooth surface not yet built.
+    pub fn new(tool: &'a ToolSurface) -> Self {
+        Self { tool, smooth: OnceCell::new() }
+    }
+
+    /// The tool's smooth surface (built on first use).
+    pub fn smooth(&self) -> &SmoothSurface<'a> {
+        self.smooth.get_or_init(|| SmoothSurface::new(self.tool))
+    }
+
+    /// The kinematic drape on the surface `settings` names.
+    fn drape(&self, settings: &KinematicSettings) -> Result<DrapeNet, DrapeError> {
+        match settings.surface {
+            SurfaceKind::Facets => drape_on(self.tool, settings),
+            SurfaceKind::Smooth => drape_smooth(self.smooth(), settings),
+        }
+    }
+
+    /// The smooth surface where `r`'s pressed contact slides on it.
+    fn for_refinement(&self, r: &Refinement) -> Option<&SmoothSurface<'a>> {
+        (r.settings().pressed_surface == PressedSurface::Smooth).then(|| self.smooth())
+    }
+}
+
+/// What a ply with `method = "auto"` gives: the kinematic net the choice kept (or mechanics
+/// started from), the refined net and the solver's record if mechanics ran, and the choice.
+pub struct AutoResult {
+    /// The kinematic net.
+    pub kinematic: DrapeNet,
+    /// The refined net and the solver's record, when mechanics was chosen.
+    pub refined: Option<(DrapeNet, Refined)>,
+    /// What was chosen and why.
+    pub choice: MethodChoice,
+}
+
+/// Why an automatic ply could not be drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum AutoError {
+    /// The kinematic drape failed.
+    #[error(transparent)]
+    Drape(#[from] DrapeError),
+    /// Mechanics was chosen and could not run.
+    #[error("refinement: {0}")]
+    Refine(#[from] RefineError),
+}
+
+/// Choose the ply's model ([`choose`]) and run mechanics if it was chosen, on one smooth surface.
+pub fn drape_auto(
+    surface: &ToolSurface,
+    settings: &KinematicSettings,
+    refinement: &Refinement,
+    locking_angle: f64,
+    auto: AutoModel,
+) -> Result<AutoResult, AutoError> {
+    let surfaces = Surfaces::new(surface);
+    let a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
+    let refined = if a.mechanical() {
+        Some(refine_ply_on(&a.net, surface, surfaces.for_refinement(refinement), refinement)?)
+    } else {
+        None
+    };
+    Ok(AutoResult { kinematic: a.net, refined, choice: a.choice })
+}
+
+/// Drape `settings` on `surfaces` and choose its model (see the module doc). `refinement` is the
 /// mechanical stage that runs if chosen (pressed), `locking_angle` the ply's, radians.
 pub fn choose(
-    surface: &ToolSurface,
+    surfaces: &Surfaces,
     settings: &KinematicSettings,
     refinement: &Refinement,
     locking_angle: f64,
@@ -77,11 +153,11 @@ pub fn choose(
     let tolerance = auto.tolerance_deg;
     let spacing_budget = SPACING_SHARE * tolerance;
     let model_budget = tolerance - spacing_budget;
-    let own = drape(surface, settings)?;
+    let own = surfaces.drape(settings)?;
     let d = settings.spacing;
     let stats = own.shear_stats(locking_angle);
     let locking_share = if stats.area > 0.0 { stats.area_over_locking / stats.area } else { 0.0 };
-    let step = equilibrium_step(surface, &own, refinement);
+    let step = equilibrium_step(surfaces, &own, refinement);
     // Pressed mechanics slides on the smooth surface over the facets: on a coarse tool most of
     // the step from a net on the facets is the facets' own error, which the kinematic net on
     // the smooth surface does not have (double dome, d = 5 mm: 2.4 deg from the pressed drape
@@ -89,8 +165,8 @@ pub fn choose(
     let mut smooth = None;
     if settings.surface == SurfaceKind::Facets && matches!(step, Ok((deg, _)) if deg > model_budget) {
         let s = KinematicSettings { surface: SurfaceKind::Smooth, ..settings.clone() };
-        if let Ok(net) = drape(surface, &s) {
-            if let Ok(smooth_step) = equilibrium_step(surface, &net, refinement) {
+        if let Ok(net) = surfaces.drape(&s) {
+            if let Ok(smooth_step) = equilibrium_step(surfaces, &net, refinement) {
                 smooth = Some((net, s, smooth_step));
             }
         }
@@ -142,7 +218,7 @@ pub fn choose(
         _ => (own, settings.clone()),
     };
     let settings = &settings;
-    let discretisation = discretisation_error(surface, settings, &net);
+    let discretisation = discretisation_error(surfaces, settings, &net);
     let spacing_needed =
         discretisation.filter(|e| *e > spacing_budget).map(|e| d * (spacing_budget / e).powf(1.0 / FISHNET_ORDER));
     indicators.discretisation_deg = discretisation;
@@ -159,7 +235,7 @@ pub fn choose(
     } else if let Some(needed) = spacing_needed {
         let k = ((d / needed).ceil() as usize).clamp(2, MAX_REFINEMENT);
         let finer = settings.at_spacing(d / k as f64);
-        match drape(surface, &finer) {
+        match surfaces.drape(&finer) {
             Ok(n) => {
                 net = n;
                 spacing = finer.spacing;
@@ -197,8 +273,8 @@ pub fn choose(
 
 /// Richardson's estimate of the largest cell-shear error of `net` (drawn with `settings`) from
 /// its spacing, degrees: against the net at twice the spacing at `net`'s complete cell centres.
-fn discretisation_error(surface: &ToolSurface, settings: &KinematicSettings, net: &DrapeNet) -> Option<f64> {
-    let coarse = drape(surface, &settings.at_spacing(2.0 * settings.spacing)).ok()?;
+fn discretisation_error(surfaces: &Surfaces, settings: &KinematicSettings, net: &DrapeNet) -> Option<f64> {
+    let coarse = surfaces.drape(&settings.at_spacing(2.0 * settings.spacing)).ok()?;
     let (fine, coarse) = (ShearField::of(net), ShearField::of(&coarse));
     let largest = fine
         .complete_cell_centres()
@@ -210,11 +286,12 @@ fn discretisation_error(surface: &ToolSurface, settings: &KinematicSettings, net
 
 /// One step of the mechanical model from `net`: the largest cell-shear change, degrees, and
 /// |F - P| / |P| after it; or why no step could be taken.
-fn equilibrium_step(surface: &ToolSurface, net: &DrapeNet, r: &Refinement) -> Result<(f64, f64), String> {
+fn equilibrium_step(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Result<(f64, f64), String> {
     let mut settings = r.settings();
     settings.load_steps = 1;
     settings.solver = SolverSettings { max_iterations: 1, ..settings.solver };
-    let refined = refine(net, surface, &r.material, &settings).map_err(|e| e.to_string())?;
+    let refined =
+        refine_on(net, surfaces.tool, surfaces.for_refinement(r), &r.material, &settings).map_err(|e| e.to_string())?;
     let change =
         cell_changes(net, &refined.net).into_iter().flatten().map(|(g, _)| g.abs().to_degrees()).fold(0.0, f64::max);
     Ok((change, refined.steps.last().map_or(0.0, |s| s.residual)))

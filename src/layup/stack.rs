@@ -1,12 +1,13 @@
 //! Draping a layup: each ply in stacking order on the tool offset by the plies below it, its warp
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
-use super::auto::choose;
+use super::auto::{drape_auto, AutoError};
 use super::flat::ply_pattern;
 use super::{Layup, Orientation, Ply, Refinement, StackSide, Start};
 use crate::geometry::offset::{
     offset_along, offset_directions, offset_vertices, ramp_drops, OffsetReport, PLY_DROP_SLOPE,
 };
+use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
@@ -14,7 +15,7 @@ use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice};
 use crate::material::flow::sheared_thickness;
-use crate::mechanics::refine::{annotate, refine, RefineError, Refined};
+use crate::mechanics::refine::{annotate, refine_on, RefineError, Refined};
 use crate::mechanics::sheet::{default_origin_node, flat_sheet, SheetError};
 use std::time::Instant;
 
@@ -277,34 +278,32 @@ pub fn drape_layup(
         .map_err(|message| LayupError::Orientation { ply: name.clone(), line, message })?;
         settings.warp = warp;
         let drape_error = |source| LayupError::Drape { ply: name.clone(), line, source };
-        let (mut net, choice) = match (start, &ply.auto, &ply.refinement) {
+        let refine_error = |source| LayupError::Refine { ply: name.clone(), line, source };
+        // The net mechanics starts from (or the kinematic net that stands), the refined net and
+        // the solver's record when mechanics ran, and an automatic ply's choice.
+        let (start_net, refined, choice) = match (start, &ply.auto, &ply.refinement) {
             (Start::Kinematic, Some(auto), Some(r)) => {
-                let a = choose(surface, &settings, r, ply.locking_angle, *auto).map_err(drape_error)?;
-                let mechanical = a.mechanical();
-                (a.net, Some((a.choice, mechanical)))
+                let a = drape_auto(surface, &settings, r, ply.locking_angle, *auto).map_err(|e| match e {
+                    AutoError::Drape(source) => drape_error(source),
+                    AutoError::Refine(source) => refine_error(source),
+                })?;
+                (a.kinematic, a.refined, Some(a.choice))
             }
-            (Start::Kinematic, _, _) => (drape(surface, &settings).map_err(drape_error)?, None),
-            (Start::Flat { normal }, _, _) => (
-                flat_start(ply, &settings, &normal, surface).map_err(|source| LayupError::Refine {
-                    ply: name.clone(),
-                    line,
-                    source: source.into(),
-                })?,
-                None,
-            ),
+            (Start::Kinematic, _, r) => {
+                let net = drape(surface, &settings).map_err(drape_error)?;
+                let refined = r.as_ref().map(|r| refine_ply(&net, surface, r)).transpose().map_err(refine_error)?;
+                (net, refined, None)
+            }
+            (Start::Flat { normal }, _, r) => {
+                let net = flat_start(ply, &settings, &normal, surface).map_err(|source| refine_error(source.into()))?;
+                let refined = r.as_ref().map(|r| refine_ply(&net, surface, r)).transpose().map_err(refine_error)?;
+                (net, refined, None)
+            }
         };
-        let run_mechanics = choice.as_ref().map_or(ply.refinement.is_some(), |(_, m)| *m);
-        let mut refined = None;
-        if let Some(r) = ply.refinement.as_ref().filter(|_| run_mechanics) {
-            let (out, result) = refine_ply(&net, surface, r).map_err(|source| LayupError::Refine {
-                ply: name.clone(),
-                line,
-                source,
-            })?;
-            net = out;
-            refined = Some(result);
-        }
-        let choice = choice.map(|(c, _)| c);
+        let (mut net, refined) = match refined {
+            Some((out, result)) => (out, Some(result)),
+            None => (start_net, None),
+        };
         net.meta.method_choice = choice.clone();
         // What later stages (exports, reports) need to know about the ply.
         net.meta.stack_offset_max_m = Some(offset.max_distance);
@@ -333,8 +332,18 @@ pub fn drape_layup(
 /// Refine a ply's kinematic `net` on `surface` as `r` says: the refined net, annotated with the
 /// solver's record and the change from the kinematic net, and the solver's result.
 pub fn refine_ply(net: &DrapeNet, surface: &ToolSurface, r: &Refinement) -> Result<(DrapeNet, Refined), RefineError> {
+    refine_ply_on(net, surface, None, r)
+}
+
+/// [`refine_ply`] with `surface`'s smooth surface already built.
+pub fn refine_ply_on(
+    net: &DrapeNet,
+    surface: &ToolSurface,
+    smooth: Option<&SmoothSurface>,
+    r: &Refinement,
+) -> Result<(DrapeNet, Refined), RefineError> {
     let t = Instant::now();
-    let result = refine(net, surface, &r.material, &r.settings())?;
+    let result = refine_on(net, surface, smooth, &r.material, &r.settings())?;
     let mut out = result.net.clone();
     annotate(&mut out, net, &result, &r.material_path);
     out.timing.load_ms = net.timing.load_ms;

@@ -221,6 +221,18 @@ pub fn refine<L: Laws + ?Sized>(
     laws: &L,
     settings: &RefineSettings,
 ) -> Result<Refined, RefineError> {
+    refine_on(kinematic, tool, None, laws, settings)
+}
+
+/// [`refine`] with the tool's smooth surface already built (`smooth`, of `tool`), for callers
+/// that use it before (a kinematic drape on it, or a first step): built once, not per call.
+pub fn refine_on<L: Laws + ?Sized>(
+    kinematic: &DrapeNet,
+    tool: &ToolSurface,
+    smooth: Option<&SmoothSurface>,
+    laws: &L,
+    settings: &RefineSettings,
+) -> Result<Refined, RefineError> {
     if settings.load_steps == 0 {
         return Err(RefineError::LoadSteps);
     }
@@ -239,13 +251,14 @@ pub fn refine<L: Laws + ?Sized>(
     // Nodes meet the smooth patches: on the facets themselves a net finer than them crawls from
     // edge to edge (see the module doc of `geometry::smooth`).
     let on_patches = settings.pressed_surface == PressedSurface::Smooth;
-    let smooth = on_patches.then(|| SmoothSurface::new(tool));
-    let surface: &dyn ContactSurface = match &smooth {
+    let built = (on_patches && smooth.is_none()).then(|| SmoothSurface::new(tool));
+    let smooth = if on_patches { smooth.or(built.as_ref()) } else { None };
+    let surface: &dyn ContactSurface = match smooth {
         Some(s) => s,
         None => tool,
     };
     let mut x = kinematic.positions.clone();
-    if let (Some(smooth), ContactMode::Pressed) = (&smooth, settings.mode) {
+    if let (Some(smooth), ContactMode::Pressed) = (smooth, settings.mode) {
         use rayon::prelude::*;
         x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);
     }
