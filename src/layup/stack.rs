@@ -72,6 +72,9 @@ pub struct PlyResult {
     pub net: DrapeNet,
     /// The solver's record, for a mechanical ply.
     pub refined: Option<Refined>,
+    /// For a mechanical ply started from a kinematic drape: that kinematic net (the report
+    /// draws it beside the refined one).
+    pub kinematic: Option<DrapeNet>,
     /// For a ply with `method = "auto"`: what ran and why.
     pub choice: Option<MethodChoice>,
     /// The warp direction at the seed, resolved on the ply's surface.
@@ -292,13 +295,16 @@ pub fn drape_layup(
         };
         let run_mechanics = choice.as_ref().map_or(ply.refinement.is_some(), |(_, m)| *m);
         let mut refined = None;
+        let mut kinematic = None;
         if let Some(r) = ply.refinement.as_ref().filter(|_| run_mechanics) {
             let (out, result) = refine_ply(&net, surface, r).map_err(|source| LayupError::Refine {
                 ply: name.clone(),
                 line,
                 source,
             })?;
-            net = out;
+            // A flat sheet is not a kinematic drape: only a kinematic start is kept.
+            let start_net = std::mem::replace(&mut net, out);
+            kinematic = matches!(start, Start::Kinematic).then_some(start_net);
             refined = Some(result);
         }
         let choice = choice.map(|(c, _)| c);
@@ -322,7 +328,7 @@ pub fn drape_layup(
             Extent::Grid { .. } => None,
         };
         let stats = ply_stats(&net, surface, outline.as_ref(), ply.locking_angle, areal_mass);
-        results.push(PlyResult { net, refined, choice, warp, offset, stats });
+        results.push(PlyResult { net, refined, kinematic, choice, warp, offset, stats });
     }
     Ok(results)
 }
