@@ -11,8 +11,11 @@
 //! - `<ply>-histogram.png/.svg`: the distribution of signed shear with the locking angle marked;
 //! - for a mechanical ply, `<ply>-change.png` (the change of shear from the kinematic net, on
 //!   the same views) and `<ply>-change-histogram.png/.svg`, with the largest and mean change;
+//!   and when the run kept the kinematic net it started from (`<ply>.kinematic.json`),
+//!   `<ply>-kinematic.png`: that net from the same views and window on the same colour scale,
+//!   shown beside `<ply>-shear.png`;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
-//!   nets), laminate totals, what each node status means, the interactive 3D view (the
+//!   nets), laminate totals, the flow-mesh export as `layup.json` records it, what each node status means, the interactive 3D view (the
 //!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
 //!   (`*.svg` in DIR) and notes on whatever could not be drawn.
 //!
@@ -590,8 +593,12 @@ fn viewer_section(inputs: &[PlyInput], tools: &BTreeMap<PathBuf, Result<RawTool,
             tool_vertices: v.as_deref(),
         })
         .collect();
-    let tool = inputs.iter().zip(&scaled).find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())));
-    viewer::section(&viewer::data_json(tool, &plies, limit))
+    let tool = inputs
+        .iter()
+        .zip(&scaled)
+        .find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())))
+        .map(|(v, t)| viewer::ViewTool::new(v, t, viewer::TOOL_TRIANGLE_LIMIT));
+    viewer::section(&viewer::data_json(tool.as_ref(), &plies, limit), tool.as_ref())
 }
 
 /// The table row of a net that `layup.json` does not list: its shear statistics and, when its
