@@ -650,6 +650,35 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
         assert!(export.contains(&format!("{} of 2116", p.covered)), "ply {}: {export}", p.name);
     }
 
+    // The run owns its folder: run again with every ply kinematic and the kept net goes.
+    let scenes = tmp.path().join("scene");
+    std::fs::create_dir(&scenes).unwrap();
+    for f in ["hemisphere-20k.obj", "hemisphere-2k.obj"] {
+        std::fs::copy(scene.with_file_name(f), scenes.join(f)).unwrap();
+    }
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("method = \"mechanical\""));
+    let text = text
+        .replace("method = \"mechanical\"", "method = \"kinematic\"")
+        .replace("../../materials/", &format!("{}/materials/", env!("CARGO_MANIFEST_DIR")));
+    std::fs::write(scenes.join("scene.toml"), text).unwrap();
+    let rerun = tmp.path().join("rerun");
+    copy_dir(&out, &rerun);
+    assert!(rerun.join("p0.kinematic.json").is_file());
+    assert_cmd::Command::cargo_bin("drape")
+        .unwrap()
+        .args([
+            "run",
+            scenes.join("scene.toml").to_str().unwrap(),
+            "--out",
+            rerun.to_str().unwrap(),
+            "--format",
+            "json",
+        ])
+        .assert()
+        .success();
+    assert!(!rerun.join("p0.kinematic.json").exists(), "a later run removes the kinematic net it does not write");
+
     let seen = browse(&report.join("index.html"), &tmp.path().join("view.png"));
     assert_eq!(seen["errors"], serde_json::json!([]), "console errors");
     assert_eq!(seen["plies"], 4);
@@ -660,4 +689,15 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
     let height = seen["height"].as_u64().unwrap();
     eprintln!("four-ply page: {height} px");
     assert!(height < 7000, "the four-ply page is {height} px long");
+}
+
+/// Copy the files of folder `from` into a new folder `to`.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_file() {
+            std::fs::copy(&p, to.join(p.file_name().unwrap())).unwrap();
+        }
+    }
 }

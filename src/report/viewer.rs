@@ -230,7 +230,14 @@ mod tests {
         // A 193,600-triangle hemisphere of radius 1.
         let mesh = crate::geometry::shapes::hemisphere(1.0, 220);
         assert!(mesh.triangles.len() > 3 * TOOL_TRIANGLE_LIMIT, "{}", mesh.triangles.len());
+        let clock = std::time::Instant::now();
         let t = ViewTool::new(&mesh.vertices, &mesh.triangles, TOOL_TRIANGLE_LIMIT);
+        eprintln!(
+            "decimated {} triangles to {} in {:.0} ms",
+            mesh.triangles.len(),
+            t.triangles.len(),
+            clock.elapsed().as_secs_f64() * 1e3
+        );
         assert!(t.decimated() && t.original_triangles == mesh.triangles.len());
         // Within the limit, yet not needlessly coarse: the finest grid that fits.
         let n = t.triangles.len();
