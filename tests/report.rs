@@ -23,6 +23,8 @@ const CHANGE_STEP: f64 = 0.2;
 const MIN_TOOL_PIXELS: usize = 5000;
 /// Width of the legend column on the right of a shaded picture.
 const LEGEND_COLUMN: u32 = 240;
+/// Height of a shaded picture's title and subtitle band, pixels.
+const TITLE_BAND: u32 = 66;
 
 /// Write a hemisphere tool with `subdivisions` and drape ply `p0` on it; plus `p0mech`, a
 /// mechanical copy with change_from_kinematic = CHANGE_STEP deg * (i - j) per cell (null where
@@ -48,6 +50,8 @@ fn make_run(dir: &Path, subdivisions: usize) -> (DrapeNet, DrapeNet) {
     mech.meta.material = Some("materials/glass-plain-weave.toml".into());
     write_net(&net, dir, &[Format::Json]).unwrap();
     write_net(&mech, dir, &[Format::Json]).unwrap();
+    // The kinematic net the mechanical copy "started from", as `drape run` keeps it.
+    drape::io::write_json(&net, &drape::io::kinematic_net_path(dir, "p0mech")).unwrap();
     (net, mech)
 }
 
@@ -155,6 +159,7 @@ fn report_draws_every_ply_and_the_page_shows_them() {
             "p0-histogram.png",
             "p0-histogram.svg",
             "p0mech-shear.png",
+            "p0mech-kinematic.png",
             "p0mech-histogram.png",
             "p0mech-histogram.svg",
             "p0mech-change.png",
@@ -233,6 +238,24 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     assert!(c.largest_deg.abs() > 4.0 && c.mean_abs_deg > 1.0, "{c:?}");
     check_picture(&out.join("p0mech-change-histogram.png"));
 
+    // Kinematic against mechanical: the kinematic start is drawn from the mechanical ply's views
+    // and window on the layup's scale. The mechanical copy has the kinematic net's nodes, so the
+    // two pictures are the same below the title band (the titles differ); its figures are p0's.
+    let k = summary.plies[1].kinematic.expect("p0mech's kinematic net is beside it");
+    assert_eq!((k.cells, k.max_abs_shear_deg), (p.cells, p.max_abs_shear_deg));
+    assert_eq!(summary.plies[1].views, p.views);
+    assert!(summary.plies[0].kinematic.is_none(), "a kinematic ply has no side by side");
+    let (_, _, a) = decode(&out.join("p0mech-shear.png"));
+    let (_, _, b) = decode(&out.join("p0mech-kinematic.png"));
+    let below_title = TITLE_BAND as usize * WIDTH as usize;
+    let differ = a[below_title..].iter().zip(&b[below_title..]).filter(|(x, y)| x != y).count();
+    assert!(
+        differ * 1000 < a.len(),
+        "p0mech-kinematic.png differs from p0mech-shear.png in {differ} pixels below the title"
+    );
+    let differ_all = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert!(differ_all > 500, "the titles differ: {differ_all} pixels");
+
     check_svg(&out.join("p0-histogram.svg"), 10);
 
     // The page: every picture, one table row per ply, in order.
@@ -248,6 +271,17 @@ fn report_draws_every_ply_and_the_page_shows_them() {
     assert!(rows[1].contains("mechanical") && rows[1].contains("glass-plain-weave"));
     assert!(html.contains("computed from the nets"));
     assert!(!html.contains("NaN"));
+    // The side-by-side section: two pictures, then the difference map and its histogram.
+    let compare =
+        html.split("<section class=\"compare\" id=\"compare-p0mech\">").nth(1).expect("side by side of p0mech");
+    let compare = &compare[..compare.find("</section>").unwrap()];
+    let pictures: Vec<&str> = compare.split("<img src=\"").skip(1).map(|s| &s[..s.find('"').unwrap()]).collect();
+    assert_eq!(
+        pictures,
+        ["p0mech-kinematic.png", "p0mech-shear.png", "p0mech-change.png", "p0mech-change-histogram.png"]
+    );
+    assert!(compare.contains(&format!("{:+.2}°", c.largest_deg)), "the largest change is named: {compare}");
+    assert_eq!(html.matches("class=\"compare\"").count(), 1, "p0 is kinematic: no side by side");
 
     // Deterministic: a second report is byte-identical.
     let again = dir.join("again");
@@ -359,7 +393,7 @@ fn cli_report() {
         .assert()
         .success();
     let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
-    assert!(stdout.contains("ply p0:") && stdout.contains("wrote 10 files"), "{stdout}");
+    assert!(stdout.contains("ply p0:") && stdout.contains("wrote 11 files"), "{stdout}");
     assert!(out.join("index.html").is_file() && out.join("p0mech-change.png").is_file());
     // Bad input: exit code 2 and a message naming the folder.
     let empty = tmp.path().join("empty");
@@ -487,6 +521,25 @@ fn report_views_see_every_wall_of_a_hat_box() {
     assert!(html.contains("id=\"statuses\"") && html.contains(drape::report::status_meaning(status)), "status table");
 }
 
+/// What headless Chromium saw of a report page (tools/report_browser.py).
+fn browse(index: &Path, shot: &Path) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/report_browser.py");
+    let run = std::process::Command::new("python3")
+        .arg(&script)
+        .arg(index)
+        .arg(shot)
+        .output()
+        .expect("python3 must run tools/report_browser.py (tools/run-tests installs its requirements)");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "tools/report_browser.py failed ({}): {stdout}\n{}\nChromium and the Python requirements are installed by tools/run-tests.",
+        run.status,
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_str(stdout.trim()).unwrap()
+}
+
 /// The page as a person sees it: headless Chromium (installed by tools/run-tests) opens
 /// index.html with every host name unresolvable; the page must load with no console error and
 /// no request beyond local files, every picture must load, the 3D view must draw the part (a
@@ -499,22 +552,7 @@ fn report_page_in_chromium() {
     make_flat_and_curved(dir);
     let out = dir.join("r");
     write_report(dir, &out, false).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/report_browser.py");
-    let shot = dir.join("view.png");
-    let run = std::process::Command::new("python3")
-        .arg(&script)
-        .arg(out.join("index.html"))
-        .arg(&shot)
-        .output()
-        .expect("python3 must run tools/report_browser.py (tools/run-tests installs its requirements)");
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "tools/report_browser.py failed ({}): {stdout}\n{}\nChromium and the Python requirements are installed by tools/run-tests.",
-        run.status,
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let seen: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let seen = browse(&out.join("index.html"), &dir.join("view.png"));
     eprintln!("chromium saw: {seen}");
     assert_eq!(seen["loaded"], true);
     assert_eq!(seen["errors"], serde_json::json!([]), "console errors");
@@ -533,4 +571,133 @@ fn report_page_in_chromium() {
     // Two plies with their pictures, the table, the 3D view: a page, not a scroll of 15,000 px.
     let height = seen["height"].as_u64().unwrap();
     assert!(height < 6000, "the page is {height} px long");
+}
+
+/// `drape run` of the bundled four-ply hemisphere scene (the first ply pressed mechanically,
+/// the plies mapped onto a 2,116-element flow mesh) and `drape report` of it: the run keeps the
+/// mechanical ply's kinematic net beside it and lists it; the page shows the two side by side
+/// (its change lies within the solver's noise, so no difference map, said so), no side by side
+/// for the kinematic plies, the flow-mesh export from the run's record (the covered counts are
+/// those of flow.csv), and in Chromium the four-ply page loads every picture and stays under
+/// 7,000 px.
+#[test]
+fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("geometries/hemisphere/scene.toml");
+    assert_cmd::Command::cargo_bin("drape")
+        .unwrap()
+        .args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"])
+        .assert()
+        .success();
+    assert!(out.join("p0.kinematic.json").is_file(), "the mechanical ply's kinematic net is kept");
+    for k in ["p45", "p90", "m45"] {
+        assert!(!out.join(format!("{k}.kinematic.json")).exists(), "{k} is kinematic");
+    }
+    let kinematic = drape::io::read_net(&out.join("p0.kinematic.json")).unwrap();
+    let refined = drape::io::read_net(&out.join("p0.drape.json")).unwrap();
+    assert_eq!((kinematic.method, refined.method), (Method::Kinematic, Method::Mechanical));
+    assert_eq!((kinematic.nu, kinematic.nv), (refined.nu, refined.nv));
+    // The refined net records its change from this very net: mechanical − kinematic, per cell.
+    let change = &refined.meta.change_from_kinematic.as_ref().unwrap().shear_deg;
+    for (k, c) in change.iter().enumerate() {
+        let (i, j) = (k / (refined.nv - 1), k % (refined.nv - 1));
+        if let (Some(c), Some(a), Some(b)) = (c, refined.cell_shear(i, j), kinematic.cell_shear(i, j)) {
+            assert!((c - (a - b).to_degrees()).abs() < 1e-4, "cell ({i}, {j}): {c} vs {}", (a - b).to_degrees());
+        }
+    }
+    let layup = drape::report::read_layup(&out).unwrap().unwrap();
+    assert!(layup.files.contains(&"p0.kinematic.json".to_string()), "{:?}", layup.files);
+    // The export record: the mesh, its size, the formats and each ply's covered elements, as
+    // flow.csv (one row an element and ply) has them.
+    let e = layup.export.as_ref().expect("the scene exports onto a flow mesh");
+    assert!(e.mesh.ends_with("hemisphere-2k.obj"), "{}", e.mesh);
+    assert_eq!((e.elements, e.formats.clone()), (2116, vec!["vtu".to_string(), "csv".to_string()]));
+    assert_eq!(e.files, ["flow.vtu", "flow.csv"]);
+    let csv = std::fs::read_to_string(out.join("flow.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let (ply_col, covered_col) =
+        (header.iter().position(|h| *h == "ply").unwrap(), header.iter().position(|h| *h == "covered").unwrap());
+    let names: Vec<&str> = e.plies.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["p0", "p45", "p90", "m45"]);
+    for p in &e.plies {
+        let covered = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|f| f[ply_col] == p.name && matches!(f[covered_col], "1" | "true"))
+            .count();
+        assert_eq!(p.covered, covered, "ply {}", p.name);
+        assert!(covered > 1900 && p.share == covered as f64 / 2116.0, "{p:?}");
+    }
+
+    let report = out.join("report");
+    let s = write_report(&out, &report, false).unwrap();
+    assert!(s.plies[0].kinematic.is_some() && s.plies[1..].iter().all(|p| p.kinematic.is_none()));
+    assert!(report.join("p0-kinematic.png").is_file());
+    check_picture(&report.join("p0-kinematic.png"));
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert_eq!(html.matches("<section class=\"compare\"").count(), 1, "only the mechanical ply");
+    let compare = html.split("id=\"compare-p0\">").nth(1).unwrap();
+    let compare = &compare[..compare.find("</section>").unwrap()];
+    assert_eq!(compare.matches("<img ").count(), 2, "kinematic and mechanical side by side: {compare}");
+    assert!(compare.contains("src=\"p0-kinematic.png\"") && compare.contains("src=\"p0-shear.png\""));
+    assert!(compare.contains("within the solver's noise"), "{compare}");
+    let export = html.split("id=\"flow-export\"").nth(1).expect("flow-mesh export section");
+    let export = &export[..export.find("</table>").unwrap()];
+    assert!(export.contains("hemisphere-2k.obj") && export.contains("2116 elements") && export.contains("vtu, csv"));
+    for p in &e.plies {
+        assert!(export.contains(&format!("{} of 2116", p.covered)), "ply {}: {export}", p.name);
+    }
+
+    // The run owns its folder: run again with every ply kinematic and the kept net goes.
+    let scenes = tmp.path().join("scene");
+    std::fs::create_dir(&scenes).unwrap();
+    for f in ["hemisphere-20k.obj", "hemisphere-2k.obj"] {
+        std::fs::copy(scene.with_file_name(f), scenes.join(f)).unwrap();
+    }
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("method = \"mechanical\""));
+    let text = text
+        .replace("method = \"mechanical\"", "method = \"kinematic\"")
+        .replace("../../materials/", &format!("{}/materials/", env!("CARGO_MANIFEST_DIR")));
+    std::fs::write(scenes.join("scene.toml"), text).unwrap();
+    let rerun = tmp.path().join("rerun");
+    copy_dir(&out, &rerun);
+    assert!(rerun.join("p0.kinematic.json").is_file());
+    assert_cmd::Command::cargo_bin("drape")
+        .unwrap()
+        .args([
+            "run",
+            scenes.join("scene.toml").to_str().unwrap(),
+            "--out",
+            rerun.to_str().unwrap(),
+            "--format",
+            "json",
+        ])
+        .assert()
+        .success();
+    assert!(!rerun.join("p0.kinematic.json").exists(), "a later run removes the kinematic net it does not write");
+
+    let seen = browse(&report.join("index.html"), &tmp.path().join("view.png"));
+    assert_eq!(seen["errors"], serde_json::json!([]), "console errors");
+    assert_eq!(seen["plies"], 4);
+    let images = seen["images"].as_array().unwrap();
+    assert!(images.len() >= 9 && images.iter().all(|i| i["loaded"] == true), "{images:?}");
+    // Four plies with their pictures, the side by side, the flow mesh, the patterns and the 3D
+    // view: a page, not a scroll of 13,000 px.
+    let height = seen["height"].as_u64().unwrap();
+    eprintln!("four-ply page: {height} px");
+    assert!(height < 7000, "the four-ply page is {height} px long");
+}
+
+/// Copy the files of folder `from` into a new folder `to`.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_file() {
+            std::fs::copy(&p, to.join(p.file_name().unwrap())).unwrap();
+        }
+    }
 }

@@ -41,7 +41,7 @@ pub mod xml;
 pub use atomic::write_atomic;
 pub use csv::{write_csv, CSV_HEADER};
 pub use error::ExportError;
-pub use net::{write_net, write_net_shears, Format};
+pub use net::{kinematic_net_path, write_net, write_net_shears, Format, KINEMATIC_NET_SUFFIX};
 pub use net_json::{read_net, write_json};
 pub use shell_mesh::FlowMeshError;
 pub use tool::{read_tool, read_tool_mesh, ReadToolError, ToolMesh};

@@ -4,6 +4,16 @@ use super::{check, csv::write_csv, net_json::write_json_checked, vtk::write_vtu,
 use crate::kinematic::DrapeNet;
 use std::path::{Path, PathBuf};
 
+/// Suffix of the kinematic net a mechanical ply started from, written by `drape run` beside the
+/// ply's refined net (`<ply>.kinematic.json`, the `.drape.json` format) for the report's
+/// side-by-side pictures.
+pub const KINEMATIC_NET_SUFFIX: &str = ".kinematic.json";
+
+/// The kinematic net file of ply `ply` in `dir` ([`KINEMATIC_NET_SUFFIX`]).
+pub fn kinematic_net_path(dir: &Path, ply: &str) -> PathBuf {
+    dir.join(format!("{ply}{KINEMATIC_NET_SUFFIX}"))
+}
+
 /// An output format of a net.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Format {

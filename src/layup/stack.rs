@@ -75,6 +75,9 @@ pub struct PlyResult {
     pub net: DrapeNet,
     /// The solver's record, for a mechanical ply.
     pub refined: Option<Refined>,
+    /// For a mechanical ply started from a kinematic drape: that kinematic net (the report
+    /// draws it beside the refined one).
+    pub kinematic: Option<DrapeNet>,
     /// For a ply with `method = "auto"`: what ran and why.
     pub choice: Option<MethodChoice>,
     /// The warp direction at the seed, resolved on the ply's surface.
@@ -300,9 +303,11 @@ pub fn drape_layup(
                 (net, refined, None)
             }
         };
-        let (mut net, refined) = match refined {
-            Some((out, result)) => (out, Some(result)),
-            None => (start_net, None),
+        // A flat sheet is not a kinematic drape: only a kinematic start is kept beside the
+        // refined net.
+        let (mut net, refined, kinematic) = match refined {
+            Some((out, result)) => (out, Some(result), matches!(start, Start::Kinematic).then_some(start_net)),
+            None => (start_net, None, None),
         };
         net.meta.method_choice = choice.clone();
         // What later stages (exports, reports) need to know about the ply.
@@ -324,7 +329,7 @@ pub fn drape_layup(
             Extent::Grid { .. } => None,
         };
         let stats = ply_stats(&net, surface, outline.as_ref(), ply.locking_angle, areal_mass);
-        results.push(PlyResult { net, refined, choice, warp, offset, stats });
+        results.push(PlyResult { net, refined, kinematic, choice, warp, offset, stats });
     }
     Ok(results)
 }

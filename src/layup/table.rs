@@ -28,6 +28,48 @@ pub struct LayupTable {
     /// included): the next run into the folder removes those it does not write again.
     #[serde(default)]
     pub files: Vec<String>,
+    /// What the run mapped onto the scene's flow or FE mesh (`[export]`), when it did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub export: Option<ExportRow>,
+}
+
+/// The plies on the scene's flow or FE mesh (`[export]`), in the layup table: which mesh, what
+/// was written and how much of it each ply covers. `drape report` shows it as it is.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExportRow {
+    /// The mesh file, as the scene names it.
+    pub mesh: String,
+    /// Its elements.
+    pub elements: usize,
+    /// Its nodes.
+    #[serde(default)]
+    pub nodes: usize,
+    /// The formats written, as the scene names them (`vtu`, `csv`, `nastran`, ...).
+    #[serde(default)]
+    pub formats: Vec<String>,
+    /// The files written (names in the run folder), in the order of the formats.
+    #[serde(default)]
+    pub files: Vec<String>,
+    /// One entry per ply, in stacking order.
+    #[serde(default)]
+    pub plies: Vec<ExportPlyRow>,
+}
+
+/// How much of the flow mesh one ply covers.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExportPlyRow {
+    /// Ply name.
+    pub name: String,
+    /// Elements the ply covers.
+    pub covered: usize,
+    /// Covered over all elements (0 for a mesh without elements).
+    pub share: f64,
+    /// Largest |shear| over the covered elements, degrees.
+    #[serde(default)]
+    pub max_abs_shear_deg: Option<f64>,
+    /// Mean |shear| over the covered elements, degrees.
+    #[serde(default)]
+    pub mean_abs_shear_deg: Option<f64>,
 }
 
 /// One ply of the layup table.

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// The suffix of a net file.
 const NET_SUFFIX: &str = ".drape.json";
 /// Suffixes of the other files a net's ply writes beside it (`<ply><suffix>`).
-const NET_SIBLINGS: &[&str] = &[".vtu", ".cells.csv", ".svg"];
+const NET_SIBLINGS: &[&str] = &[".vtu", ".cells.csv", ".svg", crate::io::KINEMATIC_NET_SUFFIX];
 
 /// Why a run cannot use its output folder (bad input: exit code 2).
 #[derive(Debug, thiserror::Error)]
@@ -33,7 +33,7 @@ pub enum FolderError {
         reason: String,
     },
     /// The folder holds nets no earlier run into it lists.
-    #[error("--out {path} holds drape nets that no earlier `drape run` into it wrote ({nets}): give --replace to remove them (with their .vtu, .cells.csv and .svg files), or another --out")]
+    #[error("--out {path} holds drape nets that no earlier `drape run` into it wrote ({nets}): give --replace to remove them (with their .vtu, .cells.csv, .svg and .kinematic.json files), or another --out")]
     Foreign {
         /// The folder.
         path: PathBuf,

@@ -15,13 +15,15 @@ use crate::geometry::ToolSurface;
 use crate::io::drawing::{write_cutting_plan, PatternError};
 use crate::io::flow::{write_flow_with, FlowOptions};
 use crate::io::layup_json::{self, LAYUP_FILE};
-use crate::io::{read_flow_mesh, read_tool, write_net, ExportError, Format, ReadToolError};
+use crate::io::{
+    kinematic_net_path, read_flow_mesh, read_tool, write_json, write_net, ExportError, Format, ReadToolError,
+};
 use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeError};
 use crate::kinematic::Extent;
 use crate::layup::flat::{ply_pattern, FlatError};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::stack::{drape_layup, LayupError, PlyResult};
-use crate::layup::table::{LayupRow, LayupTable, NestingRow};
+use crate::layup::table::{ExportPlyRow, ExportRow, LayupRow, LayupTable, NestingRow};
 use crate::layup::Ply;
 use crate::mapping::{map_plies, FlowMesh, LayupMap, MapError, PlyToMap};
 use crate::material::flow::PermeabilityModel;
@@ -54,7 +56,8 @@ pub enum Event<'a> {
         ply: &'a Ply,
         /// Its drape.
         result: &'a PlyResult,
-        /// The files written, in the order of the formats.
+        /// The files written, in the order of the formats, then the kinematic net a mechanical
+        /// ply started from (`<ply>.kinematic.json`, with the json format).
         files: &'a [PathBuf],
         /// Time to read the tool, ms.
         load_ms: f64,
@@ -254,6 +257,15 @@ pub fn run(
         r.net.meta.tool = Some(scene.tool.display().to_string());
         r.net.meta.tool_scale = Some(scene.scale);
         r.net.meta.scene = Some(scene.path.display().to_string());
+        if let Some(k) = &mut r.kinematic {
+            k.timing.load_ms = load_ms;
+            k.meta.tool = r.net.meta.tool.clone();
+            k.meta.tool_scale = r.net.meta.tool_scale;
+            k.meta.scene = r.net.meta.scene.clone();
+            k.meta.material = r.net.meta.material.clone();
+            k.meta.angle_deg = r.net.meta.angle_deg;
+            k.meta.thickness_m = r.net.meta.thickness_m;
+        }
         if let Some(refined) = &r.refined {
             if !refined.ok() {
                 unconverged.push(format!("ply '{}' ({:?})", ply.settings.name, refined.outcome()));
@@ -262,7 +274,13 @@ pub fn run(
     }
     for (ply, result) in scene.layup.plies.iter().zip(&results) {
         let t_write = Instant::now();
-        let files = write_net(&result.net, out, formats)?;
+        let mut files = write_net(&result.net, out, formats)?;
+        // The kinematic net a mechanical ply started from, beside its JSON net (the report's).
+        if let Some(k) = result.kinematic.as_ref().filter(|_| formats.contains(&Format::Json)) {
+            let path = kinematic_net_path(out, &ply.settings.name);
+            write_json(k, &path)?;
+            files.push(path);
+        }
         let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
         on(Event::PlyWritten { ply, result, files: &files, load_ms, write_ms });
         written.extend(files);
@@ -270,10 +288,13 @@ pub fn run(
     on(Event::Layup { scene, results: &results });
     let nesting = cutting_plan(scene, &results, out, &mut written, on)?;
     // The flow export before the table, so that the table lists its files.
-    if let Some(export) = &scene.export {
-        let flow = flow.as_ref().expect("read with the export");
-        export_flow(scene, export, flow, &results, out, &mut written, on)?;
-    }
+    let export_row = match &scene.export {
+        Some(export) => {
+            let flow = flow.as_ref().expect("read with the export");
+            Some(export_flow(scene, export, flow, &results, out, &mut written, on)?)
+        }
+        None => None,
+    };
     let files = folder.names(&written);
     let table = LayupTable {
         scene: Some(scene.path.display().to_string()),
@@ -281,6 +302,7 @@ pub fn run(
         plies: scene.layup.plies.iter().zip(&results).map(|(ply, r)| LayupRow::of(ply, r)).collect(),
         nesting: nesting.as_ref().map(NestingRow::from),
         files: files.clone(),
+        export: export_row,
     };
     let path = out.join(LAYUP_FILE);
     layup_json::write(&table, &path)?;
@@ -338,7 +360,8 @@ fn cutting_plan(
 }
 
 /// Map every ply onto the scene's resin-flow mesh and write the formats it asks for as
-/// `DIR/flow.<ext>` (`FlowFormat::scene_file`; field names prefixed by the ply).
+/// `DIR/flow.<ext>` (`FlowFormat::scene_file`; field names prefixed by the ply); returns the
+/// layup table's record of it.
 fn export_flow(
     scene: &Scene,
     export: &SceneExport,
@@ -347,7 +370,7 @@ fn export_flow(
     out: &Path,
     written: &mut Vec<PathBuf>,
     on: &mut dyn FnMut(Event),
-) -> Result<(), RunError> {
+) -> Result<ExportRow, RunError> {
     let t = Instant::now();
     let mesh = &flow.mesh;
     let plies: Vec<PlyToMap> = scene
@@ -366,13 +389,36 @@ fn export_flow(
     let map = map_plies(mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
     let ms = flow.read_ms + t.elapsed().as_secs_f64() * 1e3;
     on(Event::FlowMapped { path: &export.mesh, mesh, map: &map, ms });
+    let mut row = ExportRow {
+        mesh: export.mesh.display().to_string(),
+        elements: mesh.elements.len(),
+        nodes: mesh.nodes.len(),
+        formats: export.formats.iter().map(|f| f.name().to_string()).collect(),
+        files: Vec::new(),
+        plies: map
+            .plies
+            .iter()
+            .map(|p| {
+                let c = p.coverage();
+                let any = c.covered > 0;
+                ExportPlyRow {
+                    name: p.ply.clone(),
+                    covered: c.covered,
+                    share: if c.elements > 0 { c.covered as f64 / c.elements as f64 } else { 0.0 },
+                    max_abs_shear_deg: any.then_some(c.max_abs_shear_deg),
+                    mean_abs_shear_deg: any.then_some(c.mean_abs_shear_deg),
+                }
+            })
+            .collect(),
+    };
     for &format in &export.formats {
         let options = FlowOptions { vtu: export.vtu, ..FlowOptions::default() };
         let files = write_flow_with(mesh, &map, format, &out.join(format.scene_file()), &options)?;
         on(Event::FlowWritten { files: &files });
+        row.files.extend(files.iter().filter_map(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned()));
         written.extend(files);
     }
-    Ok(())
+    Ok(row)
 }
 
 /// What the flow export needs that can be checked before anything is draped.

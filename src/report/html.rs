@@ -75,8 +75,11 @@ table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:
 th{background:#f3f3f3}td.t,th.t{text-align:left}img{max-width:100%;height:auto;border:1px solid #ddd;margin:.5em 0}\
 .notes{background:#fff6e0;border-left:4px solid #e0a000;padding:.5em 1em}.small{color:#666;font-size:.9em}\
 dl{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dt{color:#666}dd{margin:0}\
-.pattern svg{max-width:100%;max-height:560px;height:auto;border:1px solid #ddd}\
-figure{margin:.5em 0}.pair{display:flex;gap:1em;flex-wrap:wrap}.pair figure{flex:1 1 45%;min-width:300px}\
+.pattern svg{max-width:100%;max-height:300px;height:auto;border:1px solid #ddd}\
+figure{margin:.5em 0}.pair{display:flex;gap:1em;flex-wrap:wrap}.pair figure{flex:1 1 45%;min-width:300px;max-width:calc(50% - .5em)}\
+figcaption{margin-top:-.3em}dl.summary{grid-template-columns:max-content auto max-content auto}details{margin:.5em 0}summary{cursor:pointer;color:#345}\
+.compare{border-left:4px solid #9ab;padding-left:1em;margin:1em 0}.compare h3{margin:.3em 0}\
+.patterns{display:grid;grid-template-columns:repeat(auto-fill,minmax(340px,1fr));gap:.5em 1em}.patterns h3{font-size:1em;margin:.3em 0}\
 #drape-view{width:100%;height:auto;border:1px solid #ddd;cursor:grab}.viewer-controls label{margin-right:1em}";
 
 /// The whole page.
@@ -111,6 +114,9 @@ pub(crate) fn page(p: &Page) -> String {
             let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
         }
         let _ = writeln!(h, "</dl>");
+    }
+    if let Some(e) = p.layup.as_ref().and_then(|l| l.export.as_ref()) {
+        export_section(&mut h, e);
     }
     if !p.statuses.is_empty() {
         let _ = writeln!(
@@ -164,25 +170,57 @@ pub(crate) fn page(p: &Page) -> String {
         }
     }
     if !p.patterns.is_empty() {
-        let _ = writeln!(h, "<h2 id=\"patterns\">Flat patterns</h2>");
+        // In a grid of small drawings: each opens full size from its link.
+        let _ = writeln!(h, "<h2 id=\"patterns\">Flat patterns</h2>\n<div class=\"patterns\">");
         for (name, body) in &p.patterns {
             match body {
                 Ok(svg) => {
-                    let _ = writeln!(h, "<h3>{}</h3>\n<div class=\"pattern\">{svg}</div>", escape(name));
+                    let _ = writeln!(h, "<div><h3>{}</h3>\n<div class=\"pattern\">{svg}</div></div>", escape(name));
                 }
                 Err(link) => {
                     let _ = writeln!(
                         h,
-                        "<h3>{0}</h3>\n<p><a href=\"{1}\">{0}</a> (too large to show inline)</p>",
+                        "<div><h3>{0}</h3>\n<p><a href=\"{1}\">{0}</a> (too large to show inline)</p></div>",
                         escape(name),
                         escape(link)
                     );
                 }
             }
         }
+        let _ = writeln!(h, "</div>");
     }
     let _ = writeln!(h, "<p class=\"small\">Written by drape {}.</p>\n</body>\n</html>", env!("CARGO_PKG_VERSION"));
     h
+}
+
+/// The plies on the flow or FE mesh, as the run recorded them in `layup.json`.
+fn export_section(h: &mut String, e: &crate::layup::table::ExportRow) {
+    let _ = writeln!(
+        h,
+        "<h3 id=\"flow-export\">Flow-mesh export</h3>\n<p class=\"small\">The run mapped every ply onto the mesh <code>{}</code> ({} elements, {} nodes) and wrote {} ({}).</p>",
+        escape(&e.mesh),
+        e.elements,
+        e.nodes,
+        if e.formats.is_empty() { "no format".to_string() } else { escape(&e.formats.join(", ")) },
+        if e.files.is_empty() { "no file".to_string() } else { escape(&e.files.join(", ")) }
+    );
+    let _ = writeln!(
+        h,
+        "<table id=\"export-table\"><tr><th class=\"t\">ply</th><th>elements covered</th><th>share of the mesh</th><th>max |γ| on the mesh (°)</th><th>mean |γ| on the mesh (°)</th></tr>"
+    );
+    for r in &e.plies {
+        let share = if r.share.is_finite() { format!("{:.1}%", 100.0 * r.share) } else { "—".into() };
+        let _ = writeln!(
+            h,
+            "<tr class=\"export-ply\"><td class=\"t\">{}</td><td>{} of {}</td><td>{share}</td><td>{}</td><td>{}</td></tr>",
+            escape(&r.name),
+            r.covered,
+            e.elements,
+            num(r.max_abs_shear_deg, 1),
+            num(r.mean_abs_shear_deg, 1)
+        );
+    }
+    let _ = writeln!(h, "</table>");
 }
 
 fn layup_table(h: &mut String, rows: &[LayupRow]) {
@@ -247,16 +285,14 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
     let name = escape(&ply.name);
     let _ =
         writeln!(h, "<h2 id=\"ply-{name}\">Ply {name} <span class=\"small\">({})</span></h2>", method_name(ply.method));
-    let _ = writeln!(h, "<dl>");
-    let summary = [
+    let mut summary = vec![
         ("complete cells".to_string(), ply.cells.to_string()),
         ("max |shear|".to_string(), format!("{}°", num(Some(ply.max_abs_shear_deg), 1))),
         ("mean |shear|".to_string(), format!("{}°", num(Some(ply.mean_abs_shear_deg), 1))),
         ("locking angle".to_string(), format!("{}°", num(Some(ply.locking_angle_deg), 1))),
         ("colour scale".to_string(), format!("±{}°", num(Some(ply.colour_limit_deg), 0))),
     ];
-    let mut summary = summary.to_vec();
-    if let Some(c) = &ply.change {
+    let change = ply.change.as_ref().map(|c| {
         let at = c.largest_at;
         let place = if at.iter().all(|x| x.is_finite()) {
             format!(
@@ -270,18 +306,27 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         } else {
             String::new()
         };
-        summary.push((
-            "mechanical − kinematic".to_string(),
-            format!(
-                "largest change {:+.2}°{place}; mean |change| {:.2}° over {} cells",
-                c.largest_deg, c.mean_abs_deg, c.cells
-            ),
-        ));
+        format!(
+            "largest change {:+.2}°{place}; mean |change| {:.2}° over {} cells",
+            c.largest_deg, c.mean_abs_deg, c.cells
+        )
+    });
+    if let Some(c) = &change {
+        summary.push(("mechanical − kinematic".to_string(), c.clone()));
     }
-    for (k, v) in summary.iter().chain(facts) {
+    let _ = writeln!(h, "<dl class=\"summary\">");
+    for (k, v) in &summary {
         let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
     }
     let _ = writeln!(h, "</dl>");
+    // The net's particulars are secondary: folded away.
+    if !facts.is_empty() {
+        let _ = writeln!(h, "<details class=\"facts\"><summary>Net details</summary><dl>");
+        for (k, v) in facts {
+            let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(k), escape(v));
+        }
+        let _ = writeln!(h, "</dl></details>");
+    }
     if !ply.notes.is_empty() {
         let _ = writeln!(h, "<div class=\"notes\"><ul>");
         for n in &ply.notes {
@@ -289,31 +334,92 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         }
         let _ = writeln!(h, "</ul></div>");
     }
-    // The shaded views full width; the histogram and the change map side by side below.
     let names: Vec<String> =
         ply.files.iter().filter_map(|f| Some(f.file_name()?.to_string_lossy().into_owned())).collect();
-    let pngs: Vec<&String> = names.iter().filter(|n| n.ends_with(".png")).collect();
-    let (main, small): (Vec<&String>, Vec<&String>) = pngs.into_iter().partition(|n| n.ends_with("-shear.png"));
-    let figure = |h: &mut String, png: &str, class: &str| {
+    let png = |suffix: &str| names.iter().find(|n| n.ends_with(&format!("-{suffix}.png"))).cloned();
+    let figure = |h: &mut String, png: &str, caption: &str| {
         let svg = png.trim_end_matches(".png").to_string() + ".svg";
         let svg_link =
             if names.contains(&svg) { format!(" · <a href=\"{}\">SVG</a>", escape(&svg)) } else { String::new() };
         let _ = writeln!(
             h,
-            "<figure class=\"{class}\"><img src=\"{0}\" alt=\"{0}\" width=\"{1}\" height=\"{2}\"><figcaption class=\"small\"><a href=\"{0}\">PNG</a>{svg_link}</figcaption></figure>",
+            "<figure><img src=\"{0}\" alt=\"{0}\" width=\"{1}\" height=\"{2}\"><figcaption class=\"small\">{3}<a href=\"{0}\">PNG</a>{svg_link}</figcaption></figure>",
             escape(png),
             super::WIDTH,
-            super::HEIGHT
+            super::HEIGHT,
+            caption
         );
     };
-    for png in main {
-        figure(h, png, "wide");
+    // Pictures two to a row: a mechanical ply with its kinematic start shows the two side by
+    // side, then the change map and its histogram, then the shear histogram.
+    let mut rows: Vec<Vec<(String, &str)>> = Vec::new();
+    match (png("kinematic"), png("shear")) {
+        (Some(k), Some(m)) => {
+            let _ = writeln!(
+                h,
+                "<section class=\"compare\" id=\"compare-{name}\"><h3>Kinematic against mechanical</h3>\n<p class=\"small\">The kinematic net the mechanics started from and the mechanical result, from the same views on the layup's colour scale (±{}°). {}</p>",
+                num(Some(ply.colour_limit_deg), 0),
+                escape(&compare_text(ply, change.as_deref()))
+            );
+            let _ = writeln!(h, "<div class=\"pair\">");
+            figure(h, &k, "kinematic · ");
+            figure(h, &m, "mechanical · ");
+            let _ = writeln!(h, "</div>");
+            let change: Vec<(String, &str)> =
+                ["change", "change-histogram"].iter().filter_map(|s| png(s)).map(|p| (p, "")).collect();
+            if change.is_empty() {
+                let _ = writeln!(
+                    h,
+                    "<p class=\"small\">No difference map: every change lies within the solver's noise (see the note above).</p>"
+                );
+            } else {
+                let _ = writeln!(h, "<div class=\"pair\">");
+                for (p, c) in &change {
+                    figure(h, p, c);
+                }
+                let _ = writeln!(h, "</div>");
+            }
+            let _ = writeln!(h, "</section>");
+            rows.push(png("histogram").into_iter().map(|p| (p, "")).collect());
+        }
+        (_, shear) => {
+            rows.push(shear.into_iter().chain(png("histogram")).map(|p| (p, "")).collect());
+            rows.push(["change", "change-histogram"].iter().filter_map(|s| png(s)).map(|p| (p, "")).collect());
+        }
     }
-    let _ = writeln!(h, "<div class=\"pair\">");
-    for png in small {
-        figure(h, png, "half");
+    for row in rows.iter().filter(|r| !r.is_empty()) {
+        let _ = writeln!(h, "<div class=\"pair\">");
+        for (p, c) in row {
+            figure(h, p, c);
+        }
+        let _ = writeln!(h, "</div>");
     }
-    let _ = writeln!(h, "</div>");
+}
+
+/// The side-by-side section's figures in words: each net's shear and the change between them.
+fn compare_text(ply: &PlyReport, change: Option<&str>) -> String {
+    let mut t = String::new();
+    if let Some(k) = &ply.kinematic {
+        t += &format!(
+            "Kinematic: max |γ| {}°, mean {}°, {} cells past locking. ",
+            num(Some(k.max_abs_shear_deg), 1),
+            num(Some(k.mean_abs_shear_deg), 1),
+            k.over_locking_cells
+        );
+    }
+    t += &format!(
+        "Mechanical: max |γ| {}°, mean {}°, {} cells past locking.",
+        num(Some(ply.max_abs_shear_deg), 1),
+        num(Some(ply.mean_abs_shear_deg), 1),
+        ply.over_locking_cells
+    );
+    if let Some(c) = change {
+        t += &format!(" Mechanical − kinematic: {c}.");
+    }
+    if let Some(n) = &ply.change_noise {
+        t += &format!(" Changes within ±{:.2}° are the solver's noise and drawn as none.", n.floor_deg);
+    }
+    t
 }
 
 #[cfg(test)]

@@ -11,8 +11,11 @@
 //! - `<ply>-histogram.png/.svg`: the distribution of signed shear with the locking angle marked;
 //! - for a mechanical ply, `<ply>-change.png` (the change of shear from the kinematic net, on
 //!   the same views) and `<ply>-change-histogram.png/.svg`, with the largest and mean change;
+//!   and when the run kept the kinematic net it started from (`<ply>.kinematic.json`),
+//!   `<ply>-kinematic.png`: that net from the same views and window on the same colour scale,
+//!   shown beside `<ply>-shear.png`;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
-//!   nets), laminate totals, what each node status means, the interactive 3D view (the
+//!   nets), laminate totals, the flow-mesh export as `layup.json` records it, what each node status means, the interactive 3D view (the
 //!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
 //!   (`*.svg` in DIR) and notes on whatever could not be drawn.
 //!
@@ -33,7 +36,7 @@ pub use view::{change_limit, colour_limit, shear_colour, View};
 use crate::geometry::Point;
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::read_tool_mesh;
-use crate::io::{read_net, write_atomic, ExportError};
+use crate::io::{kinematic_net_path, read_net, write_atomic, ExportError};
 use crate::kinematic::coverage::surface_coverage;
 use crate::kinematic::{DrapeNet, Method};
 use crate::layup::table::{CoverageOf, LayupRow, LayupTable};
@@ -130,6 +133,9 @@ pub struct PlyReport {
     pub change_noise: Option<change::ChangeNoise>,
     /// For a mechanical ply: the change of shear from the kinematic net, summed up.
     pub change: Option<ChangeSummary>,
+    /// For a mechanical ply whose kinematic net the run kept: that net in figures (its picture,
+    /// `<ply>-kinematic.png`, is drawn beside `<ply>-shear.png` from the same views).
+    pub kinematic: Option<KinematicSummary>,
     /// Names of the views drawn (the first is isometric).
     pub views: Vec<String>,
     /// Share of the drawn cells that some view shows (facing it, not hidden).
@@ -153,7 +159,7 @@ const NET_SUFFIX: &str = ".drape.json";
 /// Flat-pattern SVGs larger than this are linked from the page instead of inlined.
 const PATTERN_INLINE_LIMIT: u64 = 8 << 20;
 /// The kinds of picture, as file-name suffixes after `<ply>-`.
-const PICTURES: [&str; 4] = ["shear", "histogram", "change", "change-histogram"];
+const PICTURES: [&str; 5] = ["shear", "kinematic", "histogram", "change", "change-histogram"];
 /// Candidate scales (metres per OBJ unit) tried when the tool's units are not recorded.
 const TOOL_SCALES: [f64; 2] = [1.0, 1e-3];
 
@@ -266,6 +272,28 @@ struct PlyInput {
     tool_note: Option<String>,
     /// The material card the net records, when it can be read.
     card: Option<MaterialCard>,
+    /// For a mechanical ply: the kinematic net it started from (`<ply>.kinematic.json`).
+    kinematic: Option<DrapeNet>,
+}
+
+/// The kinematic net a mechanical ply started from, when the run wrote it beside the ply's net
+/// (`drape run` does; a net refined by `drape refine` has none, and the page says so).
+fn read_kinematic(dir: &Path, stem: &str, notes: &mut Vec<String>) -> Option<DrapeNet> {
+    let path = kinematic_net_path(dir, stem);
+    if !path.is_file() {
+        notes.push(format!(
+            "ply '{stem}': no {} beside its net (`drape run` writes it): the kinematic and mechanical pictures are not shown side by side",
+            path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned())
+        ));
+        return None;
+    }
+    match read_net(&path) {
+        Ok(k) => Some(k),
+        Err(e) => {
+            notes.push(format!("ply '{stem}': the kinematic net cannot be read ({e}): not shown side by side"));
+            None
+        }
+    }
 }
 
 /// Everything the page shows, gathered by [`write_report`].
@@ -379,7 +407,8 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
                 ),
             },
         };
-        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note, card });
+        let kinematic = if net.method == Method::Mechanical { read_kinematic(dir, &stem, &mut notes) } else { None };
+        inputs.push(PlyInput { stem, net, locking_deg, locking_source, given, tool, tool_note, card, kinematic });
     }
 
     std::fs::create_dir_all(out).map_err(|source| ReportError::CreateDir { path: out.to_path_buf(), source })?;
@@ -401,7 +430,10 @@ pub fn write_report(dir: &Path, out: &Path, progress: bool) -> Result<ReportSumm
         })
         .collect();
 
-    let pictures: u64 = inputs.iter().map(|i| if i.net.method == Method::Mechanical { 3 } else { 2 }).sum();
+    let pictures: u64 = inputs
+        .iter()
+        .map(|i| if i.net.method == Method::Mechanical { 3 } else { 2 } + u64::from(i.kinematic.is_some()))
+        .sum();
     let bar = if progress {
         ProgressBar::with_draw_target(Some(pictures + 1), ProgressDrawTarget::stderr())
     } else {
@@ -561,8 +593,12 @@ fn viewer_section(inputs: &[PlyInput], tools: &BTreeMap<PathBuf, Result<RawTool,
             tool_vertices: v.as_deref(),
         })
         .collect();
-    let tool = inputs.iter().zip(&scaled).find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())));
-    viewer::section(&viewer::data_json(tool, &plies, limit))
+    let tool = inputs
+        .iter()
+        .zip(&scaled)
+        .find_map(|(i, v)| Some((v.as_deref()?, tool_of(i)?.triangles.as_slice())))
+        .map(|(v, t)| viewer::ViewTool::new(v, t, viewer::TOOL_TRIANGLE_LIMIT));
+    viewer::section(&viewer::data_json(tool.as_ref(), &plies, limit), tool.as_ref())
 }
 
 /// The table row of a net that `layup.json` does not list: its shear statistics and, when its
@@ -618,8 +654,12 @@ pub(crate) fn method_name(m: Method) -> &'static str {
 /// The colour limit (degrees, symmetric) shared by every ply of a report: one scale for the
 /// whole layup, so equal colours mean equal shear on every ply.
 fn shared_limit(inputs: &[PlyInput]) -> f64 {
-    let max =
-        inputs.iter().map(|i| i.net.shear_stats(i.locking_deg.to_radians()).max_abs.to_degrees()).fold(0.0, f64::max);
+    // The kinematic nets drawn beside mechanical plies are on the same scale.
+    let max = inputs
+        .iter()
+        .flat_map(|i| std::iter::once(&i.net).chain(&i.kinematic).map(|n| (n, i.locking_deg)))
+        .map(|(n, lock)| n.shear_stats(lock.to_radians()).max_abs.to_degrees())
+        .fold(0.0, f64::max);
     let lock = inputs.iter().map(|i| i.locking_deg).fold(0.0, f64::max);
     colour_limit(max, lock)
 }
@@ -714,19 +754,19 @@ fn draw_ply(
         Mark { value: lock, label: format!("+{lock:.0}° locking") },
         Mark { value: -lock, label: format!("−{lock:.0}° locking") },
     ];
-    let folded = shade::folded_cells(net);
-    let paint: Vec<Option<CellPaint>> = values
-        .iter()
-        .zip(&folded)
-        .map(|(v, f)| {
-            v.map(|g| CellPaint {
-                colour: if *f { shade::FOLD_FILL } else { shear_colour(g, limit) },
-                hatch: g.abs() > lock,
-            })
-        })
-        .collect();
-    let folded_count = folded.iter().filter(|f| **f).count();
-    let scene = PlyScene::new(net, tool_mesh(), paint, true);
+    let (paint, folded_count) = shear_paint(net, &values, limit, lock);
+    let mut scene = PlyScene::new(net, tool_mesh(), paint, true);
+    // A mechanical ply's kinematic start, on the same views, window and colour scale.
+    let kinematic = input.kinematic.as_ref().map(|k| {
+        let values = shear_values(k);
+        let (paint, folded) = shear_paint(k, &values, limit, lock);
+        let mut scene = PlyScene::new(k, tool_mesh(), paint, true);
+        scene.frame = placed_points(net);
+        (k, values, folded, scene)
+    });
+    if let Some((k, ..)) = &kinematic {
+        scene.frame = placed_points(k);
+    }
     let (views, seen_share) = if st.cells > 0 { shade::choose_views(&scene) } else { (Vec::new(), 1.0) };
     if seen_share < 1.0 {
         notes.push(format!(
@@ -735,43 +775,13 @@ fn draw_ply(
             100.0 * seen_share
         ));
     }
-    // The fibre step depends on the picture's scale: draw once to learn it, then the legend.
-    let mut legend = vec![
-        LegendItem { swatch: Swatch::Line(shade::WARP_LINE), text: "warp fibres".into() },
-        LegendItem { swatch: Swatch::Line(shade::WEFT_LINE), text: "weft fibres".into() },
-        LegendItem { swatch: Swatch::Seed, text: "seed, arrow: warp direction".into() },
-        LegendItem { swatch: Swatch::Line(shade::EDGE_LINE), text: "ply edge".into() },
-        LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
-        LegendItem {
-            swatch: Swatch::Hatch(shear_colour(limit, limit)),
-            text: format!("past locking: {} cells", st.over_locking),
-        },
-        LegendItem { swatch: Swatch::Fill(shade::FOLD_FILL), text: format!("folded (wrinkle): {folded_count}") },
-    ];
-    let mut stops: BTreeMap<crate::kinematic::NodeStatus, usize> = BTreeMap::new();
-    for (_, s) in &scene.frontier {
-        *stops.entry(*s).or_default() += 1;
-    }
-    for (s, n) in &stops {
-        legend.push(LegendItem {
-            swatch: Swatch::Dot(shade::status_colour(*s)),
-            text: format!("stopped, {}: {n}", status_short(*s)),
-        });
-    }
-    let mut pic = ShadedPicture {
-        title: format!("Ply {}: shear angle ({kind})", input.stem),
-        subtitle: format!(
-            "{} cells; {} view{} showing {:.1}% of them; colour scale ±{limit:.0}° for the whole layup; {tool_text}",
-            st.cells,
-            views.len(),
-            if views.len() == 1 { "" } else { "s" },
-            100.0 * seen_share
-        ),
-        limit,
-        bar_label: "shear angle (deg)".into(),
-        marks: lock_marks.clone(),
-        legend,
-    };
+    let subtitle = format!(
+        "{} cells; {} view{} showing {:.1}% of them; colour scale ±{limit:.0}° for the whole layup; {tool_text}",
+        st.cells,
+        views.len(),
+        if views.len() == 1 { "" } else { "s" },
+        100.0 * seen_share
+    );
     let mut files = Vec::new();
     let name = |suffix: &str| out.join(format!("{}-{suffix}", input.stem));
     let draw_err = |p: &Path| {
@@ -779,15 +789,49 @@ fn draw_ply(
         move |message: String| ReportError::Draw { path: p.clone(), message }
     };
     let shear_png = name("shear.png");
-    let (_, outs) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
-    let fibre_step = outs.first().map_or(0, |o| o.fibre_step);
-    let every =
-        if fibre_step <= 1 { "every fibre".to_string() } else { format!("every {} fibre", ordinal(fibre_step)) };
-    pic.legend[0].text = format!("warp fibres ({every})");
-    let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&shear_png))?;
+    let title = format!("Ply {}: shear angle ({kind})", input.stem);
+    let shot = ShearShot {
+        scene: &scene,
+        views: &views,
+        title,
+        subtitle,
+        limit,
+        lock,
+        over_locking: st.over_locking,
+        folded: folded_count,
+    };
+    let (bytes, fibre_step, stops) = shear_picture(&shot).map_err(draw_err(&shear_png))?;
     write_atomic(&shear_png, |w| w.write_all(&bytes))?;
     files.push(shear_png);
     bar.inc(1);
+    let mut kinematic_stats = None;
+    if let Some((k, _, folded, kscene)) = &kinematic {
+        let kst = k.shear_stats(lock.to_radians());
+        let p = name("kinematic.png");
+        let shot = ShearShot {
+            scene: kscene,
+            views: &views,
+            title: format!("Ply {}: shear angle (kinematic, where the mechanics started)", input.stem),
+            subtitle: format!(
+                "{} cells; the mechanical net's views and window; colour scale ±{limit:.0}° for the whole layup; {tool_text}",
+                kst.cells
+            ),
+            limit,
+            lock,
+            over_locking: kst.over_locking,
+            folded: *folded,
+        };
+        let (bytes, _, _) = shear_picture(&shot).map_err(draw_err(&p))?;
+        write_atomic(&p, |w| w.write_all(&bytes))?;
+        files.push(p);
+        kinematic_stats = Some(KinematicSummary {
+            cells: kst.cells,
+            max_abs_shear_deg: kst.max_abs.to_degrees(),
+            mean_abs_shear_deg: kst.mean_abs.to_degrees(),
+            over_locking_cells: kst.over_locking,
+        });
+        bar.inc(1);
+    }
 
     let hist = render::HistogramPicture {
         title: format!("Ply {}: shear distribution ({kind})", input.stem),
@@ -896,6 +940,7 @@ fn draw_ply(
         tool_drawn: scaled.is_some(),
         change_noise,
         change: change_summary,
+        kinematic: kinematic_stats,
         views: views.into_iter().map(|(_, n)| n).collect(),
         seen_share,
         fibre_step,
@@ -905,6 +950,108 @@ fn draw_ply(
         files,
         notes,
     })
+}
+
+/// The placed nodes of a net.
+fn placed_points(net: &DrapeNet) -> Vec<Point> {
+    net.positions
+        .iter()
+        .zip(&net.status)
+        .filter(|(_, s)| **s == crate::kinematic::NodeStatus::Placed)
+        .map(|(p, _)| *p)
+        .collect()
+}
+
+/// A net painted by signed shear on the colour scale `limit` (degrees), folded cells in their
+/// own colour, cells past `lock` hatched: the paint and the count of folded cells.
+fn shear_paint(net: &DrapeNet, values: &[Option<f64>], limit: f64, lock: f64) -> (Vec<Option<CellPaint>>, usize) {
+    let folded = shade::folded_cells(net);
+    let paint = values
+        .iter()
+        .zip(&folded)
+        .map(|(v, f)| {
+            v.map(|g| CellPaint {
+                colour: if *f { shade::FOLD_FILL } else { shear_colour(g, limit) },
+                hatch: g.abs() > lock,
+            })
+        })
+        .collect();
+    (paint, folded.iter().filter(|f| **f).count())
+}
+
+/// What a shear picture shows.
+struct ShearShot<'a> {
+    scene: &'a PlyScene<'a>,
+    views: &'a [(View, String)],
+    title: String,
+    subtitle: String,
+    /// Colour limit, degrees.
+    limit: f64,
+    /// Locking angle, degrees.
+    lock: f64,
+    over_locking: usize,
+    folded: usize,
+}
+
+/// Draw a shear picture with its legend: the PNG, the fibre step of its first view and where
+/// the net stopped (status and placed nodes bordering it). Drawn twice: the first pass learns
+/// the fibre step the legend names.
+type ShearPng = (Vec<u8>, usize, BTreeMap<crate::kinematic::NodeStatus, usize>);
+fn shear_picture(shot: &ShearShot) -> Result<ShearPng, String> {
+    let (limit, lock) = (shot.limit, shot.lock);
+    let mut legend = vec![
+        LegendItem { swatch: Swatch::Line(shade::WARP_LINE), text: "warp fibres".into() },
+        LegendItem { swatch: Swatch::Line(shade::WEFT_LINE), text: "weft fibres".into() },
+        LegendItem { swatch: Swatch::Seed, text: "seed, arrow: warp direction".into() },
+        LegendItem { swatch: Swatch::Line(shade::EDGE_LINE), text: "ply edge".into() },
+        LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
+        LegendItem {
+            swatch: Swatch::Hatch(shear_colour(limit, limit)),
+            text: format!("past locking: {} cells", shot.over_locking),
+        },
+        LegendItem { swatch: Swatch::Fill(shade::FOLD_FILL), text: format!("folded (wrinkle): {}", shot.folded) },
+    ];
+    let mut stops: BTreeMap<crate::kinematic::NodeStatus, usize> = BTreeMap::new();
+    for (_, s) in &shot.scene.frontier {
+        *stops.entry(*s).or_default() += 1;
+    }
+    for (s, n) in &stops {
+        legend.push(LegendItem {
+            swatch: Swatch::Dot(shade::status_colour(*s)),
+            text: format!("stopped, {}: {n}", status_short(*s)),
+        });
+    }
+    let mut pic = ShadedPicture {
+        title: shot.title.clone(),
+        subtitle: shot.subtitle.clone(),
+        limit,
+        bar_label: "shear angle (deg)".into(),
+        marks: vec![
+            Mark { value: lock, label: format!("+{lock:.0}° locking") },
+            Mark { value: -lock, label: format!("−{lock:.0}° locking") },
+        ],
+        legend,
+    };
+    let (_, outs) = render::shaded_png(shot.scene, shot.views, &pic)?;
+    let fibre_step = outs.first().map_or(0, |o| o.fibre_step);
+    let every =
+        if fibre_step <= 1 { "every fibre".to_string() } else { format!("every {} fibre", ordinal(fibre_step)) };
+    pic.legend[0].text = format!("warp fibres ({every})");
+    let (bytes, _) = render::shaded_png(shot.scene, shot.views, &pic)?;
+    Ok((bytes, fibre_step, stops))
+}
+
+/// The kinematic net a mechanical ply started from, in figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KinematicSummary {
+    /// Complete cells.
+    pub cells: usize,
+    /// Largest |shear|, degrees.
+    pub max_abs_shear_deg: f64,
+    /// Mean |shear|, degrees.
+    pub mean_abs_shear_deg: f64,
+    /// Cells sheared past the locking angle.
+    pub over_locking_cells: usize,
 }
 
 /// The change of shear from the kinematic to the mechanical net, in figures.

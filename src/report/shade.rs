@@ -118,6 +118,9 @@ pub struct PlyScene<'a> {
     /// Placed nodes (by index) next to a node that failed, with that failure: where the net
     /// stopped (trimming at an outline is not marked).
     pub frontier: Vec<(usize, NodeStatus)>,
+    /// More points each view frames besides the placed nodes (the other net of a side-by-side
+    /// pair, so that both pictures show the same window).
+    pub frame: Vec<Point>,
     node_normals: Vec<Vector>,
 }
 
@@ -126,7 +129,7 @@ impl<'a> PlyScene<'a> {
     pub fn new(net: &'a DrapeNet, tool: Option<ToolMesh<'a>>, cells: Vec<Option<CellPaint>>, fibres: bool) -> Self {
         let normals = outer_normals(net, tool.as_ref().map(|t| t.vertices));
         let frontier = frontier(net).into_iter().filter(|(_, s)| *s != NodeStatus::OutsideOutline).collect();
-        PlyScene { net, tool, cells, fibres, frontier, node_normals: normals }
+        PlyScene { net, tool, cells, fibres, frontier, frame: Vec::new(), node_normals: normals }
     }
 
     /// Node `k`'s position lifted off the tool along its outer normal by `lift` metres.
@@ -285,7 +288,7 @@ pub struct PanelOut {
 
 /// The view's screen box of the placed nodes (or the tool), padded.
 fn view_bounds(scene: &PlyScene, view: &View) -> Option<[f64; 4]> {
-    let mut pts: Vec<Point> = scene.placed().collect();
+    let mut pts: Vec<Point> = scene.placed().chain(scene.frame.iter().copied()).collect();
     if pts.is_empty() {
         pts = scene.tool.iter().flat_map(|t| t.vertices.iter().copied()).collect();
     }

@@ -10,9 +10,102 @@ use serde_json::{json, Value};
 /// The viewer's script, embedded in the page.
 pub const SCRIPT: &str = include_str!("viewer.js");
 
-/// Tools with more triangles than this are left out of the 3D view (the page would grow by
-/// megabytes and the canvas slow down); the plies are still shown.
+/// Tools with more triangles than this are shown decimated in the 3D view ([`decimate`]): the
+/// page would grow by megabytes and the canvas slow down.
 pub const TOOL_TRIANGLE_LIMIT: usize = 60_000;
+/// Finest clustering grid tried (cells along the tool's longest side).
+const MAX_CLUSTER_GRID: usize = 1 << 12;
+
+/// The tool as the 3D view shows it.
+pub struct ViewTool {
+    /// Vertices, metres.
+    pub vertices: Vec<Point>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Triangles of the tool as read (more than `triangles` when decimated).
+    pub original_triangles: usize,
+}
+
+impl ViewTool {
+    /// The tool for the view: as read when it has at most `limit` triangles, else decimated.
+    pub fn new(vertices: &[Point], triangles: &[[u32; 3]], limit: usize) -> ViewTool {
+        let (vertices, kept) = if triangles.len() <= limit {
+            (vertices.to_vec(), triangles.to_vec())
+        } else {
+            decimate(vertices, triangles, limit)
+        };
+        ViewTool { vertices, triangles: kept, original_triangles: triangles.len() }
+    }
+
+    /// Whether the view shows fewer triangles than the tool has.
+    pub fn decimated(&self) -> bool {
+        self.triangles.len() < self.original_triangles
+    }
+}
+
+/// Vertex clustering on a grid of cubes with `n` cells along the longest side of the bounding
+/// box: each vertex moves to the mean of its cube's vertices (summed in vertex order), triangles
+/// whose corners fall into fewer than three cubes vanish, repeats are kept once (the first).
+fn cluster(vertices: &[Point], triangles: &[[u32; 3]], lo: &Point, size: f64, n: usize) -> (Vec<Point>, Vec<[u32; 3]>) {
+    let h = size / n as f64;
+    let mut ids: std::collections::HashMap<[i64; 3], u32> = std::collections::HashMap::new();
+    let mut sums: Vec<(Vector, usize)> = Vec::new();
+    let of: Vec<u32> = vertices
+        .iter()
+        .map(|p| {
+            let key = [0, 1, 2].map(|k| (((p[k] - lo[k]) / h).floor() as i64).clamp(0, n as i64));
+            let id = *ids.entry(key).or_insert_with(|| {
+                sums.push((Vector::zeros(), 0));
+                (sums.len() - 1) as u32
+            });
+            sums[id as usize].0 += p.coords;
+            sums[id as usize].1 += 1;
+            id
+        })
+        .collect();
+    let mut seen = std::collections::HashSet::new();
+    let kept: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| of[v as usize]))
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .filter(|t| {
+            let mut key = *t;
+            key.sort_unstable();
+            seen.insert(key)
+        })
+        .collect();
+    let points = sums.iter().map(|(s, c)| Point::from(s / *c as f64)).collect();
+    (points, kept)
+}
+
+/// The tool decimated to at most `limit` triangles by vertex clustering ([`cluster`]) on the
+/// finest grid that keeps within the limit (bisection on the grid size); deterministic.
+pub fn decimate(vertices: &[Point], triangles: &[[u32; 3]], limit: usize) -> (Vec<Point>, Vec<[u32; 3]>) {
+    let mut lo = Point::from([f64::INFINITY; 3]);
+    let mut hi = Point::from([f64::NEG_INFINITY; 3]);
+    for v in vertices {
+        lo = lo.inf(v);
+        hi = hi.sup(v);
+    }
+    let size = (hi - lo).max();
+    if !(size.is_finite() && size > 0.0) {
+        return (Vec::new(), Vec::new());
+    }
+    // The triangle count grows with the grid (roughly as its square on a surface): bisect for
+    // the finest grid within the limit.
+    let (mut good, mut bad) = (1usize, MAX_CLUSTER_GRID);
+    let mut best = cluster(vertices, triangles, &lo, size, good);
+    while bad - good > 1 {
+        let mid = (good + bad) / 2;
+        let c = cluster(vertices, triangles, &lo, size, mid);
+        if c.1.len() <= limit {
+            (good, best) = (mid, c);
+        } else {
+            bad = mid;
+        }
+    }
+    best
+}
 
 /// One ply for the viewer.
 pub struct ViewerPly<'a> {
@@ -80,13 +173,13 @@ fn ply_json(p: &ViewerPly) -> Value {
     })
 }
 
-/// The page's data: the tool (mm; `None` when not read or too large), the plies, the shear
-/// colour map's stops and the shared colour limit (degrees).
-pub fn data_json(tool: Option<(&[Point], &[[u32; 3]])>, plies: &[ViewerPly], shear_limit: f64) -> String {
-    let tool = tool.filter(|(_, t)| t.len() <= TOOL_TRIANGLE_LIMIT).map(|(v, t)| {
+/// The page's data: the tool (mm; `None` when not read), the plies, the shear colour map's
+/// stops and the shared colour limit (degrees).
+pub fn data_json(tool: Option<&ViewTool>, plies: &[ViewerPly], shear_limit: f64) -> String {
+    let tool = tool.map(|t| {
         json!({
-            "v": v.iter().flat_map(|p| [mm(p.x), mm(p.y), mm(p.z)]).collect::<Vec<f64>>(),
-            "t": t.iter().flatten().copied().collect::<Vec<u32>>(),
+            "v": t.vertices.iter().flat_map(|p| [mm(p.x), mm(p.y), mm(p.z)]).collect::<Vec<f64>>(),
+            "t": t.triangles.iter().flatten().copied().collect::<Vec<u32>>(),
         })
     });
     let stops: Vec<Value> = super::view::DIVERGING.iter().map(|(t, c)| json!([t, c])).collect();
@@ -100,13 +193,22 @@ pub fn data_json(tool: Option<(&[Point], &[[u32; 3]])>, plies: &[ViewerPly], she
     data.to_string().replace("</", "<\\/")
 }
 
-/// The viewer's HTML: controls, the canvas, the data and the script.
-pub fn section(data: &str) -> String {
+/// The viewer's HTML: controls (with what the tool shown is, when `tool` says), the canvas, the
+/// data and the script.
+pub fn section(data: &str, tool: Option<&ViewTool>) -> String {
+    let note = match tool {
+        Some(t) if t.decimated() => format!(
+            r#" <span class="small" id="drape-tool-note">(decimated for the view: {} of its {} triangles)</span>"#,
+            t.triangles.len(),
+            t.original_triangles
+        ),
+        _ => String::new(),
+    };
     format!(
         r#"<h2 id="view3d">3D view</h2>
 <p class="small">Drag to rotate, shift-drag (or right-drag) to pan, wheel to zoom; point at a cell to read its values.</p>
 <div class="viewer-controls"><span id="drape-plies"></span>
-<label><input type="checkbox" id="drape-tool" checked> tool</label>
+<label><input type="checkbox" id="drape-tool" checked> tool</label>{note}
 <label>colour by <select id="drape-colour"><option value="shear">shear</option><option value="thickness">thickness</option><option value="vf">Vf</option></select></label>
 <button type="button" id="drape-reset">reset view</button></div>
 <canvas id="drape-view" width="1000" height="620"></canvas>
@@ -117,4 +219,44 @@ pub fn section(data: &str) -> String {
 {SCRIPT}</script>
 "#
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_large_tool_is_decimated_within_the_limit_and_keeps_its_shape() {
+        // A 193,600-triangle hemisphere of radius 1.
+        let mesh = crate::geometry::shapes::hemisphere(1.0, 220);
+        assert!(mesh.triangles.len() > 3 * TOOL_TRIANGLE_LIMIT, "{}", mesh.triangles.len());
+        let clock = std::time::Instant::now();
+        let t = ViewTool::new(&mesh.vertices, &mesh.triangles, TOOL_TRIANGLE_LIMIT);
+        eprintln!(
+            "decimated {} triangles to {} in {:.0} ms",
+            mesh.triangles.len(),
+            t.triangles.len(),
+            clock.elapsed().as_secs_f64() * 1e3
+        );
+        assert!(t.decimated() && t.original_triangles == mesh.triangles.len());
+        // Within the limit, yet not needlessly coarse: the finest grid that fits.
+        let n = t.triangles.len();
+        assert!(n <= TOOL_TRIANGLE_LIMIT && n > TOOL_TRIANGLE_LIMIT / 3, "{n} triangles");
+        // Every vertex is a mean of points on the sphere, within a grid cell of it.
+        for p in &t.vertices {
+            let r = p.coords.norm();
+            assert!(r <= 1.0 + 1e-12 && r > 0.99, "radius {r}");
+        }
+        assert!(t.triangles.iter().flatten().all(|&v| (v as usize) < t.vertices.len()));
+        // The viewer's legend says so.
+        let html = section("{}", Some(&t));
+        assert!(html.contains(&format!("decimated for the view: {n} of its 193600 triangles")), "{html}");
+        assert!(!section("{}", None).contains("decimated"));
+        // Deterministic, and a small tool is shown as read.
+        let again = ViewTool::new(&mesh.vertices, &mesh.triangles, TOOL_TRIANGLE_LIMIT);
+        assert_eq!((again.vertices, again.triangles), (t.vertices, t.triangles));
+        let small = crate::geometry::shapes::hemisphere(1.0, 8);
+        let s = ViewTool::new(&small.vertices, &small.triangles, TOOL_TRIANGLE_LIMIT);
+        assert!(!s.decimated() && s.triangles == small.triangles);
+    }
 }
