@@ -437,9 +437,9 @@ pub fn drape_on<S: DrapeSurface>(surface: &S, settings: &KinematicSettings) -> R
         })
         .collect();
     // The generator row and column of each quadrant, copied before the net is cut up.
-    let axes: Vec<(Vec<Option<Placed>>, Vec<Option<Placed>>)> = quadrants
+    let axes: Vec<_> = quadrants
         .iter()
-        .map(|q| {
+        .map(|q| -> (Vec<Option<Placed>>, Vec<Option<Placed>>) {
             let node = |a: usize, b: usize| {
                 let i = (i0 as i64 + q.si * a as i64) as usize;
                 let j = (j0 as i64 + q.sj * b as i64) as usize;
