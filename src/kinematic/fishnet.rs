@@ -333,20 +333,6 @@ impl QuadrantRows<'_> {
             j0 - b
         }
     }
-
-    /// Node (a, b) if it was placed.
-    #[inline]
-    fn get(&self, q: &Quadrant, j0: usize, a: usize, b: usize) -> Option<Placed> {
-        if a == 0 {
-            return self.row0[b];
-        }
-        if b == 0 {
-            return self.column0[a];
-        }
-        let (r, c) = (a - 1, self.column(q, j0, b));
-        (self.status[r][c] == NodeStatus::Placed)
-            .then(|| Placed { point: self.positions[r][c], triangle: self.triangles[r][c] })
-    }
 }
 
 /// The rows of `values` (the net's `nu x nv` node array) off the origin's row and column, cut
@@ -578,7 +564,10 @@ fn write_generators(net: &mut DrapeNet, g: &Generators) {
     }
 }
 
-/// Fill one quadrant of the net in place, anti-diagonal by anti-diagonal.
+/// Fill one quadrant of the net in place, anti-diagonal by anti-diagonal. A node's parents lie
+/// on the two anti-diagonals before its own, so those two are kept as compact arrays (node
+/// (a, k - a) of anti-diagonal k at index a): the parents are read from memory side by side,
+/// not from three of the net's rows each.
 fn fill_quadrant<S: DrapeSurface>(
     surface: &S,
     settings: &KinematicSettings,
@@ -590,43 +579,61 @@ fn fill_quadrant<S: DrapeSurface>(
     let (si, sj) = (q.si as f64, q.sj as f64);
     let d = settings.spacing;
     let max_shear = settings.max_shear;
-    let solve = |rows: &QuadrantRows, a: usize, b: usize| -> Result<Placed, NodeStatus> {
-        let pa = rows.get(q, j0, a - 1, b);
-        let pb = rows.get(q, j0, a, b - 1);
-        let pc = rows.get(q, j0, a - 1, b - 1);
-        match (pa, pb, pc) {
-            (Some(pa), Some(pb), Some(pc)) => place_node(surface, d, max_shear, &pa, &pb, &pc.point, si, sj),
-            _ => Err(NodeStatus::ParentMissing),
-        }
-    };
+    // Anti-diagonals k - 2, k - 1 and k; 0 and 1 hold generator nodes only.
+    let mut before: Vec<Option<Placed>> = vec![None; na];
+    let mut last: Vec<Option<Placed>> = vec![None; na];
+    let mut this: Vec<Option<Placed>> = vec![None; na];
+    before[0] = rows.row0[0];
+    if nb > 1 {
+        last[0] = rows.row0[1];
+    }
+    if na > 1 {
+        last[1] = rows.column0[1];
+    }
     let mut results: Vec<Result<Placed, NodeStatus>> = Vec::new();
     for k in 2..(na + nb - 1) {
-        // Nodes with a + b = k, 1 <= a < na, 1 <= b < nb.
+        if k < nb {
+            this[0] = rows.row0[k];
+        }
+        if k < na {
+            this[k] = rows.column0[k];
+        }
+        // Nodes with a + b = k, 1 <= a < na, 1 <= b < nb: parents (a - 1, b) and (a, b - 1) on
+        // anti-diagonal k - 1 at a - 1 and a, the diagonal node (a - 1, b - 1) on k - 2 at a - 1.
         let a_lo = k.saturating_sub(nb - 1).max(1);
         let a_hi = (k - 1).min(na - 1);
-        if a_lo > a_hi {
-            continue;
-        }
-        let len = a_hi - a_lo + 1;
-        if len >= PARALLEL_DIAGONAL {
-            let shared = &*rows;
-            (a_lo..a_hi + 1).into_par_iter().map(|a| solve(shared, a, k - a)).collect_into_vec(&mut results);
-        } else {
-            results.clear();
-            results.extend((a_lo..=a_hi).map(|a| solve(rows, a, k - a)));
-        }
-        for (off, r) in results.iter().enumerate() {
-            let a = a_lo + off;
-            let (row, c) = (a - 1, rows.column(q, j0, k - a));
-            match r {
-                Ok(p) => {
-                    rows.positions[row][c] = p.point;
-                    rows.triangles[row][c] = p.triangle;
-                    rows.status[row][c] = NodeStatus::Placed;
+        if a_lo <= a_hi {
+            let (last, before) = (&last, &before);
+            let solve = |a: usize| -> Result<Placed, NodeStatus> {
+                match (last[a - 1], last[a], before[a - 1]) {
+                    (Some(pa), Some(pb), Some(pc)) => place_node(surface, d, max_shear, &pa, &pb, &pc.point, si, sj),
+                    _ => Err(NodeStatus::ParentMissing),
                 }
-                Err(s) => rows.status[row][c] = *s,
+            };
+            if a_hi - a_lo + 1 >= PARALLEL_DIAGONAL {
+                (a_lo..a_hi + 1).into_par_iter().map(solve).collect_into_vec(&mut results);
+            } else {
+                results.clear();
+                results.extend((a_lo..=a_hi).map(solve));
+            }
+            for (off, r) in results.iter().enumerate() {
+                let a = a_lo + off;
+                let (row, c) = (a - 1, rows.column(q, j0, k - a));
+                match r {
+                    Ok(p) => {
+                        rows.positions[row][c] = p.point;
+                        rows.triangles[row][c] = p.triangle;
+                        rows.status[row][c] = NodeStatus::Placed;
+                    }
+                    Err(s) => rows.status[row][c] = *s,
+                }
+                this[a] = r.ok();
             }
         }
+        // k - 1 becomes k - 2, k becomes k - 1; `this` is overwritten where anti-diagonal k + 1
+        // has nodes before it is read.
+        std::mem::swap(&mut before, &mut last);
+        std::mem::swap(&mut last, &mut this);
     }
 }
 
