@@ -10,8 +10,12 @@ static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Write `path` through `f`: the bytes go to a temporary file `.NAME.tmp-PID-N` in the same
 /// directory, which is flushed, synced and then renamed over `path`. On any error (or a panic
-/// inside `f`) the temporary file is removed and `path` is left as it was.
-pub fn write_atomic(path: &Path, f: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>) -> Result<(), ExportError> {
+/// inside `f`) the temporary file is removed and `path` is left as it was. A large file is
+/// synced as it is written ([`SyncAheadFile`]), so the final sync waits for its tail only.
+pub fn write_atomic(
+    path: &Path,
+    f: impl FnOnce(&mut BufWriter<SyncAheadFile>) -> io::Result<()>,
+) -> Result<(), ExportError> {
     let err = |source: io::Error| ExportError::Write { path: path.to_path_buf(), source };
     let file_name = path
         .file_name()
@@ -28,14 +32,81 @@ pub fn write_atomic(path: &Path, f: impl FnOnce(&mut BufWriter<File>) -> io::Res
     let temp_path = temp.path().to_path_buf();
 
     let file = OpenOptions::new().write(true).create_new(true).open(&temp_path).map_err(err)?;
-    let mut w = BufWriter::new(file);
+    let mut w = BufWriter::new(SyncAheadFile::new(file));
     f(&mut w).map_err(err)?;
     let file = w.into_inner().map_err(|e| err(e.into_error()))?;
-    file.sync_all().map_err(err)?;
-    drop(file);
+    file.finish().map_err(err)?;
     fs::rename(&temp_path, path).map_err(err)?;
     temp.disarm();
     Ok(())
+}
+
+/// Bytes written between two background syncs of a [`SyncAheadFile`].
+const SYNC_AHEAD: u64 = 8 << 20;
+
+/// The temporary file of [`write_atomic`]. Every [`SYNC_AHEAD`] bytes it starts syncing what is
+/// written so far on a background thread (one at a time), so the disk writes a large file while
+/// the rest of it is formatted, and the sync before the rename waits for the tail only. (Whole
+/// `fsync` calls on a clone of the file: `sync_file_range` would need `unsafe` and `libc`.)
+pub struct SyncAheadFile {
+    file: File,
+    written: u64,
+    next_sync: u64,
+    syncing: Option<std::thread::JoinHandle<io::Result<()>>>,
+}
+
+impl SyncAheadFile {
+    fn new(file: File) -> Self {
+        SyncAheadFile { file, written: 0, next_sync: SYNC_AHEAD, syncing: None }
+    }
+
+    /// The background sync's outcome, waiting for it.
+    fn join_sync(&mut self) -> io::Result<()> {
+        match self.syncing.take() {
+            Some(h) => h.join().unwrap_or_else(|_| Err(io::Error::other("the background sync panicked"))),
+            None => Ok(()),
+        }
+    }
+
+    /// Start syncing what is written, unless the last sync is still running.
+    fn sync_ahead(&mut self) -> io::Result<()> {
+        if self.syncing.as_ref().is_some_and(|h| !h.is_finished()) {
+            return Ok(());
+        }
+        self.join_sync()?;
+        let file = self.file.try_clone()?;
+        self.syncing = Some(std::thread::spawn(move || file.sync_data()));
+        self.next_sync = self.written + SYNC_AHEAD;
+        Ok(())
+    }
+
+    /// Wait for the background sync, then sync the whole file (data and metadata).
+    fn finish(mut self) -> io::Result<()> {
+        self.join_sync()?;
+        self.file.sync_all()
+    }
+}
+
+impl io::Write for SyncAheadFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.written += n as u64;
+        if self.written >= self.next_sync {
+            self.sync_ahead()?;
+        }
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.flush()
+    }
+}
+
+impl Drop for SyncAheadFile {
+    fn drop(&mut self) {
+        // On an error path: do not leave a thread syncing a file that is being removed.
+        let _ = self.join_sync();
+    }
 }
 
 /// Removes the temporary file when dropped, unless disarmed after the rename.
@@ -62,6 +133,17 @@ impl Drop for TempGuard {
 mod tests {
     use super::*;
     use std::io::Write;
+
+    #[test]
+    fn a_file_larger_than_the_sync_step_is_written_whole() {
+        // Several background syncs while writing: the bytes are all there, in order.
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.bin");
+        let bytes: Vec<u8> = (0..(2 * SYNC_AHEAD as usize + 12_345)).map(|k| (k % 251) as u8).collect();
+        write_atomic(&p, |w| bytes.chunks(100_003).try_for_each(|c| w.write_all(c))).unwrap();
+        assert_eq!(fs::read(&p).unwrap(), bytes);
+        assert_eq!(entries(dir.path()), vec!["big.bin"]);
+    }
 
     fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> =

@@ -38,7 +38,7 @@ mod tool;
 pub mod vtk;
 pub mod xml;
 
-pub use atomic::write_atomic;
+pub use atomic::{write_atomic, SyncAheadFile};
 pub use csv::{write_csv, CSV_HEADER};
 pub use error::ExportError;
 pub use net::{kinematic_net_path, write_net, write_net_shears, Format, KINEMATIC_NET_SUFFIX};

@@ -1,8 +1,8 @@
 //! Fishnet cell completion: every node off the generators is the point of the tool at distance d
 //! from its two placed neighbours (the intersection of the tool with a circle), on the side away
-//! from the diagonal node. Quadrants are filled in parallel, each one anti-diagonal at a time
-//! (every node of an anti-diagonal depends only on the one before), so the result does not depend
-//! on the number of threads.
+//! from the diagonal node. Quadrants are filled in parallel, each in its own part of the net (in
+//! place), one anti-diagonal at a time (every node of an anti-diagonal depends only on the one
+//! before), so the result does not depend on the number of threads.
 use super::generators::{lay_generators, Generators};
 use super::net::{corner_shear, DrapeNet, Method, NodeStatus};
 use super::surface::DrapeSurface;
@@ -32,7 +32,9 @@ pub const MIN_SPACING_REL: f64 = 1e-7;
 /// and far below where squared distances overflow (`io::net_json::MAX_NET_COORDINATE` is this).
 pub const MAX_COORDINATE: f64 = 1e6;
 
-/// Bytes of memory per node while a net is being built (positions, triangle, status, quadrant copy).
+/// Bytes of memory per node while a net is built and written: its position, triangle and status
+/// (29), each cell's shear as the writer keeps it (16), and room for the rest (the quadrants fill
+/// the net in place; they once kept a copy of it).
 pub const BYTES_PER_NODE: usize = 2 * (24 + 4 + 1) + 8;
 
 /// Why a drape could not start. Per-node failures are not errors: they are recorded in the net.
@@ -307,11 +309,54 @@ struct Quadrant {
     nb: usize,
 }
 
-/// Quadrant-local node storage, index a * nb + b.
-struct QuadrantNodes {
-    placed: Vec<Option<Placed>>,
-    status: Vec<NodeStatus>,
+/// One quadrant's part of the net, written in place: its rows `a = 1..na` (row `a` at index
+/// `a - 1`), each the half-row of columns `b = 1..nb` (at `b - 1` when `sj > 0`, else at
+/// `j0 - b`), of positions, triangles and statuses; and its generator row (`a = 0`) and column
+/// (`b = 0`), copied, since neighbouring quadrants read them too.
+struct QuadrantRows<'n> {
+    positions: Vec<&'n mut [Point]>,
+    triangles: Vec<&'n mut [u32]>,
+    status: Vec<&'n mut [NodeStatus]>,
+    /// Nodes (a, 0), a = 0..na.
+    column0: Vec<Option<Placed>>,
+    /// Nodes (0, b), b = 0..nb.
+    row0: Vec<Option<Placed>>,
 }
+
+impl QuadrantRows<'_> {
+    /// Index of node (a >= 1, b >= 1) in its half-row `a - 1`.
+    #[inline]
+    fn column(&self, q: &Quadrant, j0: usize, b: usize) -> usize {
+        if q.sj > 0 {
+            b - 1
+        } else {
+            j0 - b
+        }
+    }
+}
+
+/// The rows of `values` (the net's `nu x nv` node array) off the origin's row and column, cut
+/// into the four quadrants' half-rows in the order of [`QUADRANTS`], rows in order of growing
+/// distance from the origin's row. Disjoint borrows: the quadrants fill in parallel, in place.
+fn split_quadrants<T>(values: &mut [T], nv: usize, (i0, j0): (usize, usize)) -> [Vec<&mut [T]>; 4] {
+    let (above, rest) = values.split_at_mut(i0 * nv);
+    let below = &mut rest[nv..];
+    let mut out: [Vec<&mut [T]>; 4] = Default::default();
+    // QUADRANTS: (1, 1), (-1, 1), (-1, -1), (1, -1).
+    for (rows, (right, left)) in
+        [(below.chunks_mut(nv).collect::<Vec<_>>(), (0, 3)), (above.chunks_mut(nv).rev().collect(), (1, 2))]
+    {
+        for row in rows {
+            let (l, r) = row.split_at_mut(j0);
+            out[right].push(&mut r[1..]);
+            out[left].push(l);
+        }
+    }
+    out
+}
+
+/// The quadrants' directions (si, sj), in the order the fill takes them.
+const QUADRANTS: [(i64, i64); 4] = [(1, 1), (-1, 1), (-1, -1), (1, -1)];
 
 /// Drape one ply on the tool with the kinematic (fishnet) method, on the surface the settings
 /// name: the facets as given or the smooth surface over them ([`SurfaceKind`]).
@@ -376,7 +421,7 @@ pub fn drape_on<S: DrapeSurface>(surface: &S, settings: &KinematicSettings) -> R
     let mut net = DrapeNet::new(&settings.name, d, nu, nv, (i0, j0));
     net.method = Method::Kinematic;
     write_generators(&mut net, &generators);
-    let quadrants: Vec<Quadrant> = [(1i64, 1i64), (-1, 1), (-1, -1), (1, -1)]
+    let quadrants: Vec<Quadrant> = QUADRANTS
         .into_iter()
         .map(|(si, sj)| Quadrant {
             si,
@@ -385,22 +430,36 @@ pub fn drape_on<S: DrapeSurface>(surface: &S, settings: &KinematicSettings) -> R
             nb: if sj > 0 { nv - j0 } else { j0 + 1 },
         })
         .collect();
-    let filled: Vec<QuadrantNodes> = quadrants.par_iter().map(|q| fill_quadrant(surface, settings, &net, q)).collect();
-    for (q, nodes) in quadrants.iter().zip(&filled) {
-        for a in 1..q.na {
-            for b in 1..q.nb {
-                let k = a * q.nb + b;
+    // The generator row and column of each quadrant, copied before the net is cut up.
+    let axes: Vec<_> = quadrants
+        .iter()
+        .map(|q| -> (Vec<Option<Placed>>, Vec<Option<Placed>>) {
+            let node = |a: usize, b: usize| {
                 let i = (i0 as i64 + q.si * a as i64) as usize;
                 let j = (j0 as i64 + q.sj * b as i64) as usize;
-                let g = net.index(i, j);
-                net.status[g] = nodes.status[k];
-                if let Some(p) = nodes.placed[k] {
-                    net.positions[g] = p.point;
-                    net.triangles[g] = p.triangle;
-                }
-            }
-        }
-    }
+                let k = net.index(i, j);
+                (net.status[k] == NodeStatus::Placed)
+                    .then(|| Placed { point: net.positions[k], triangle: net.triangles[k] })
+            };
+            ((0..q.na).map(|a| node(a, 0)).collect(), (0..q.nb).map(|b| node(0, b)).collect())
+        })
+        .collect();
+    // Each quadrant fills its own nodes of the net in place (no copy to merge afterwards).
+    let [p0, p1, p2, p3] = split_quadrants(&mut net.positions, nv, (i0, j0));
+    let [t0, t1, t2, t3] = split_quadrants(&mut net.triangles, nv, (i0, j0));
+    let [s0, s1, s2, s3] = split_quadrants(&mut net.status, nv, (i0, j0));
+    let parts: Vec<QuadrantRows> = [(p0, t0, s0), (p1, t1, s1), (p2, t2, s2), (p3, t3, s3)]
+        .into_iter()
+        .zip(axes)
+        .map(|((positions, triangles, status), (column0, row0))| QuadrantRows {
+            positions,
+            triangles,
+            status,
+            column0,
+            row0,
+        })
+        .collect();
+    quadrants.par_iter().zip(parts).for_each(|(q, mut rows)| fill_quadrant(surface, settings, j0, q, &mut rows));
     if let Some(o) = &outline {
         o.drop_outside(&mut net);
     }
@@ -513,68 +572,77 @@ fn write_generators(net: &mut DrapeNet, g: &Generators) {
     }
 }
 
-/// Fill one quadrant, anti-diagonal by anti-diagonal.
+/// Fill one quadrant of the net in place, anti-diagonal by anti-diagonal. A node's parents lie
+/// on the two anti-diagonals before its own, so those two are kept as compact arrays (node
+/// (a, k - a) of anti-diagonal k at index a): the parents are read from memory side by side,
+/// not from three of the net's rows each.
 fn fill_quadrant<S: DrapeSurface>(
     surface: &S,
     settings: &KinematicSettings,
-    net: &DrapeNet,
+    j0: usize,
     q: &Quadrant,
-) -> QuadrantNodes {
+    rows: &mut QuadrantRows,
+) {
     let (na, nb) = (q.na, q.nb);
-    let (i0, j0) = net.origin_node;
-    let mut nodes = QuadrantNodes { placed: vec![None; na * nb], status: vec![NodeStatus::Pending; na * nb] };
-    // Row a = 0 and column b = 0 come from the generators.
-    for a in 0..na {
-        for b in [0usize].into_iter().chain(if a == 0 { 1..nb } else { 0..0 }) {
-            let i = (i0 as i64 + q.si * a as i64) as usize;
-            let j = (j0 as i64 + q.sj * b as i64) as usize;
-            let k = net.index(i, j);
-            nodes.status[a * nb + b] = net.status[k];
-            if net.status[k] == NodeStatus::Placed {
-                nodes.placed[a * nb + b] = Some(Placed { point: net.positions[k], triangle: net.triangles[k] });
-            }
-        }
-    }
     let (si, sj) = (q.si as f64, q.sj as f64);
     let d = settings.spacing;
     let max_shear = settings.max_shear;
-    let solve = |nodes: &QuadrantNodes, a: usize, b: usize| -> Result<Placed, NodeStatus> {
-        let pa = nodes.placed[(a - 1) * nb + b];
-        let pb = nodes.placed[a * nb + b - 1];
-        let pc = nodes.placed[(a - 1) * nb + b - 1];
-        match (pa, pb, pc) {
-            (Some(pa), Some(pb), Some(pc)) => place_node(surface, d, max_shear, &pa, &pb, &pc.point, si, sj),
-            _ => Err(NodeStatus::ParentMissing),
-        }
-    };
+    // Anti-diagonals k - 2, k - 1 and k; 0 and 1 hold generator nodes only.
+    let mut before: Vec<Option<Placed>> = vec![None; na];
+    let mut last: Vec<Option<Placed>> = vec![None; na];
+    let mut this: Vec<Option<Placed>> = vec![None; na];
+    before[0] = rows.row0[0];
+    if nb > 1 {
+        last[0] = rows.row0[1];
+    }
+    if na > 1 {
+        last[1] = rows.column0[1];
+    }
     let mut results: Vec<Result<Placed, NodeStatus>> = Vec::new();
     for k in 2..(na + nb - 1) {
-        // Nodes with a + b = k, 1 <= a < na, 1 <= b < nb.
+        if k < nb {
+            this[0] = rows.row0[k];
+        }
+        if k < na {
+            this[k] = rows.column0[k];
+        }
+        // Nodes with a + b = k, 1 <= a < na, 1 <= b < nb: parents (a - 1, b) and (a, b - 1) on
+        // anti-diagonal k - 1 at a - 1 and a, the diagonal node (a - 1, b - 1) on k - 2 at a - 1.
         let a_lo = k.saturating_sub(nb - 1).max(1);
         let a_hi = (k - 1).min(na - 1);
-        if a_lo > a_hi {
-            continue;
-        }
-        let len = a_hi - a_lo + 1;
-        if len >= PARALLEL_DIAGONAL {
-            (a_lo..a_hi + 1).into_par_iter().map(|a| solve(&nodes, a, k - a)).collect_into_vec(&mut results);
-        } else {
-            results.clear();
-            results.extend((a_lo..=a_hi).map(|a| solve(&nodes, a, k - a)));
-        }
-        for (off, r) in results.iter().enumerate() {
-            let a = a_lo + off;
-            let idx = a * nb + (k - a);
-            match r {
-                Ok(p) => {
-                    nodes.placed[idx] = Some(*p);
-                    nodes.status[idx] = NodeStatus::Placed;
+        if a_lo <= a_hi {
+            let (last, before) = (&last, &before);
+            let solve = |a: usize| -> Result<Placed, NodeStatus> {
+                match (last[a - 1], last[a], before[a - 1]) {
+                    (Some(pa), Some(pb), Some(pc)) => place_node(surface, d, max_shear, &pa, &pb, &pc.point, si, sj),
+                    _ => Err(NodeStatus::ParentMissing),
                 }
-                Err(s) => nodes.status[idx] = *s,
+            };
+            if a_hi - a_lo + 1 >= PARALLEL_DIAGONAL {
+                (a_lo..a_hi + 1).into_par_iter().map(solve).collect_into_vec(&mut results);
+            } else {
+                results.clear();
+                results.extend((a_lo..=a_hi).map(solve));
+            }
+            for (off, r) in results.iter().enumerate() {
+                let a = a_lo + off;
+                let (row, c) = (a - 1, rows.column(q, j0, k - a));
+                match r {
+                    Ok(p) => {
+                        rows.positions[row][c] = p.point;
+                        rows.triangles[row][c] = p.triangle;
+                        rows.status[row][c] = NodeStatus::Placed;
+                    }
+                    Err(s) => rows.status[row][c] = *s,
+                }
+                this[a] = r.ok();
             }
         }
+        // k - 1 becomes k - 2, k becomes k - 1; `this` is overwritten where anti-diagonal k + 1
+        // has nodes before it is read.
+        std::mem::swap(&mut before, &mut last);
+        std::mem::swap(&mut last, &mut this);
     }
-    nodes
 }
 
 /// Mean shear (radians) of the cell with warp parent `a`, weft parent `b`, diagonal `c` and new
