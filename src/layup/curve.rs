@@ -30,7 +30,7 @@ pub const SMOOTH_CHORD_TOL: f64 = 5e-5;
 /// Largest distance (m) between an offset's round arc and its sampled chords.
 pub const OFFSET_ARC_TOL: f64 = 5e-5;
 
-/// Pieces of a split offset with a point closer to the cut than the margin less this (m) are
+/// Pieces of an offset with a point closer to the cut than the margin less this (m) are
 /// dropped: twice [`OFFSET_ARC_TOL`], as a crossing on a round join's chord lies up to that
 /// inside the arc, and the tails cut off at concavities come closer by far more.
 const OFFSET_KEEP_TOL: f64 = 2.0 * OFFSET_ARC_TOL;
@@ -303,7 +303,6 @@ pub fn offset_loops(loops: &[Vec<P>], margin: f64) -> Option<Vec<Vec<Vec<P>>>> {
         let raw = raw_offset(&l, margin);
         let mut todo = vec![raw];
         let mut pieces = Vec::new();
-        let mut split = false;
         let mut splits = 0;
         while let Some(r) = todo.pop() {
             match first_crossing(std::slice::from_ref(&r)) {
@@ -312,7 +311,6 @@ pub fn offset_loops(loops: &[Vec<P>], margin: f64) -> Option<Vec<Vec<Vec<P>>>> {
                     if splits > MAX_SPLITS {
                         return None;
                     }
-                    split = true;
                     let (i, j) = (c.a.1, c.b.1);
                     let mut one = vec![c.at];
                     one.extend_from_slice(&r[i + 1..=j]);
@@ -337,7 +335,8 @@ pub fn offset_loops(loops: &[Vec<P>], margin: f64) -> Option<Vec<Vec<Vec<P>>>> {
         let mut kept: Vec<Vec<P>> = pieces
             .into_iter()
             .filter(|r| signed_area(r).signum() == sign)
-            .filter(|r| !split || r.iter().all(|&p| distance_to_loops(p, loops) >= keep_at))
+            // Also without a crossing: a hole offset past half its width turns inside out.
+            .filter(|r| r.iter().all(|&p| distance_to_loops(p, loops) >= keep_at))
             .collect();
         if sign > 0.0 {
             // An outer loop grown outward is one loop: the rest are slivers of its tails.
