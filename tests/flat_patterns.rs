@@ -12,8 +12,8 @@ use drape::io::dxf::{dxf_layer_names, write_dxf};
 use drape::io::svg::{svg_ids, write_pattern_svg, write_svg};
 use drape::kinematic::{drape, DrapeNet, Extent, KinematicSettings, NodeStatus};
 use drape::layup::flat::{
-    flat_pattern, flat_pattern_in_outline, flat_pattern_with_margin, ply_pattern, shoelace_area, CutLine, FlatError,
-    FlatPattern, Region,
+    flat_pattern, flat_pattern_in_outline, flat_pattern_smooth, flat_pattern_with_margin, ply_pattern, shoelace_area,
+    CutLine, CutWarning, FlatError, FlatPattern, Region,
 };
 use drape::layup::nest::{nest, Nesting, Rotation};
 use proptest::prelude::*;
@@ -25,11 +25,11 @@ use std::sync::OnceLock;
 /// Relative tolerance between areas computed two ways in floating point.
 const AREA_REL: f64 = 1e-12;
 /// Relative tolerance of areas read back from a file (coordinates printed in mm).
-const FILE_AREA_REL: f64 = 1e-9;
+pub(crate) const FILE_AREA_REL: f64 = 1e-9;
 /// Rounding-level length tolerance (m).
 const LEN_EPS: f64 = 1e-9;
 
-fn hemisphere() -> &'static ToolSurface {
+pub(crate) fn hemisphere() -> &'static ToolSurface {
     static TOOL: OnceLock<ToolSurface> = OnceLock::new();
     TOOL.get_or_init(|| shapes::hemisphere_with_triangles(1.0, 20_000).into_surface().unwrap())
 }
@@ -286,7 +286,7 @@ fn pinch() -> FlatPattern {
 }
 
 /// A flat net of `cells` (i, j) on an nu x nv grid, spacing d: a hand-made pattern shape.
-fn shape_net(name: &str, d: f64, nu: usize, nv: usize, cells: impl Fn(usize, usize) -> bool) -> DrapeNet {
+pub(crate) fn shape_net(name: &str, d: f64, nu: usize, nv: usize, cells: impl Fn(usize, usize) -> bool) -> DrapeNet {
     let mut net = DrapeNet::new(name, d, nu, nv, (nu / 2, nv / 2));
     for i in 0..nu - 1 {
         for j in 0..nv - 1 {
@@ -471,6 +471,8 @@ fn rect_pattern(name: &str, a: f64, b: f64, at: [f64; 2]) -> FlatPattern {
         half_cells: 0,
         area: a * b,
         cut: CutLine::Nodes,
+        margin: 0.0,
+        warnings: Vec::new(),
         min: [x0, y0],
         max: [x1, y1],
         anchor: [x0 + a / 2.0, y0 + b / 2.0],
@@ -520,7 +522,7 @@ fn nesting_refuses_a_piece_wider_than_the_roll() {
 }
 
 /// Whether the Python part should run; fails the test (with what to do) if ezdxf is missing.
-fn python_ready() -> bool {
+pub(crate) fn python_ready() -> bool {
     if std::env::var("DRAPE_SKIP_PYTHON").is_ok_and(|v| v == "1") {
         eprintln!("flat_patterns: DRAPE_SKIP_PYTHON=1: skipped the independent Python read-back");
         return false;
@@ -535,7 +537,7 @@ fn python_ready() -> bool {
     }
 }
 
-fn readback(files: &[&Path]) -> Value {
+pub(crate) fn readback(files: &[&Path]) -> Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/pattern_readback.py");
     let out = Command::new("python3").arg(&script).args(files).output().unwrap();
     assert!(
@@ -549,11 +551,11 @@ fn readback(files: &[&Path]) -> Value {
         .unwrap_or_else(|e| panic!("readback output is not JSON ({e}):\n{}", String::from_utf8_lossy(&out.stdout)))
 }
 
-fn num(v: &Value) -> f64 {
+pub(crate) fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-fn close(a: f64, b: f64, rel: f64) -> bool {
+pub(crate) fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * b.abs().max(1e-300)
 }
 
@@ -690,7 +692,7 @@ fn drawings_read_back_independently() {
 const MAX_OUTLINE_TURN_DEG: f64 = 10.0;
 
 /// A circle of `n` points round the z axis at `z`, radius `r`, counter-clockwise seen from +z.
-fn circle(r: f64, z: f64, n: usize) -> Vec<Point> {
+pub(crate) fn circle(r: f64, z: f64, n: usize) -> Vec<Point> {
     (0..n)
         .map(|k| {
             let t = k as f64 * std::f64::consts::TAU / n as f64;
@@ -722,12 +724,18 @@ fn outline_ply_on_a_plate_is_cut_along_the_outline_itself() {
     let p = flat_pattern(&net).unwrap();
     check_net_pattern(&p, &net);
     assert!(p.area < q.area && q.area - p.area < 2.0 * std::f64::consts::PI * r * d, "{} vs {}", p.area, q.area);
-    // What the run cuts: the outline without a margin, the grown cells with one.
+    // What the run cuts: the outline, also with a margin (offset from it); without an outline,
+    // the smooth curve through the boundary nodes.
     assert_eq!(ply_pattern(&net, Some(&outline), 0.0).unwrap(), q);
-    assert_eq!(ply_pattern(&net, None, 0.0).unwrap(), p);
-    assert_eq!(ply_pattern(&net, Some(&outline), 0.003).unwrap().cut, CutLine::GrownCells);
-    // An outline the net does not reach (twice as large) falls back to the boundary nodes.
-    assert_eq!(flat_pattern_in_outline(&net, &circle(2.0 * r, 0.0, n)).unwrap(), p);
+    let smooth = flat_pattern_smooth(&net).unwrap();
+    assert_eq!(ply_pattern(&net, None, 0.0).unwrap(), smooth);
+    let m = ply_pattern(&net, Some(&outline), 0.003).unwrap();
+    assert_eq!((m.cut, m.margin, m.warnings.len()), (CutLine::Outline, 0.003, 0));
+    // An outline the net does not reach (twice as large) falls back to the smooth curve through
+    // the boundary nodes, and says so.
+    let far = flat_pattern_in_outline(&net, &circle(2.0 * r, 0.0, n)).unwrap();
+    assert_eq!((far.cut, far.area), (CutLine::SmoothNodes, smooth.area));
+    assert_eq!(far.warnings, vec![CutWarning::OutlineOffNet { point: 0, of: n }]);
 }
 
 /// The chords through the boundary nodes follow a circle without the staircase of whole cells:

@@ -8,6 +8,7 @@ mod auto_method;
 mod calculix;
 mod chebyshev_reference;
 mod cli;
+mod cut_lines;
 mod developable;
 mod energy_derivatives;
 mod energy_parallel;

@@ -10,6 +10,8 @@ Prints one JSON object to stdout, {path: summary}, where a DXF summary has
   by_layer: {layer: {closed_polylines, open_polylines, lines, texts, text (list),
              signed_area_mm2, abs_area_mm2, vertices, bbox_mm [xmin, ymin, xmax, ymax] of the
              polylines, text_bbox_mm the same of the texts as ezdxf measures them,
+             text_boxes_mm (one [xmin, ymin, xmax, ymax] a text, in the order of `text`),
+             loops_mm (the closed polylines' vertices, [[x, y], ...] each),
              self_intersecting (loops that cross or repeat a vertex),
              loops_ccw, loops_cw, max_turn_deg (the largest turn between consecutive edges of
              the closed polylines, degrees), max_edge_mm (their longest edge)}}
@@ -97,7 +99,8 @@ def read_dxf(path):
         s = out["by_layer"].setdefault(e.dxf.layer, {
             "closed_polylines": 0, "open_polylines": 0, "lines": 0, "texts": 0, "text": [],
             "signed_area_mm2": 0.0, "abs_area_mm2": 0.0, "vertices": 0,
-            "bbox_mm": [inf, inf, -inf, -inf], "text_bbox_mm": [inf, inf, -inf, -inf], "self_intersecting": 0, "loops_ccw": 0, "loops_cw": 0,
+            "bbox_mm": [inf, inf, -inf, -inf], "text_bbox_mm": [inf, inf, -inf, -inf], "text_boxes_mm": [],
+            "loops_mm": [], "self_intersecting": 0, "loops_ccw": 0, "loops_cw": 0,
             "max_turn_deg": 0.0, "max_edge_mm": 0.0,
         })
         kind = e.dxftype()
@@ -110,6 +113,7 @@ def read_dxf(path):
                 s["open_polylines"] += 1
                 continue
             s["closed_polylines"] += 1
+            s["loops_mm"].append([list(p) for p in pts])
             a = signed_area(pts)
             s["signed_area_mm2"] += a
             s["abs_area_mm2"] += abs(a)
@@ -126,6 +130,7 @@ def read_dxf(path):
             s["text"].append(e.dxf.text)
             box = ezdxf.bbox.extents([e])
             bbox_update(s["text_bbox_mm"], [(box.extmin[0], box.extmin[1]), (box.extmax[0], box.extmax[1])])
+            s["text_boxes_mm"].append([box.extmin[0], box.extmin[1], box.extmax[0], box.extmax[1]])
     return out
 
 

@@ -85,6 +85,7 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
         }
         Event::Layup { scene, results } => println!("{}", layup_table(scene, results)),
         Event::NoPattern { ply } => println!("ply {ply}: no complete cell, no flat pattern"),
+        Event::PatternWarning { ply, warning } => println!("warning: ply '{ply}': flat pattern: {warning}"),
         Event::RollWidthAssumed { width } => {
             println!("no roll_width in the scene: nesting on a roll {width:.3} m wide (the widest piece)")
         }

@@ -11,18 +11,27 @@
 //!   along that outline, each of its points located on the draped net (its cell and the
 //!   bilinear parameters there, extended up to [`OUTLINE_REACH`] cells beyond the placed cells,
 //!   where the nodes outside the outline were refused) and carried into the flat frame;
-//! - **the boundary nodes** ([`flat_pattern`]): otherwise the polygon through the net's placed
-//!   boundary nodes, the boundary of the cells with four placed corners and of the half cells
-//!   (triangles) whose three corners were placed. Its edges run along a fibre or across one
-//!   cell's diagonal, so a curved edge is followed by chords, not by a staircase of whole cells;
-//! - **the cells grown by a margin** ([`flat_pattern_with_margin`] with a margin): the union of
-//!   the complete cells, each grown by the margin (a staircase with square corners).
+//! - **the smooth curve through the boundary nodes** ([`flat_pattern_smooth`]): otherwise a
+//!   smooth closed curve ([`super::curve::smooth_loop`]: cubic Hermite, corners kept)
+//!   through the points of the boundary polygon ([`flat_pattern`]: the polygon through the net's
+//!   placed boundary nodes, the boundary of the cells with four placed corners and of the half
+//!   cells (triangles) whose three corners were placed; its edges run along a fibre or across one
+//!   cell's diagonal);
+//! - **with a cutting margin** ([`with_margin`]): that cut line offset outward by the margin in
+//!   the flat plane ([`super::curve::offset_loops`]: round joins); when the offset loops would
+//!   overlap (pieces or a hole closer than twice the margin), the complete cells each grown by
+//!   the margin ([`flat_pattern_with_margin`], a staircase with square corners) instead.
+//!
+//! A pattern not cut along the line its ply asks for (an outline the net does not carry, a
+//! margin that cannot be offset) says why in [`FlatPattern::warnings`].
 //!
 //! Nodes lost for other reasons than an outline (off the tool, shear limit, folds) are trimmed
 //! the same way: the pattern is the fabric that actually lies on the tool.
+use super::curve::{first_crossing, offset_loops, smooth_loop};
 use crate::geometry::Point;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// Why a flat pattern or a nesting could not be made.
@@ -92,15 +101,43 @@ pub struct Region {
     pub area: f64,
 }
 
-/// The line a pattern is cut along (see the module comment).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The line a pattern is cut along (see the module comment). With a cutting margin, the line
+/// the margin was offset from ([`FlatPattern::margin`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum CutLine {
     /// The ply's outline, carried through the draped net into the flat frame.
     Outline,
     /// The polygon through the net's placed boundary nodes (complete cells and half cells).
     Nodes,
+    /// The smooth curve through the points of that polygon (corners kept).
+    SmoothNodes,
     /// The complete cells, each grown by the cutting margin.
     GrownCells,
+}
+
+/// Why a pattern is not cut along the line its ply asks for. Recorded in the pattern, printed by
+/// `drape run`, written in `layup.json` and shown in the report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, thiserror::Error)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum CutWarning {
+    /// A point of the ply's outline does not land on the draped net.
+    #[error("outline point {point} (of {of}) is not on the draped net within {reach} cells of its placed cells (the ply did not reach it), so the pattern is cut along the smooth curve through the boundary nodes, not along the outline", reach = OUTLINE_REACH)]
+    OutlineOffNet {
+        /// Index of the first such point in the outline.
+        point: usize,
+        /// Number of outline points.
+        of: usize,
+    },
+    /// The outline carried into the flat frame crosses itself or encloses no area.
+    #[error("the outline carried into the flat frame crosses itself or encloses no area (the net folds or shears too much along it), so the pattern is cut along the smooth curve through the boundary nodes, not along the outline")]
+    OutlineNotSimple,
+    /// The cut line offset by the margin overlaps itself.
+    #[error("the cutting margin of {margin} m around the cut line makes pieces or holes overlap (closer than twice the margin), so the margin is grown around the complete cells instead (square steps of whole cells)")]
+    MarginOverlaps {
+        /// The margin, m.
+        margin: f64,
+    },
 }
 
 /// The flat cutting pattern of one ply, in its own frame: metres, warp along +x, weft along +y,
@@ -125,6 +162,10 @@ pub struct FlatPattern {
     pub area: f64,
     /// The line the pattern is cut along.
     pub cut: CutLine,
+    /// The cutting margin included outside that line (m; 0 without one).
+    pub margin: f64,
+    /// Why the pattern is not cut along the line its ply asks for (empty when it is).
+    pub warnings: Vec<CutWarning>,
     /// Lower-left corner of the bounding box (m).
     pub min: [f64; 2],
     /// Upper-right corner of the bounding box (m).
@@ -186,22 +227,68 @@ const PATCH_STEPS: usize = 12;
 /// converge.
 const PATCH_CONVERGED: f64 = 1e-9;
 
+/// The flat pattern of a draped net cut along the smooth curve through its boundary nodes: each
+/// loop of [`flat_pattern`] replaced by [`smooth_loop`] through its points (the boundary nodes
+/// where it turns; an edge ending at a corner stays straight). A loop whose curve would cross
+/// itself keeps its chords; if the curves of two loops cross, the whole pattern keeps its chords
+/// and says [`CutLine::Nodes`]. The area is the curves' shoelace area. Errors as
+/// [`flat_pattern`].
+pub fn flat_pattern_smooth(net: &DrapeNet) -> Result<FlatPattern, FlatError> {
+    let nodes = flat_pattern(net)?;
+    let regions: Vec<Region> = nodes
+        .regions
+        .iter()
+        .map(|r| {
+            let loops: Vec<Vec<[f64; 2]>> = r
+                .loops
+                .iter()
+                .map(|l| {
+                    let s = smooth_loop(l);
+                    if first_crossing(std::slice::from_ref(&s)).is_some() {
+                        l.clone()
+                    } else {
+                        s
+                    }
+                })
+                .collect();
+            let area = loops.iter().map(|l| shoelace_area(l)).sum();
+            Region { loops, cells: r.cells, area }
+        })
+        .collect();
+    let all: Vec<Vec<[f64; 2]>> = regions.iter().flat_map(|r| r.loops.iter().cloned()).collect();
+    if first_crossing(&all).is_some() {
+        return Ok(nodes);
+    }
+    let area = regions.iter().map(|r| r.area).sum();
+    Ok(pattern_of(net, regions, nodes.cells, nodes.half_cells, area, CutLine::SmoothNodes, nodes.anchor))
+}
+
 /// The flat pattern of a ply draped with an outline (`outline`: the points as the drape was
 /// given them, on the tool): cut along the outline carried through the net into the flat frame
 /// (see the module comment). When some outline point does not land on the net within
 /// [`OUTLINE_REACH`] cells of a complete cell (the ply did not reach it: off the tool, a
-/// failure), or the carried outline crosses itself, the pattern is cut through the boundary
-/// nodes instead ([`flat_pattern`]); `cut` says which. Errors as [`flat_pattern`].
+/// failure), or the carried outline crosses itself, the pattern is cut along the smooth curve
+/// through the boundary nodes instead ([`flat_pattern_smooth`]); `cut` says which and `warnings`
+/// why. Errors as [`flat_pattern`].
 pub fn flat_pattern_in_outline(net: &DrapeNet, outline: &[Point]) -> Result<FlatPattern, FlatError> {
+    let fallback = |why: CutWarning| {
+        flat_pattern_smooth(net).map(|mut p| {
+            p.warnings.push(why);
+            p
+        })
+    };
     let nodes = flat_pattern(net)?;
-    let Some(mut poly) = flat_outline(net, outline) else { return Ok(nodes) };
+    let mut poly = match flat_outline(net, outline) {
+        Ok(poly) => poly,
+        Err(point) => return fallback(CutWarning::OutlineOffNet { point, of: outline.len() }),
+    };
     // Consecutive points that land on one flat point are one vertex.
     poly.dedup_by(|a, b| a == b);
     while poly.len() > 1 && poly.first() == poly.last() {
         poly.pop();
     }
     if poly.len() < 3 || polygon_crosses_itself(&poly) {
-        return Ok(nodes);
+        return fallback(CutWarning::OutlineNotSimple);
     }
     let mut area = shoelace_area(&poly);
     if area < 0.0 {
@@ -209,40 +296,87 @@ pub fn flat_pattern_in_outline(net: &DrapeNet, outline: &[Point]) -> Result<Flat
         area = -area;
     }
     if !(area > 0.0) {
-        return Ok(nodes);
+        return fallback(CutWarning::OutlineNotSimple);
     }
     let regions = vec![Region { loops: vec![poly], cells: nodes.cells, area }];
     Ok(pattern_of(net, regions, nodes.cells, nodes.half_cells, area, CutLine::Outline, nodes.anchor))
 }
 
-/// The pattern of a ply as the run cuts it: with a cutting margin the complete cells grown by it
-/// ([`flat_pattern_with_margin`]); without one, along the ply's outline when it has one
-/// ([`flat_pattern_in_outline`]), else through the boundary nodes ([`flat_pattern`]).
+/// The pattern of a ply as the run cuts it: along the ply's outline when it has one
+/// ([`flat_pattern_in_outline`]), else along the smooth curve through its boundary nodes
+/// ([`flat_pattern_smooth`]); with a cutting margin that line offset by it ([`with_margin`]).
+/// Errors as [`flat_pattern`], and for a negative or non-finite margin.
 pub fn ply_pattern(net: &DrapeNet, outline: Option<&[Point]>, margin: f64) -> Result<FlatPattern, FlatError> {
-    match outline {
-        Some(points) if margin == 0.0 => flat_pattern_in_outline(net, points),
-        _ => flat_pattern_with_margin(net, margin),
-    }
+    check_margin(net, margin)?;
+    let base = match outline {
+        Some(points) => flat_pattern_in_outline(net, points)?,
+        None => flat_pattern_smooth(net)?,
+    };
+    with_margin(net, base, margin)
 }
 
-/// The outline's points carried into the flat frame, or `None` when one of them does not land
-/// on the net within [`OUTLINE_REACH`] cells.
-fn flat_outline(net: &DrapeNet, outline: &[Point]) -> Option<Vec<[f64; 2]>> {
+/// `pattern` (a pattern of `net`, cut along its line without a margin) with a cutting margin:
+/// every loop offset outward by `margin` (m) in the flat plane
+/// ([`offset_loops`]: round joins; a hole narrower than twice the margin closes). When the offset
+/// loops would overlap, the complete cells grown by the margin instead
+/// ([`flat_pattern_with_margin`]), with a [`CutWarning::MarginOverlaps`]. `margin = 0` gives the
+/// pattern back. Errors for a negative or non-finite margin.
+pub fn with_margin(net: &DrapeNet, pattern: FlatPattern, margin: f64) -> Result<FlatPattern, FlatError> {
+    check_margin(net, margin)?;
+    if margin == 0.0 {
+        return Ok(pattern);
+    }
+    let loops: Vec<Vec<[f64; 2]>> = pattern.loops().cloned().collect();
+    let Some(mut offset) = offset_loops(&loops, margin) else {
+        let mut grown = flat_pattern_with_margin(net, margin)?;
+        grown.warnings = pattern.warnings;
+        grown.warnings.push(CutWarning::MarginOverlaps { margin });
+        return Ok(grown);
+    };
+    let mut regions = Vec::with_capacity(pattern.regions.len());
+    let mut next = offset.drain(..);
+    for r in &pattern.regions {
+        let mut loops: Vec<Vec<[f64; 2]>> = Vec::new();
+        for _ in &r.loops {
+            loops.extend(next.next().expect("one offset a loop"));
+        }
+        // Outer loops (counter-clockwise) first; holes keep their order.
+        loops.sort_by_key(|l| std::cmp::Reverse(shoelace_area(l) > 0.0));
+        let area = loops.iter().map(|l| shoelace_area(l)).sum();
+        regions.push(Region { loops, cells: r.cells, area });
+    }
+    let area = regions.iter().map(|r| r.area).sum();
+    let mut out = pattern_of(net, regions, pattern.cells, pattern.half_cells, area, pattern.cut, pattern.anchor);
+    out.margin = margin;
+    out.warnings = pattern.warnings;
+    Ok(out)
+}
+
+fn check_margin(net: &DrapeNet, margin: f64) -> Result<(), FlatError> {
+    if !(margin.is_finite() && margin >= 0.0) {
+        return Err(FlatError::BadMargin { ply: net.name.clone(), margin });
+    }
+    Ok(())
+}
+
+/// The outline's points carried into the flat frame, or the index of the first point that does
+/// not land on the net within [`OUTLINE_REACH`] cells.
+fn flat_outline(net: &DrapeNet, outline: &[Point]) -> Result<Vec<[f64; 2]>, usize> {
     let d = net.spacing;
-    let sampler = NetSampler::new(net)?;
+    let sampler = NetSampler::new(net).ok_or(0usize)?;
     let (i0, j0) = (net.origin_node.0 as f64, net.origin_node.1 as f64);
     let mut out = Vec::with_capacity(outline.len());
-    for p in outline {
-        let h = sampler.nearest_within(p, (OUTLINE_REACH + 1.0) * std::f64::consts::SQRT_2 * d)?;
+    for (k, p) in outline.iter().enumerate() {
+        let h = sampler.nearest_within(p, (OUTLINE_REACH + 1.0) * std::f64::consts::SQRT_2 * d).ok_or(k)?;
         let (i, j) = h.cell;
-        let [s, t] = locate_on_patch(net, i, j, p, [h.s, h.t])?;
+        let [s, t] = locate_on_patch(net, i, j, p, [h.s, h.t]).ok_or(k)?;
         let beyond = (-s).max(s - 1.0).max(-t).max(t - 1.0);
         if beyond > OUTLINE_REACH {
-            return None;
+            return Err(k);
         }
         out.push([(i as f64 + s - i0) * d, (j as f64 + t - j0) * d]);
     }
-    Some(out)
+    Ok(out)
 }
 
 /// Bilinear parameters (s, t) of the point of cell (i, j)'s patch, extended beyond the cell,
@@ -348,6 +482,8 @@ fn pattern_of(
         half_cells,
         area,
         cut,
+        margin: 0.0,
+        warnings: Vec::new(),
         min,
         max,
         anchor,
@@ -540,9 +676,7 @@ const SNAP: f64 = 1e-9;
 /// negative or non-finite margin.
 pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPattern, FlatError> {
     check_spacing(net)?;
-    if !(margin.is_finite() && margin >= 0.0) {
-        return Err(FlatError::BadMargin { ply: net.name.clone(), margin });
-    }
+    check_margin(net, margin)?;
     if margin == 0.0 {
         return flat_pattern(net);
     }
@@ -576,7 +710,9 @@ pub fn flat_pattern_with_margin(net: &DrapeNet, margin: f64) -> Result<FlatPatte
     let anchor = to_flat([a[0] as f64 + 0.5, a[1] as f64 + 0.5]);
     let area = regions.iter().map(|r| r.area).sum();
     let half_cells = triangles_of(net).half_cells;
-    Ok(pattern_of(net, regions, cells, half_cells, area, CutLine::GrownCells, anchor))
+    let mut p = pattern_of(net, regions, cells, half_cells, area, CutLine::GrownCells, anchor);
+    p.margin = margin;
+    Ok(p)
 }
 
 /// Sorted distinct coordinates, those within [`SNAP`] of a kept one dropped.

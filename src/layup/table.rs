@@ -1,6 +1,7 @@
 //! The layup table: one row per ply (angle, material, shear, coverage, fabric used, offset) and
 //! the nesting of the flat patterns. `drape run` prints it and writes it as `layup.json`
 //! ([`crate::io::layup_json`]); `drape report` reads that file into the same type.
+use super::flat::{CutLine, CutWarning};
 use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
@@ -142,6 +143,16 @@ pub struct LayupRow {
     /// Fabric used (the flat pattern's area), m^2.
     #[serde(default)]
     pub fabric_area_m2: Option<f64>,
+    /// The line the ply's flat pattern is cut along (`outline`, `smooth_nodes`, `nodes`, or
+    /// `grown_cells` when the margin could not be offset), when it has a pattern.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pattern_cut: Option<CutLine>,
+    /// The cutting margin outside that line, m, when the ply has a pattern.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pattern_margin_m: Option<f64>,
+    /// Why the ply's flat pattern is not cut along the line the ply asks for (empty when it is).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pattern_warnings: Vec<CutWarning>,
     /// Mass of that fabric, kg.
     #[serde(default)]
     pub fabric_mass_kg: Option<f64>,
@@ -241,6 +252,10 @@ impl LayupRow {
             offset_m: Some(result.offset.max_distance),
             offset_folded_triangles: Some(result.offset.folded),
             offset_bridged_vertices: Some(result.offset.relaxed),
+            // Filled in by the run from the ply's pattern.
+            pattern_cut: None,
+            pattern_margin_m: None,
+            pattern_warnings: Vec::new(),
         }
     }
 }

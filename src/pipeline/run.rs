@@ -20,7 +20,7 @@ use crate::io::{
 };
 use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeError};
 use crate::kinematic::Extent;
-use crate::layup::flat::{ply_pattern, FlatError};
+use crate::layup::flat::{ply_pattern, CutWarning, FlatError, FlatPattern};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::stack::{drape_layup, LayupError, PlyResult};
 use crate::layup::table::{ExportPlyRow, ExportRow, LayupRow, LayupTable, NestingRow};
@@ -75,6 +75,14 @@ pub enum Event<'a> {
     NoPattern {
         /// The ply's name.
         ply: &'a str,
+    },
+    /// A ply's flat pattern is not cut along the line the ply asks for (its outline, its margin
+    /// offset from the cut line): why, and what it is cut along instead.
+    PatternWarning {
+        /// The ply's name.
+        ply: &'a str,
+        /// Why.
+        warning: &'a CutWarning,
     },
     /// The scene gives no roll width: the pieces were nested on a roll as wide as the widest.
     RollWidthAssumed {
@@ -286,7 +294,7 @@ pub fn run(
         written.extend(files);
     }
     on(Event::Layup { scene, results: &results });
-    let nesting = cutting_plan(scene, &results, out, &mut written, on)?;
+    let (nesting, patterns) = cutting_plan(scene, &results, out, &mut written, on)?;
     // The flow export before the table, so that the table lists its files.
     let export_row = match &scene.export {
         Some(export) => {
@@ -299,7 +307,21 @@ pub fn run(
     let table = LayupTable {
         scene: Some(scene.path.display().to_string()),
         tool: Some(scene.tool.display().to_string()),
-        plies: scene.layup.plies.iter().zip(&results).map(|(ply, r)| LayupRow::of(ply, r)).collect(),
+        plies: scene
+            .layup
+            .plies
+            .iter()
+            .zip(&results)
+            .map(|(ply, r)| {
+                let mut row = LayupRow::of(ply, r);
+                if let Some(p) = patterns.iter().find(|p| p.ply == ply.settings.name) {
+                    row.pattern_cut = Some(p.cut);
+                    row.pattern_margin_m = Some(p.margin);
+                    row.pattern_warnings = p.warnings.clone();
+                }
+                row
+            })
+            .collect(),
         nesting: nesting.as_ref().map(NestingRow::from),
         files: files.clone(),
         export: export_row,
@@ -318,14 +340,15 @@ pub fn run(
 }
 
 /// Flat patterns of every ply, nested on the roll: `patterns.dxf`, `patterns.svg` and one SVG a
-/// ply. Plies without a complete cell have no pattern and are named.
+/// ply. Plies without a complete cell have no pattern and are named; a pattern not cut along the
+/// line its ply asks for says why. Returns the nesting (when there is a pattern) and the patterns.
 fn cutting_plan(
     scene: &Scene,
     results: &[PlyResult],
     out: &Path,
     written: &mut Vec<PathBuf>,
     on: &mut dyn FnMut(Event),
-) -> Result<Option<Nesting>, RunError> {
+) -> Result<(Option<Nesting>, Vec<FlatPattern>), RunError> {
     let mut patterns = Vec::new();
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         // A ply draped with an outline is cut along it (without a margin).
@@ -334,13 +357,18 @@ fn cutting_plan(
             Extent::Grid { .. } => None,
         };
         match ply_pattern(&r.net, outline, scene.cutting_margin) {
-            Ok(p) => patterns.push(p),
+            Ok(p) => {
+                for warning in &p.warnings {
+                    on(Event::PatternWarning { ply: &p.ply, warning });
+                }
+                patterns.push(p)
+            }
             Err(FlatError::NoCells { ply }) => on(Event::NoPattern { ply: &ply }),
             Err(e) => return Err(RunError::Flat(e)),
         }
     }
     if patterns.is_empty() {
-        return Ok(None);
+        return Ok((None, patterns));
     }
     let rotation = if scene.rotate_patterns { Rotation::AllowQuarterTurn } else { Rotation::WarpAlongRoll };
     let roll_width = match scene.roll_width {
@@ -356,7 +384,7 @@ fn cutting_plan(
     let files = write_cutting_plan(&patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
     on(Event::CuttingPlan { pieces: patterns.len(), nesting: &nesting, files: &files });
     written.extend(files);
-    Ok(Some(nesting))
+    Ok((Some(nesting), patterns))
 }
 
 /// Map every ply onto the scene's resin-flow mesh and write the formats it asks for as

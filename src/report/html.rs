@@ -2,6 +2,7 @@
 //! the same folder, flat patterns inlined).
 use super::{method_name, LayupRow, Page, PlyReport};
 use crate::kinematic::DrapeNet;
+use crate::layup::flat::CutWarning;
 use std::fmt::Write;
 
 /// Escape text for HTML element content and attribute values (the crate's one XML escape).
@@ -169,9 +170,24 @@ pub(crate) fn page(p: &Page) -> String {
             );
         }
     }
-    if !p.patterns.is_empty() {
+    // Patterns not cut along the line their ply asks for, from layup.json.
+    let cut_warnings: Vec<(&str, &CutWarning)> = p
+        .layup
+        .iter()
+        .flat_map(|l| l.plies.iter())
+        .flat_map(|r| r.pattern_warnings.iter().map(move |w| (r.name.as_str(), w)))
+        .collect();
+    if !p.patterns.is_empty() || !cut_warnings.is_empty() {
+        let _ = writeln!(h, "<h2 id=\"patterns\">Flat patterns</h2>");
+        if !cut_warnings.is_empty() {
+            let _ = writeln!(h, "<ul id=\"pattern-warnings\" class=\"warning\">");
+            for (ply, w) in &cut_warnings {
+                let _ = writeln!(h, "<li>warning: ply {}: {}</li>", escape(ply), escape(&w.to_string()));
+            }
+            let _ = writeln!(h, "</ul>");
+        }
         // In a grid of small drawings: each opens full size from its link.
-        let _ = writeln!(h, "<h2 id=\"patterns\">Flat patterns</h2>\n<div class=\"patterns\">");
+        let _ = writeln!(h, "<div class=\"patterns\">");
         for (name, body) in &p.patterns {
             match body {
                 Ok(svg) => {
