@@ -144,7 +144,8 @@ pub struct PlyReport {
     pub fibre_step: usize,
     /// Cells sheared past the locking angle (hatched).
     pub over_locking_cells: usize,
-    /// Cells folded over against their neighbours (wrinkle risk).
+    /// Cells folded over against their neighbours or lying on another part of the net (wrinkle
+    /// risk).
     pub folded_cells: usize,
     /// Where the net stopped: failure status and how many placed nodes border it.
     pub stops: Vec<(crate::kinematic::NodeStatus, usize)>,
@@ -1009,7 +1010,10 @@ fn shear_picture(shot: &ShearShot) -> Result<ShearPng, String> {
             swatch: Swatch::Hatch(shear_colour(limit, limit)),
             text: format!("past locking: {} cells", shot.over_locking),
         },
-        LegendItem { swatch: Swatch::Fill(shade::FOLD_FILL), text: format!("folded (wrinkle): {}", shot.folded) },
+        LegendItem {
+            swatch: Swatch::Fill(shade::FOLD_FILL),
+            text: format!("folded or overlapping (wrinkle): {}", shot.folded),
+        },
     ];
     let mut stops: BTreeMap<crate::kinematic::NodeStatus, usize> = BTreeMap::new();
     for (_, s) in &shot.scene.frontier {

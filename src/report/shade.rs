@@ -185,9 +185,72 @@ pub fn outer_normals(net: &DrapeNet, tool_vertices: Option<&[Point]>) -> Vec<Vec
     normals
 }
 
-/// Cells whose normal points against the summed normals of their complete neighbours: the net
-/// folded back over itself there (a wrinkle risk). By cell index.
+/// A cell whose centre lies closer than this (spacings) to the centre of a cell more than one row
+/// or column away lies on another part of the net: the fabric overlaps itself there. Cells of
+/// one sound net come that close only past 85 deg of shear (two short diagonals of 2 d sin((90 -
+/// g) / 2) each), far beyond any locking angle.
+pub const OVERLAP_SPACINGS: f64 = 0.25;
+
+/// Cells where the net folds or overlaps itself (a wrinkle risk), by cell index: a cell whose
+/// normal points against the summed normals of its complete neighbours (folded back over
+/// itself), or one lying on another part of the net without turning over (see
+/// [`OVERLAP_SPACINGS`]: a layer doubled back twice, a net wrapped past a full turn).
 pub fn folded_cells(net: &DrapeNet) -> Vec<bool> {
+    let mut out = turned_cells(net);
+    for (c, over) in overlapping_cells(net).into_iter().enumerate() {
+        out[c] |= over;
+    }
+    out
+}
+
+/// Cells lying on a part of the net more than one row or column away (see
+/// [`OVERLAP_SPACINGS`]), found through a hash of cell centres in buckets of the reach.
+fn overlapping_cells(net: &DrapeNet) -> Vec<bool> {
+    use std::collections::HashMap;
+    let (cu, cv) = (net.nu.saturating_sub(1), net.nv.saturating_sub(1));
+    let mut out = vec![false; cu * cv];
+    let reach = OVERLAP_SPACINGS * net.spacing;
+    if !(reach > 0.0) {
+        return out;
+    }
+    let centres: Vec<Option<Point>> = (0..cu * cv)
+        .map(|c| {
+            net.cell_corners(c / cv, c % cv)
+                .map(|q| Point::from(q.iter().fold(Vector::zeros(), |s, p| s + p.coords) / 4.0))
+        })
+        .collect();
+    let key = |p: &Point| [(p.x / reach).floor() as i64, (p.y / reach).floor() as i64, (p.z / reach).floor() as i64];
+    let mut buckets: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (c, p) in centres.iter().enumerate() {
+        if let Some(p) = p {
+            buckets.entry(key(p)).or_default().push(c);
+        }
+    }
+    for (c, p) in centres.iter().enumerate() {
+        let Some(p) = p else { continue };
+        let k = key(p);
+        let (i, j) = (c / cv, c % cv);
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = buckets.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else { continue };
+                    for &o in list {
+                        let (a, b) = (o / cv, o % cv);
+                        let apart = i.abs_diff(a) > 1 || j.abs_diff(b) > 1;
+                        if apart && centres[o].is_some_and(|q| (q - p).norm() < reach) {
+                            out[c] = true;
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Cells whose normal points against the summed normals of their complete neighbours.
+fn turned_cells(net: &DrapeNet) -> Vec<bool> {
     let (cu, cv) = (net.nu.saturating_sub(1), net.nv.saturating_sub(1));
     let normal =
         |i: usize, j: usize| net.cell_corners(i, j).map(|[p00, p10, p01, p11]| (p11 - p00).cross(&(p01 - p10)));
@@ -618,5 +681,39 @@ mod tests {
         net.positions[k] = Point::new(0.6, 0.6, 0.0);
         let f = folded_cells(&net);
         assert!(f[3 + 1], "{f:?}");
+    }
+
+    #[test]
+    fn a_net_lying_on_itself_without_turning_over_is_found() {
+        // A 12 x 4 strip along x whose rows from i = 7 on are carried back over rows 1-4, 0.1 mm
+        // above them, the same way up: no cell of those turns over, yet they overlap.
+        let d = 0.01;
+        let mut net = DrapeNet::new("o", d, 12, 4, (0, 0));
+        for i in 0..12 {
+            for j in 0..4 {
+                let k = net.index(i, j);
+                net.positions[k] = Point::new(i as f64 * d, j as f64 * d, 0.0);
+                net.status[k] = NodeStatus::Placed;
+            }
+        }
+        assert!(folded_cells(&net).iter().all(|f| !f), "a flat strip neither folds nor overlaps");
+        for i in 7..12 {
+            for j in 0..4 {
+                let k = net.index(i, j);
+                net.positions[k] = Point::new((i - 6) as f64 * d, j as f64 * d, 1e-4);
+            }
+        }
+        let f = folded_cells(&net);
+        let cv = 3;
+        for j in 0..cv {
+            for i in 7..11 {
+                assert!(f[i * cv + j], "cell ({i}, {j}) lies on cell ({}, {j})", i - 6);
+                assert!(f[(i - 6) * cv + j], "cell ({}, {j}) lies under cell ({i}, {j})", i - 6);
+            }
+            assert!(!f[j], "cell (0, {j}) lies alone");
+        }
+        // Away from the cell that turns back (6, next to which the turned-over test flags 5 and 7
+        // too), the layer on top is found by the overlap alone.
+        assert!(turned_cells(&net)[8 * cv..11 * cv].iter().all(|t| !t), "the layer on top is not turned over");
     }
 }
