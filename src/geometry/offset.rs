@@ -126,6 +126,23 @@ fn folded_triangles(tool: &ToolSurface, moved: &[Point]) -> Vec<usize> {
         .collect()
 }
 
+/// The vertices joined to each vertex by an edge of the tool, in index order.
+fn vertex_rings(tool: &ToolSurface) -> Vec<Vec<u32>> {
+    let mut ring: Vec<Vec<u32>> = vec![Vec::new(); tool.vertices().len()];
+    for tri in tool.triangles() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            ring[a as usize].push(b);
+            ring[b as usize].push(a);
+        }
+    }
+    for r in &mut ring {
+        r.sort_unstable();
+        r.dedup();
+    }
+    ring
+}
+
 /// Sweeps of fold relaxation at most.
 const MAX_UNFOLD_SWEEPS: usize = 200;
 
@@ -141,18 +158,7 @@ fn unfold(tool: &ToolSurface, moved: &mut [Point], distance: &[f64]) -> (usize, 
         return (0, 0);
     }
     let n = moved.len();
-    let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for tri in tool.triangles() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            ring[a as usize].push(b);
-            ring[b as usize].push(a);
-        }
-    }
-    for r in &mut ring {
-        r.sort_unstable();
-        r.dedup();
-    }
+    let ring = vertex_rings(tool);
     let mut touched = vec![false; n];
     let mut widen = 0;
     let mut last = usize::MAX;
@@ -229,15 +235,7 @@ pub fn ramp_drops(tool: &ToolSurface, distance: &[f64], slope: f64) -> Vec<f64> 
         }
     }
     let vertices = tool.vertices();
-    let n = vertices.len();
-    let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for tri in tool.triangles() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            ring[a as usize].push(b);
-            ring[b as usize].push(a);
-        }
-    }
+    let ring = vertex_rings(tool);
     let mut value = distance.to_vec();
     let mut heap: BinaryHeap<Entry> =
         value.iter().enumerate().filter(|(_, h)| **h > 0.0).map(|(v, &h)| Entry(h, v as u32)).collect();
