@@ -292,13 +292,13 @@ pub fn drape_layup(
                 })?;
                 (a.kinematic, a.refined, Some(a.choice))
             }
-            (Start::Kinematic, _, r) => {
-                let net = drape(surface, &settings).map_err(drape_error)?;
-                let refined = r.as_ref().map(|r| refine_ply(&net, surface, r)).transpose().map_err(refine_error)?;
-                (net, refined, None)
-            }
-            (Start::Flat { normal }, _, r) => {
-                let net = flat_start(ply, &settings, &normal, surface).map_err(|source| refine_error(source.into()))?;
+            (start, _, r) => {
+                let net = match start {
+                    Start::Kinematic => drape(surface, &settings).map_err(drape_error)?,
+                    Start::Flat { normal } => {
+                        flat_start(ply, &settings, &normal, surface).map_err(|source| refine_error(source.into()))?
+                    }
+                };
                 let refined = r.as_ref().map(|r| refine_ply(&net, surface, r)).transpose().map_err(refine_error)?;
                 (net, refined, None)
             }
