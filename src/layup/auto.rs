@@ -25,7 +25,6 @@
 //!
 //! The choice, its reason and the measurements are recorded ([`MethodChoice`]) in the net's meta
 //! and in `layup.json`, and shown in the layup table and the report.
-use super::stack::refine_ply_on;
 use super::{AutoModel, Refinement};
 use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::ToolSurface;
@@ -132,11 +131,8 @@ pub fn drape_auto(
 ) -> Result<AutoResult, AutoError> {
     let surfaces = Surfaces::new(surface);
     let a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
-    let refined = if a.mechanical() {
-        Some(refine_ply_on(&a.net, surface, surfaces.for_refinement(refinement), refinement)?)
-    } else {
-        None
-    };
+    let refined =
+        if a.mechanical() { Some(refinement.run(&a.net, surface, surfaces.for_refinement(refinement))?) } else { None };
     Ok(AutoResult { kinematic: a.net, refined, choice: a.choice })
 }
 

@@ -1,13 +1,15 @@
 //! The plies of a layup, ready to drape: what each ply is made of, how its warp is given and
 //! whether it is refined mechanically. A scene file ([`crate::pipeline::scene`]) is one way to
 //! make them.
-use crate::geometry::Vector;
-use crate::kinematic::KinematicSettings;
+use crate::geometry::smooth::SmoothSurface;
+use crate::geometry::{ToolSurface, Vector};
+use crate::kinematic::{DrapeNet, KinematicSettings};
 use crate::material::MaterialCard;
-use crate::mechanics::refine::RefineSettings;
+use crate::mechanics::refine::{annotate, refine_on, RefineError, RefineSettings, Refined};
 use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::{ContactMode, SolverSettings};
 use std::path::PathBuf;
+use std::time::Instant;
 
 /// Locking angle used for reporting when neither the ply nor its material card gives one
 /// (degrees; woven glass and carbon lock between about 40 and 60 degrees).
@@ -158,6 +160,25 @@ impl Refinement {
             stick: self.stick,
             ..RefineSettings::default()
         }
+    }
+
+    /// Refine a ply's kinematic `net` on `surface` as this refinement says (on `smooth`, the
+    /// surface's smooth surface, when the caller has built it): the refined net, annotated with
+    /// the solver's record and the change from the kinematic net, and the solver's result.
+    pub fn run(
+        &self,
+        net: &DrapeNet,
+        surface: &ToolSurface,
+        smooth: Option<&SmoothSurface>,
+    ) -> Result<(DrapeNet, Refined), RefineError> {
+        let t = Instant::now();
+        let result = refine_on(net, surface, smooth, &self.material, &self.settings())?;
+        let mut out = result.net.clone();
+        annotate(&mut out, net, &result, &self.material_path);
+        out.timing.load_ms = net.timing.load_ms;
+        out.timing.generators_ms = 0.0;
+        out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
+        Ok((out, result))
     }
 }
 

@@ -3,11 +3,10 @@
 //! numbers of the layup table.
 use super::auto::{drape_auto, AutoError};
 use super::flat::ply_pattern;
-use super::{Layup, Orientation, Ply, Refinement, StackSide, Start};
+use super::{Layup, Orientation, Ply, StackSide, Start};
 use crate::geometry::offset::{
     offset_along, offset_directions, offset_vertices, ramp_drops, OffsetReport, PLY_DROP_SLOPE,
 };
-use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
@@ -15,9 +14,8 @@ use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice};
 use crate::material::flow::sheared_thickness;
-use crate::mechanics::refine::{annotate, refine_on, RefineError, Refined};
+use crate::mechanics::refine::{RefineError, Refined};
 use crate::mechanics::sheet::{default_origin_node, flat_sheet, SheetError};
-use std::time::Instant;
 
 /// A reference direction closer than this (sine of the angle) to the tool normal at a seed has
 /// no usable projection onto the tool there.
@@ -299,7 +297,7 @@ pub fn drape_layup(
                         flat_start(ply, &settings, &normal, surface).map_err(|source| refine_error(source.into()))?
                     }
                 };
-                let refined = r.as_ref().map(|r| refine_ply(&net, surface, r)).transpose().map_err(refine_error)?;
+                let refined = r.as_ref().map(|r| r.run(&net, surface, None)).transpose().map_err(refine_error)?;
                 (net, refined, None)
             }
         };
@@ -332,29 +330,6 @@ pub fn drape_layup(
         results.push(PlyResult { net, refined, kinematic, choice, warp, offset, stats });
     }
     Ok(results)
-}
-
-/// Refine a ply's kinematic `net` on `surface` as `r` says: the refined net, annotated with the
-/// solver's record and the change from the kinematic net, and the solver's result.
-pub fn refine_ply(net: &DrapeNet, surface: &ToolSurface, r: &Refinement) -> Result<(DrapeNet, Refined), RefineError> {
-    refine_ply_on(net, surface, None, r)
-}
-
-/// [`refine_ply`] with `surface`'s smooth surface already built.
-pub fn refine_ply_on(
-    net: &DrapeNet,
-    surface: &ToolSurface,
-    smooth: Option<&SmoothSurface>,
-    r: &Refinement,
-) -> Result<(DrapeNet, Refined), RefineError> {
-    let t = Instant::now();
-    let result = refine_on(net, surface, smooth, &r.material, &r.settings())?;
-    let mut out = result.net.clone();
-    annotate(&mut out, net, &result, &r.material_path);
-    out.timing.load_ms = net.timing.load_ms;
-    out.timing.generators_ms = 0.0;
-    out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
-    Ok((out, result))
 }
 
 /// Add a draped ply's thickness t0 / cos(gamma) (sheared cells keep their fibre lengths, so their
