@@ -245,11 +245,22 @@ impl<'a> SmoothSurface<'a> {
 
     /// f = A / W with A = sum w_s q_s and W = sum w_s; derivatives by the quotient rule.
     fn evaluate(&self, region: u32, p: &Point, hessian: bool) -> Option<(f64, Vector, Matrix3<f64>)> {
+        self.evaluate_among(self.bvh.intersect_aabb(&Aabb::new(*p, *p)), region, p, hessian)
+    }
+
+    /// [`SmoothSurface::evaluate`] over the sectors `candidates`, which must include every sector
+    /// whose support holds `p` (in the order the BVH gives them, so sums agree to the bit).
+    fn evaluate_among(
+        &self,
+        candidates: impl IntoIterator<Item = u32>,
+        region: u32,
+        p: &Point,
+        hessian: bool,
+    ) -> Option<(f64, Vector, Matrix3<f64>)> {
         let (mut w_sum, mut a_sum) = (0.0, 0.0);
         let (mut dw_sum, mut da_sum) = (Vector::zeros(), Vector::zeros());
         let (mut hw_sum, mut ha_sum) = (Matrix3::zeros(), Matrix3::zeros());
-        let probe = Aabb::new(*p, *p);
-        for s in self.bvh.intersect_aabb(&probe) {
+        for s in candidates {
             let sec = &self.sectors[s as usize];
             if sec.region != region {
                 continue;
@@ -314,6 +325,21 @@ impl<'a> SmoothSurface<'a> {
 
     /// As [`SmoothSurface::project`], given the closest facet point `foot` of `q`.
     pub fn project_from(&self, q: &Point, foot: &SurfacePoint) -> SmoothPoint {
+        self.project_inner(q, foot, false).0
+    }
+
+    /// [`SmoothSurface::project`] and the surface's [`SmoothSurface::curvature`] at the point
+    /// found (from the sectors the projection already gathered).
+    pub fn project_curved(&self, q: &Point) -> (SmoothPoint, Matrix3<f64>) {
+        self.project_inner(q, &self.tool.closest_point(q), true)
+    }
+
+    /// [`SmoothSurface::project_from`] and the curvature there.
+    pub fn project_from_curved(&self, q: &Point, foot: &SurfacePoint) -> (SmoothPoint, Matrix3<f64>) {
+        self.project_inner(q, foot, true)
+    }
+
+    fn project_inner(&self, q: &Point, foot: &SurfacePoint, curved: bool) -> (SmoothPoint, Matrix3<f64>) {
         let region = self.regions[foot.triangle as usize];
         let l = self.tool.barycentric(foot.triangle, &foot.point);
         let off = q - foot.point;
@@ -326,8 +352,13 @@ impl<'a> SmoothSurface<'a> {
         let mut p = *q;
         let mut normal = foot.normal;
         let mut restarted = false;
+        // The sectors near the Newton iterates, gathered once for a box around them (the steps
+        // stay within about the query's distance from its facet) instead of a BVH query a step.
+        let reach = 2.0 * off.norm() + tol;
+        let mut near = NearSectors::default();
         for _ in 0..PROJECTION_MAX_ITERATIONS {
-            let Some((f, g)) = self.value_and_gradient(region, &p) else {
+            let candidates = near.around(self, &p, reach);
+            let Some((f, g, _)) = self.evaluate_among(candidates.iter().copied(), region, &p, false) else {
                 if restarted {
                     break;
                 }
@@ -364,7 +395,16 @@ impl<'a> SmoothSurface<'a> {
         let beyond_edge_or_corner = outside
             && off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
             && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
-        SmoothPoint {
+        let curvature = if curved {
+            let candidates = near.around(self, &p, reach);
+            match self.evaluate_among(candidates.iter().copied(), region, &p, true) {
+                Some((_, g, h)) if g.norm() > 0.0 => h / g.norm(),
+                _ => Matrix3::zeros(),
+            }
+        } else {
+            Matrix3::zeros()
+        };
+        let point = SmoothPoint {
             point: p,
             triangle: foot.triangle,
             barycentric: clamp_barycentric(l),
@@ -372,7 +412,30 @@ impl<'a> SmoothSurface<'a> {
             region,
             beyond_boundary,
             beyond_region: beyond_crease || beyond_edge_or_corner,
+        };
+        (point, curvature)
+    }
+}
+
+/// The sectors whose supports meet a box, kept while the points asked about stay in it.
+#[derive(Default)]
+struct NearSectors {
+    bounds: Option<Aabb>,
+    sectors: Vec<u32>,
+}
+
+impl NearSectors {
+    /// The sectors that may hold `p`: the kept ones if `p` is in the box, else those meeting a
+    /// new box of half-width `reach` around `p`.
+    fn around(&mut self, surface: &SmoothSurface, p: &Point, reach: f64) -> &[u32] {
+        if !self.bounds.is_some_and(|b| b.contains_local_point(p)) {
+            let half = Vector::repeat(reach);
+            let bounds = Aabb::new(p - half, p + half);
+            self.sectors.clear();
+            self.sectors.extend(surface.bvh.intersect_aabb(&bounds));
+            self.bounds = Some(bounds);
         }
+        &self.sectors
     }
 }
 

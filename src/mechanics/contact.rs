@@ -49,13 +49,13 @@ impl ContactSurface for ToolSurface {
 
 impl ContactSurface for SmoothSurface<'_> {
     fn locate(&self, p: &Point) -> Foot {
-        let s = self.project(p);
+        let (s, curvature) = self.project_curved(p);
         Foot {
             point: s.point,
             normal: s.normal,
             open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric),
             gap: s.normal.dot(&(p - s.point)),
-            curvature: self.curvature(s.region, &s.point),
+            curvature,
         }
     }
     fn locate_near(&self, p: &Point, range: f64) -> Option<Foot> {
@@ -68,7 +68,7 @@ impl ContactSurface for SmoothSurface<'_> {
         if facet.distance > 2.0 * range {
             return None;
         }
-        let s = self.project_from(p, &facet);
+        let (s, curvature) = self.project_from_curved(p, &facet);
         let open_edges = self.tool().open_edges_at(s.triangle, &s.barycentric);
         if s.beyond_boundary || s.beyond_region {
             // Past the tool's open edge, or past a sharp edge of the region the nearest tool is the edge itself: the point is
@@ -82,13 +82,7 @@ impl ContactSurface for SmoothSurface<'_> {
                 curvature: Matrix3::zeros(),
             });
         }
-        Some(Foot {
-            point: s.point,
-            normal: s.normal,
-            open_edges,
-            gap: s.normal.dot(&(p - s.point)),
-            curvature: self.curvature(s.region, &s.point),
-        })
+        Some(Foot { point: s.point, normal: s.normal, open_edges, gap: s.normal.dot(&(p - s.point)), curvature })
     }
 }
 
