@@ -240,6 +240,9 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                     if p.pareto { "  (Pareto)" } else { "" }
                 );
             }
+            if let Some(why) = &s.auto_not_run {
+                println!("auto not run: {why}");
+            }
             for a in &s.auto {
                 println!(
                     "auto at d = {:.5} m ran {}: error {} against the {} deg tolerance ({}), {:.3} s{}",
