@@ -240,6 +240,9 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                     if p.pareto { "  (Pareto)" } else { "" }
                 );
             }
+            if let Some(why) = &s.auto_not_run {
+                println!("auto not run: {why}");
+            }
             for a in &s.auto {
                 println!(
                     "auto at d = {:.5} m ran {}: error {} against the {} deg tolerance ({}), {:.3} s{}",
@@ -259,11 +262,16 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                         a.mechanical_time_s.unwrap_or_default()
                     ))
                 );
-                if let Some(m) = a.mechanical_within_tolerance_s {
-                    println!(
+                // Auto's cost against mechanics of the same accuracy only where it has that accuracy.
+                match (a.mechanical_within_tolerance_s, a.within_tolerance) {
+                    (Some(m), Some(true)) => println!(
                         "  mechanics within the tolerance takes {m:.3} s at best: auto costs {:.0}% of that",
                         100.0 * a.time_s / m
-                    );
+                    ),
+                    (Some(m), _) => println!(
+                        "  mechanics within the tolerance takes {m:.3} s at best; auto is not within it here, so it saves nothing against that"
+                    ),
+                    (None, _) => {}
                 }
             }
         }

@@ -225,7 +225,7 @@ pub fn choose(
         // Mechanics at a finer spacing costs the square of the refinement in nodes and more
         // iterations: it runs at the ply's spacing, and the estimate is reported.
         reason.push_str(&format!(
-            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics runs at the ply's spacing",
+            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics runs at the ply's spacing, so the tolerance is not assured: the pressed drape has a spacing error of its own",
             discretisation.unwrap_or_default()
         ));
     } else if let Some(needed) = spacing_needed {

@@ -271,6 +271,10 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                     )
                 })
                 .collect();
+            let auto = match &s.auto_not_run {
+                Some(why) => format!("{auto} Auto was not run: {why}."),
+                None => auto,
+            };
             let summary = summary + &auto;
             found.push((
                 "speed_accuracy",

@@ -211,6 +211,9 @@ pub struct SpeedAccuracy {
     /// The `auto` runs: error kept and cost saved against mechanics.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub auto: Vec<AutoCost>,
+    /// Why `auto` was not run, when it was not (a free drape, a ply without a material card).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auto_not_run: Option<String>,
 }
 
 /// Cell centres of `f` and the values of the other fields there, where all have one.
@@ -365,7 +368,26 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
     };
     mark_pareto(&mut points);
     let auto = auto_costs(records, &points);
-    SpeedAccuracy { ply: plan.ply.clone(), reference, limits, points, auto }
+    let auto_not_run = auto_not_run(plan);
+    SpeedAccuracy { ply: plan.ply.clone(), reference, limits, points, auto, auto_not_run }
+}
+
+/// Why the plan has no `auto` case ([`methods_for`]), or `None` when it has one.
+fn auto_not_run(plan: &Plan) -> Option<String> {
+    let methods: Vec<StudyMethod> = plan.cases.iter().map(|c| c.variant.method).collect();
+    if methods.contains(&StudyMethod::Auto) {
+        None
+    } else if methods.contains(&StudyMethod::MechanicalFree) {
+        Some(format!(
+            "ply {} is a free drape: auto chooses between the kinematic net on the tool and the pressed drape, and a sheet hanging under gravity has no kinematic counterpart, so only mechanics applies",
+            plan.ply
+        ))
+    } else {
+        Some(format!(
+            "ply {} has no material card: auto weighs the kinematic net under the card's mechanical model (give the ply material = ...)",
+            plan.ply
+        ))
+    }
 }
 
 /// Each `auto` run against the pressed mechanical run at the same spacing and tool.
