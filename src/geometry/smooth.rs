@@ -352,9 +352,11 @@ impl<'a> SmoothSurface<'a> {
         let mut p = *q;
         let mut normal = foot.normal;
         let mut restarted = false;
-        // The sectors near the Newton iterates, gathered once for a box around them (the steps
-        // stay within about the query's distance from its facet) instead of a BVH query a step.
-        let reach = 2.0 * off.norm() + tol;
+        // The sectors near the Newton iterates, gathered for a box around an iterate and kept
+        // while the next ones stay in it: Newton's steps at least halve near the surface, so a box
+        // of half the last step holds the rest (a far query's box stays small: a large box
+        // gathers sectors that all have to be tried).
+        let mut reach = tol;
         let mut near = NearSectors::default();
         for _ in 0..PROJECTION_MAX_ITERATIONS {
             let candidates = near.around(self, &p, reach);
@@ -375,6 +377,7 @@ impl<'a> SmoothSurface<'a> {
                 break;
             }
             p -= g * (f / g2);
+            reach = 0.5 * f.abs() / g2.sqrt() + tol;
         }
         // A region's implicit surface runs on past its sharp edges (a table's top continues as a
         // plane beyond the rim): where the point found lies across such an edge of the facet under

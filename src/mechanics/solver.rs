@@ -342,8 +342,10 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     // The reach of a step (spacings) and whether the last step needed the convex model.
     let mut reach = MAX_STEP_SPACINGS;
     let mut prefer_convex = false;
-    // Whether the next iteration tries a chord step first.
+    // Whether the next iteration tries a chord step first, and the free directions of the
+    // model last factorised.
     let mut chord_ready = false;
+    let mut chord_dofs: Option<Vec<u8>> = None;
     for it in 0..settings.max_iterations {
         if residual <= settings.tolerance || red.is_empty() {
             outcome = Outcome::Converged;
@@ -386,7 +388,10 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         let mut accepted = None;
         let mut failure = None;
         let mut chord = false;
-        if chord_ready && settings.chord_steps {
+        // The factorisation held is of a model over the same free directions (no node has
+        // touched or left the tool, or an edge, since).
+        let same_set = chord_dofs.as_deref() == Some(red.dofs());
+        if chord_ready && same_set && settings.chord_steps && cons.mode == ContactMode::Pressed {
             // The last step went as its model said: try the factorisation it used once more
             // with the new forces (triangular solves instead of a factorisation). Kept only if
             // it goes as the current exact model says, else the model is factorised as usual.
@@ -509,6 +514,9 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             }
             refused = true;
             shift = (shift * 4.0).max(1e-8);
+        }
+        if !chord {
+            chord_dofs = Some(red.dofs().to_vec());
         }
         let (accepted_flag, corrected, step, accepted_step) = match accepted {
             Some((trial, feet, ratio, corrected)) => {
