@@ -378,8 +378,6 @@ pub struct QpEngine {
     factored: Option<Vec<f64>>,
     /// Subproblems solved with the factorisation of the one before.
     pub reused_factorisations: u32,
-    /// Chord steps: subproblems solved with an earlier subproblem's factorisation.
-    pub chord_solves: u32,
     /// Time spent in Clarabel (set-up, updates and solves), ms.
     pub time_ms: f64,
 }
@@ -418,37 +416,6 @@ impl QpEngine {
         let result = self.solve_timed(red, values, q, n);
         self.time_ms += start.elapsed().as_secs_f64() * 1e3;
         result
-    }
-
-    /// A step for the right-hand side `q` with the matrix the engine holds factorised (an earlier
-    /// subproblem's, not the current model's): a chord step of modified Newton, at the cost of
-    /// triangular solves instead of a factorisation. The matrix is positive definite, so the
-    /// step descends wherever `q` is not zero; how far it gets is for the caller to judge. None
-    /// when no factorisation of `red`'s pattern is held.
-    pub fn solve_factorised(&mut self, red: &Reduction, q: &[f64]) -> Option<Vec<f64>> {
-        let start = std::time::Instant::now();
-        let result = self.factorised_timed(red, q);
-        self.time_ms += start.elapsed().as_secs_f64() * 1e3;
-        result
-    }
-
-    fn factorised_timed(&mut self, red: &Reduction, q: &[f64]) -> Option<Vec<f64>> {
-        let n = red.len();
-        let held = matches!(&self.cached, Some((key, _)) if key.as_slice() == red.key());
-        if n == 0 || !held || self.factored.is_none() {
-            return None;
-        }
-        let (_, solver) = self.cached.as_mut().expect("checked");
-        solver.update_q(&q.to_vec()).ok()?;
-        let settings = Self::settings(n);
-        let ok = solver.kktsystem.solve_initial_point(&mut solver.variables, &solver.data, &settings);
-        let mut y = solver.variables.x.clone();
-        if !ok || !y.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        self.chord_solves += 1;
-        red.clear_pinned(&mut y);
-        Some(y)
     }
 
     fn solve_timed(&mut self, red: &Reduction, values: &[f64], q: &[f64], n: usize) -> Result<Vec<f64>, QpFailure> {
@@ -513,4 +480,67 @@ impl QpEngine {
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+
+    /// Two free nodes coupled by a fixed symmetric positive definite 6 x 6 matrix.
+    struct Dense(DMatrix<f64>);
+    impl HessianBlocks for Dense {
+        fn block(&self, a: usize, b: usize) -> Matrix3<f64> {
+            Matrix3::from_fn(|i, j| self.0[(3 * a + i, 3 * b + j)])
+        }
+    }
+
+    fn spd(seed: f64) -> DMatrix<f64> {
+        let b = DMatrix::from_fn(6, 6, |i, j| ((i * 7 + j * 3) as f64 * seed).sin());
+        &b * b.transpose() + DMatrix::identity(6, 6) * 0.5
+    }
+
+    #[test]
+    fn subproblems_solve_the_models_they_are_given() {
+        let red = Reduction::new(vec![3, 3], vec![3, 3], vec![0, 1], &[(0, 0), (0, 1), (1, 1)]);
+        let bases = [NodeBasis::free(), NodeBasis::free()];
+        let (p1, p2) = (spd(0.7), spd(1.3));
+        let q1 = [1.0, -2.0, 0.5, 0.25, 3.0, -1.0];
+        let q2 = [-0.5, 1.0, 2.0, -1.5, 0.0, 0.75];
+        let exact =
+            |p: &DMatrix<f64>, q: &[f64]| p.clone().cholesky().unwrap().solve(&(-DVector::from_column_slice(q)));
+        let close = |y: &[f64], want: &DVector<f64>| {
+            let err = (DVector::from_column_slice(y) - want).norm();
+            assert!(err < 1e-9 * want.norm(), "{y:?} vs {want}");
+        };
+        let mut engine = QpEngine::new();
+        let v1 = red.values(&Dense(p1.clone()), &bases);
+        let y = engine.solve(&red, &v1, &q1).unwrap();
+        close(&y, &exact(&p1, &q1));
+        assert!(red.model_residual(&v1, &y, &q1) < 1e-12);
+        // The same matrix with other forces (a second-order correction): the factorisation held.
+        let y = engine.solve(&red, &v1, &q2).unwrap();
+        close(&y, &exact(&p1, &q2));
+        assert_eq!(engine.reused_factorisations, 1);
+        // A new matrix is factorised anew.
+        let v2 = red.values(&Dense(p2.clone()), &bases);
+        let y = engine.solve(&red, &v2, &q2).unwrap();
+        close(&y, &exact(&p2, &q2));
+        assert_eq!(engine.reused_factorisations, 1);
+    }
+
+    #[test]
+    fn a_model_too_near_singular_for_its_step_is_refused() {
+        // A diagonal spanning 1 .. 1e-30: rounding swamps the step along the soft direction.
+        let red = Reduction::new(vec![3], vec![3], vec![0], &[(0, 0)]);
+        let p = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 1e-30, 1.0]));
+        let values = red.values(&Dense(p), &[NodeBasis::free()]);
+        let q = [1.0, 1.0, 1.0];
+        let mut engine = QpEngine::new();
+        match engine.solve(&red, &values, &q) {
+            Err(QpFailure::NotSolved(why)) => assert!(why.contains("singular"), "{why}"),
+            Ok(y) => panic!("a step {y:?} from a singular model"),
+            Err(e) => panic!("{e:?}"),
+        }
+    }
 }

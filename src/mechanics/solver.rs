@@ -85,8 +85,6 @@ pub struct SolverSettings {
     pub initial_shift: f64,
     /// Try a second-order correction before shortening a rejected step.
     pub second_order_correction: bool,
-    /// Try a chord step (the last factorisation with the new forces) before factorising.
-    pub chord_steps: bool,
 }
 
 impl Default for SolverSettings {
@@ -97,7 +95,6 @@ impl Default for SolverSettings {
             force_scale: None,
             initial_shift: 1e-6,
             second_order_correction: true,
-            chord_steps: true,
         }
     }
 }
@@ -134,8 +131,6 @@ pub struct IterationLog {
     pub accepted: bool,
     /// Whether the accepted step needed a second-order correction.
     pub corrected: bool,
-    /// Whether the accepted step was a chord step (an earlier factorisation, new forces).
-    pub chord: bool,
     /// Clarabel subproblems solved in the iteration.
     pub subproblems: u32,
     /// Of the iteration's time: assembling the quadratic models (energy, gradient and Hessian
@@ -342,10 +337,6 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     // The reach of a step (spacings) and whether the last step needed the convex model.
     let mut reach = MAX_STEP_SPACINGS;
     let mut prefer_convex = false;
-    // Whether the next iteration tries a chord step first, and the free directions of the
-    // model last factorised.
-    let mut chord_ready = false;
-    let mut chord_dofs: Option<Vec<u8>> = None;
     for it in 0..settings.max_iterations {
         if residual <= settings.tolerance || red.is_empty() {
             outcome = Outcome::Converged;
@@ -387,38 +378,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         let mut rounding_tries = 0;
         let mut accepted = None;
         let mut failure = None;
-        let mut chord = false;
-        // The factorisation held is of a model over the same free directions (no node has
-        // touched or left the tool, or an edge, since).
-        let same_set = chord_dofs.as_deref() == Some(red.dofs());
-        if chord_ready && same_set && settings.chord_steps && cons.mode == ContactMode::Pressed {
-            // The last step went as its model said: try the factorisation it used once more
-            // with the new forces (triangular solves instead of a factorisation). Kept only if
-            // it goes as the current exact model says, else the model is factorised as usual.
-            if let Some(y) = engine.solve_factorised(&red, &g) {
-                subproblems += 1;
-                let t_trial = std::time::Instant::now();
-                let tried = try_chord(
-                    objective,
-                    cons,
-                    x,
-                    &state,
-                    &red,
-                    &rep,
-                    y,
-                    &g,
-                    &base_values,
-                    &ChordBounds { cap: reach * cons.spacing, noise, residual, force_scale },
-                );
-                trial_ms += t_trial.elapsed().as_secs_f64() * 1e3;
-                if let Some((trial, feet, ratio, capped)) = tried {
-                    accepted = Some((trial, feet, ratio, false));
-                    step_capped = capped;
-                    chord = true;
-                }
-            }
-        }
-        while accepted.is_none() && shift <= MAX_SHIFT {
+        while shift <= MAX_SHIFT {
             values.copy_from_slice(&base_values);
             red.add_diagonal(&mut values, &masses, shift * unit_shift);
             subproblems += 1;
@@ -515,10 +475,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             refused = true;
             shift = (shift * 4.0).max(1e-8);
         }
-        if !chord {
-            chord_dofs = Some(red.dofs().to_vec());
-        }
-        let (accepted_flag, corrected, step, accepted_step) = match accepted {
+        let (accepted_flag, corrected, step) = match accepted {
             Some((trial, feet, ratio, corrected)) => {
                 let step = x.iter().zip(&trial).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max) / cons.spacing;
                 x.copy_from_slice(&trial);
@@ -544,26 +501,16 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     shift *= 2.0;
                 }
                 reach = if step_capped && ratio >= GOOD_RATIO { (2.0 * reach).min(MAX_REACH_SPACINGS) } else { reach };
-                if !chord {
-                    prefer_convex = convex;
-                }
-                (true, corrected, step, Some(ratio))
+                prefer_convex = convex;
+                (true, corrected, step)
             }
-            None => (false, false, 0.0, None),
+            None => (false, false, 0.0),
         };
         if refused {
             // A step was refused on the way: start small again.
             reach = MAX_STEP_SPACINGS;
         }
-        let previous_residual = residual;
         residual = residual_of(&red, &state, force_scale);
-        // Chord steps go on while each one contracts the residual and falls as predicted; a
-        // factorised step that went as its model said starts them again.
-        chord_ready = match (&accepted_step, chord) {
-            (Some(ratio), true) => *ratio >= GOOD_RATIO && residual <= CHORD_CONTRACTION * previous_residual,
-            (Some(ratio), false) => *ratio >= GOOD_RATIO && !refused,
-            (None, _) => false,
-        };
         iterations.push(IterationLog {
             iteration: it + 1,
             energy: state.eval.energy,
@@ -573,7 +520,6 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             active_contacts: active_contacts(cons, &state),
             accepted: accepted_flag,
             corrected,
-            chord,
             subproblems,
             time_ms: t_it.elapsed().as_secs_f64() * 1e3,
             model_ms: t_it.elapsed().as_secs_f64() * 1e3 - (engine.time_ms - solve_ms_before) - trial_ms,
@@ -612,57 +558,6 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         unbalanced,
         subproblem_status,
     }
-}
-
-/// A chord step keeps at most this fraction of the residual it started from; one that keeps
-/// more is taken, but the next step factorises the model again.
-const CHORD_CONTRACTION: f64 = 0.5;
-
-/// What a chord step is judged by.
-struct ChordBounds {
-    /// Largest node displacement, m.
-    cap: f64,
-    /// Rounding in the energy.
-    noise: f64,
-    /// The residual before the step.
-    residual: f64,
-    force_scale: f64,
-}
-
-/// The chord step `y` (from an earlier factorisation) for the reduced forces `g`, judged by the
-/// current exact model `exact`: the trial (state, feet, fall over predicted fall, capped) if it
-/// falls at least [`GOOD_RATIO`] of the prediction or, where the energy cannot tell, balances the
-/// forces [`CHORD_CONTRACTION`] times better.
-#[allow(clippy::too_many_arguments)] // the solve's own locals, passed as they are
-fn try_chord(
-    objective: &dyn Objective,
-    cons: &Constraints,
-    x: &[Point],
-    s: &State,
-    red: &Reduction,
-    rep: &[usize],
-    y: Vec<f64>,
-    g: &[f64],
-    exact: &[f64],
-    bounds: &ChordBounds,
-) -> Option<(Vec<Point>, Feet, f64, bool)> {
-    if dot(g, &y) >= 0.0 {
-        return None;
-    }
-    let (y, capped) = cap_step(red, y, &s.bases, bounds.cap);
-    let predicted = -(dot(g, &y) + 0.5 * red.quad(exact, &y));
-    if predicted <= 0.0 {
-        return None;
-    }
-    let (trial, feet) = moved(cons, x, &red.expand(&y, &s.bases), &s.sliding);
-    if predicted > ROUNDING_BAND * bounds.noise {
-        let fall = s.eval.energy - objective.energy(&trial);
-        return (fall >= GOOD_RATIO * predicted).then_some((trial, feet, fall / predicted, capped));
-    }
-    let e = objective.evaluate(&trial, false);
-    let (bases, _) = bases_at(cons, rep, &e, &feet);
-    let balanced = residual_at(red, &e, &bases, bounds.force_scale) <= CHORD_CONTRACTION * bounds.residual;
-    balanced.then_some((trial, feet, 1.0, capped))
 }
 
 /// The accepted step `y` doubled while the energy keeps falling and no node moves further than
