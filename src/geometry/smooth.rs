@@ -506,6 +506,25 @@ mod tests {
     }
 
     #[test]
+    fn a_projection_with_its_curvature_agrees_with_the_separate_queries_to_the_bit() {
+        // The sectors a projection gathers once must give what a BVH query a step gives: the
+        // same point, normal and curvature, for queries near the surface and far from it.
+        let tool = shapes::hemisphere(1.0, 12).into_surface().unwrap();
+        let smooth = SmoothSurface::new(&tool);
+        for i in 0..30 {
+            for (k, lift) in [1e-9, 1e-4, 0.02, 0.3].into_iter().enumerate() {
+                let (theta, phi) = (1.4 * i as f64 / 29.0, 0.7 * i as f64 + k as f64);
+                let dir = Vector::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                let q = Point::from(dir * (1.0 + lift));
+                let (s, curvature) = smooth.project_curved(&q);
+                let plain = smooth.project(&q);
+                assert_eq!(s, plain);
+                assert_eq!(curvature, smooth.curvature(s.region, &s.point), "at {q}");
+            }
+        }
+    }
+
+    #[test]
     fn hemisphere_surface_follows_the_sphere_far_closer_than_the_facets() {
         let r = 1.0;
         let tool = shapes::hemisphere(r, 12).into_surface().unwrap();
