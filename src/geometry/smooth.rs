@@ -309,10 +309,7 @@ impl<'a> SmoothSurface<'a> {
     /// so that a point moved by the tangent vector t stays on the surface by moving
     /// `-1/2 t^T C t` along the normal.
     pub fn curvature(&self, region: u32, p: &Point) -> Matrix3<f64> {
-        match self.value_gradient_hessian(region, p) {
-            Some((_, g, h)) if g.norm() > 0.0 => h / g.norm(),
-            _ => Matrix3::zeros(),
-        }
+        curvature_of(self.value_gradient_hessian(region, p))
     }
 
     /// The point of the smooth surface over `q`: reached from `q` (or, far from the surface,
@@ -400,10 +397,7 @@ impl<'a> SmoothSurface<'a> {
             && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
         let curvature = if curved {
             let candidates = near.around(self, &p, reach);
-            match self.evaluate_among(candidates.iter().copied(), region, &p, true) {
-                Some((_, g, h)) if g.norm() > 0.0 => h / g.norm(),
-                _ => Matrix3::zeros(),
-            }
+            curvature_of(self.evaluate_among(candidates.iter().copied(), region, &p, true))
         } else {
             Matrix3::zeros()
         };
@@ -417,6 +411,14 @@ impl<'a> SmoothSurface<'a> {
             beyond_region: beyond_crease || beyond_edge_or_corner,
         };
         (point, curvature)
+    }
+}
+
+/// `C = hess f / |grad f|` from an evaluation of the implicit function (zero where there is none).
+fn curvature_of(evaluation: Option<(f64, Vector, Matrix3<f64>)>) -> Matrix3<f64> {
+    match evaluation {
+        Some((_, g, h)) if g.norm() > 0.0 => h / g.norm(),
+        _ => Matrix3::zeros(),
     }
 }
 

@@ -478,7 +478,8 @@ impl QpEngine {
     }
 }
 
-fn norm(v: &[f64]) -> f64 {
+/// The Euclidean norm of a reduced vector.
+pub(super) fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 

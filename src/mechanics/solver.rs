@@ -23,7 +23,7 @@
 //!    raised (a shorter, more cautious step).
 use super::contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use super::qp::HessianBlocks;
-use super::qp::{QpEngine, QpFailure, Reduction};
+use super::qp::{norm, QpEngine, QpFailure, Reduction};
 use crate::geometry::{Point, Vector};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -818,10 +818,6 @@ fn unbalanced_nodes(objective: &dyn Objective, x: &[Point], red: &Reduction, s: 
             UnbalancedNode { node, force, dominant_term }
         })
         .collect()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
