@@ -3,6 +3,7 @@
 //! the net's meta, the CLI table and the report; the study's account of error kept and cost
 //! saved; bad input refused.
 use assert_cmd::Command;
+use drape::study::speed_accuracy::SpeedAccuracy;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -16,6 +17,22 @@ fn repo(rel: &str) -> PathBuf {
 
 fn read_json(p: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// `drape study speed-accuracy` on `scene` into `out` (one repeat, one job) at the kinematic
+/// `spacings` and `mechanical` spacings: its stdout and `speed_accuracy.json`.
+fn study(scene: &Path, out: &Path, spacings: &str, mechanical: &str) -> (String, SpeedAccuracy) {
+    let run = drape()
+        .args(["study", "speed-accuracy"])
+        .arg(scene)
+        .arg("--out")
+        .arg(out)
+        .args(["--spacings", spacings, "--mechanical-spacings", mechanical, "--repeats", "1", "--jobs", "1"])
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    let sa = serde_json::from_str(&std::fs::read_to_string(out.join("speed_accuracy.json")).unwrap()).unwrap();
+    (stdout, sa)
 }
 
 /// Largest |shear difference| between two nets of the same grid, degrees.
@@ -193,17 +210,7 @@ fn the_study_reports_the_error_auto_keeps_and_the_cost_it_saves() {
         "name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.004\ngrid = [41, 41]\nmaterial = \"card\"",
     );
     let out = dir.path().join("study");
-    let run = drape()
-        .args(["study", "speed-accuracy"])
-        .arg(&path)
-        .arg("--out")
-        .arg(&out)
-        .args(["--spacings", "0.004", "--mechanical-spacings", "0.004,0.002", "--repeats", "1", "--jobs", "1"])
-        .assert()
-        .success();
-    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
-    let sa: drape::study::speed_accuracy::SpeedAccuracy =
-        serde_json::from_str(&std::fs::read_to_string(out.join("speed_accuracy.json")).unwrap()).unwrap();
+    let (stdout, sa) = study(&path, &out, "0.004", "0.004,0.002");
     assert_eq!(sa.reference.kind, "mechanical");
     assert_eq!(sa.reference.spacing, 0.002);
     assert_eq!(sa.auto.len(), 2, "auto at both mechanical spacings");
@@ -297,16 +304,7 @@ fn the_bundled_plate_scene_runs_auto_and_keeps_the_kinematic_net() {
 fn the_study_of_auto_on_the_bundled_cylinder_keeps_no_error_and_reports_its_cost() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("study");
-    drape()
-        .args(["study", "speed-accuracy"])
-        .arg(repo("geometries/cylinder/scene.toml"))
-        .arg("--out")
-        .arg(&out)
-        .args(["--spacings", "0.004", "--mechanical-spacings", "0.004", "--repeats", "1", "--jobs", "1"])
-        .assert()
-        .success();
-    let sa: drape::study::speed_accuracy::SpeedAccuracy =
-        serde_json::from_str(&std::fs::read_to_string(out.join("speed_accuracy.json")).unwrap()).unwrap();
+    let (_, sa) = study(&repo("geometries/cylinder/scene.toml"), &out, "0.004", "0.004");
     assert_eq!(sa.reference.kind, "mechanical");
     assert_eq!(sa.reference.spacing, 0.004);
     assert_eq!(sa.auto_not_run, None);
@@ -375,17 +373,7 @@ fn the_study_says_so_where_auto_is_outside_its_tolerance() {
     let path = dir.path().join("cone.toml");
     std::fs::write(&path, scene).unwrap();
     let out = dir.path().join("study");
-    let run = drape()
-        .args(["study", "speed-accuracy"])
-        .arg(&path)
-        .arg("--out")
-        .arg(&out)
-        .args(["--spacings", "0.003", "--mechanical-spacings", "0.003,0.0015", "--repeats", "1", "--jobs", "1"])
-        .assert()
-        .success();
-    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
-    let sa: drape::study::speed_accuracy::SpeedAccuracy =
-        serde_json::from_str(&std::fs::read_to_string(out.join("speed_accuracy.json")).unwrap()).unwrap();
+    let (stdout, sa) = study(&path, &out, "0.003", "0.003,0.0015");
     assert_eq!(sa.reference.spacing, 0.0015);
     let a = sa.auto.iter().find(|a| a.spacing == 0.003).unwrap();
     assert_eq!(a.chosen, "kinematic", "{}", a.reason);
