@@ -126,6 +126,9 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
             sum(|i| i.solve_ms),
             sum(|i| i.trial_ms)
         );
+        if let Some(c) = refined.steps.last().and_then(|s| s.stability.as_ref()) {
+            println!("  stability check: {}", c.describe());
+        }
     }
     if let Some(kb) = peak_memory_kb() {
         println!("peak memory (VmHWM): {:.0} MB", kb as f64 / 1024.0);

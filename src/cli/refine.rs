@@ -119,12 +119,15 @@ pub(crate) fn print_solver(r: &Refined) {
     let iterations: usize = r.steps.iter().map(|s| s.iterations.len()).sum();
     let ms: f64 = r.steps.iter().map(|s| s.time_ms).sum();
     let residual = r.steps.last().map_or(0.0, |s| s.residual);
+    // The check of the state the net ends in (the last load step's).
+    let stability = r.steps.last().and_then(|s| s.stability.as_ref()).map(|c| format!("; {}", c.describe()));
     println!(
-        "  solver: {:?} after {iterations} iterations in {} load step(s), {:.0} ms; |F-P|/|P| {:.2e}",
+        "  solver: {:?} after {iterations} iterations in {} load step(s), {:.0} ms; |F-P|/|P| {:.2e}{}",
         r.outcome(),
         r.steps.len(),
         ms,
         residual,
+        stability.unwrap_or_default(),
     );
     if r.energy_start == r.energy_kinematic {
         println!("  energy: kinematic {:.6e} J -> refined {:.6e} J", r.energy_kinematic, r.energy_final);

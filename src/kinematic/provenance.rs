@@ -152,6 +152,11 @@ pub struct SolverRecord {
     pub energy_start: f64,
     /// Energy of the refined net, J.
     pub energy_final: f64,
+    /// The second-order check of the final state: `minimum`, `saddle` (an equilibrium, but an
+    /// unstable one) or `unresolved`; absent when not checked (switched off, not converged).
+    /// The figures are in the last load step's `stability`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stability: Option<String>,
     /// The solver's log, one entry per load step.
     #[serde(default)]
     pub load_steps: Value,

@@ -8,8 +8,10 @@ pub mod refine;
 pub mod sheet;
 pub mod solver;
 pub mod sparse;
+pub mod stability;
 pub mod virtual_tests;
 
 pub use contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use qp::HessianBlocks;
 pub use solver::{solve, Constraints, Evaluation, Objective, Outcome, SolveReport, SolverSettings, UnbalancedNode};
+pub use stability::{Escape, Stability, StabilityCheck};

@@ -354,6 +354,21 @@ impl Reduction {
         s
     }
 
+    /// P y for the upper-triangular `values` (the full symmetric product).
+    pub fn mul(&self, values: &[f64], y: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n];
+        for c in 0..self.n {
+            let entries = self.colptr[c]..self.colptr[c + 1];
+            for (&r, &value) in self.rowval[entries.clone()].iter().zip(&values[entries]) {
+                out[r] += value * y[c];
+                if r != c {
+                    out[c] += value * y[r];
+                }
+            }
+        }
+        out
+    }
+
     fn matrix(&self, values: &[f64]) -> CscMatrix<f64> {
         CscMatrix::new(self.n, self.n, self.colptr.clone(), self.rowval.clone(), values.to_vec())
     }

@@ -473,6 +473,10 @@ pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, mat
         energy_kinematic: refined.energy_kinematic,
         energy_start: refined.energy_start,
         energy_final: refined.energy_final,
+        stability: last
+            .and_then(|s| s.stability.as_ref())
+            .and_then(|c| serde_json::to_value(c.verdict).ok())
+            .and_then(|v| v.as_str().map(str::to_string)),
         load_steps: serde_json::to_value(&refined.steps).unwrap_or_default(),
     });
 }

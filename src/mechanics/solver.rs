@@ -24,6 +24,7 @@
 use super::contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use super::qp::HessianBlocks;
 use super::qp::{norm, QpEngine, QpFailure, Reduction};
+use super::stability::{least_mode, spread, Escape, LeastMode, Stability, StabilityCheck, LANCZOS_ITERATIONS};
 use crate::geometry::{Point, Vector};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -85,6 +86,9 @@ pub struct SolverSettings {
     pub initial_shift: f64,
     /// Try a second-order correction before shortening a rejected step.
     pub second_order_correction: bool,
+    /// At convergence, check that the state is a minimum (no direction of negative curvature)
+    /// and move off a saddle ([`super::stability`]).
+    pub stability_check: bool,
 }
 
 impl Default for SolverSettings {
@@ -95,6 +99,7 @@ impl Default for SolverSettings {
             force_scale: None,
             initial_shift: 1e-6,
             second_order_correction: true,
+            stability_check: true,
         }
     }
 }
@@ -108,6 +113,11 @@ impl SolverSettings {
     /// Sets the relative residual tolerance.
     pub fn tolerance(mut self, t: f64) -> Self {
         self.tolerance = t;
+        self
+    }
+    /// Switches the stability check at convergence on or off.
+    pub fn stability_check(mut self, on: bool) -> Self {
+        self.stability_check = on;
         self
     }
 }
@@ -206,12 +216,21 @@ pub struct SolveReport {
     /// What Clarabel said of the last subproblem that failed, if the solve ended on one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subproblem_status: Option<String>,
+    /// The second-order check of the converged state (absent when switched off or not
+    /// converged). A converged state it finds a saddle it could not escape stays `Converged`
+    /// (the forces balance) with the verdict `saddle` here.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stability: Option<StabilityCheck>,
 }
 
 impl SolveReport {
     /// Whether the final state is an equilibrium to the tolerance.
     pub fn ok(&self) -> bool {
         self.outcome == Outcome::Converged
+    }
+    /// Whether the final state was checked and found a saddle (an unstable equilibrium).
+    pub fn saddle(&self) -> bool {
+        self.stability.as_ref().is_some_and(|c| c.verdict == Stability::Saddle)
     }
 }
 
@@ -268,6 +287,23 @@ const MIN_SHIFT: f64 = 1e-14;
 const MAX_SHIFT: f64 = 1e12;
 /// Nodes listed in a failure report.
 const UNBALANCED_REPORTED: usize = 5;
+/// A converged state is a saddle when the least eigenvalue of its Hessian relative to the
+/// check's positive definite reference (which bounds it from above) is below minus this: the
+/// Hessian curves down by this fraction of the reference's curvature along some direction.
+/// Rounding in the Hessian is about 1e-16 of its largest entries (1e3 of the mean diagonal),
+/// 1e-5 of the reference's smallest curvature (its mass shift, 1e-8): far below this.
+const NEGATIVE_CURVATURE: f64 = 1e-3;
+/// Most moves off saddles in one solve.
+const MAX_ESCAPES: usize = 3;
+/// The largest node move of an escape, spacings (before halving).
+const ESCAPE_STEP_SPACINGS: f64 = 0.5;
+/// An escape move is halved at most this many times while neither sign lowers the energy.
+const ESCAPE_HALVINGS: usize = 10;
+/// The mass shift of the stability check's reference model, relative (as the solver's shift):
+/// small, so that the reference stays close to the elements' convex parts.
+const REFERENCE_SHIFT: f64 = 1e-8;
+/// Shifts beyond this (relative) are not tried for the reference: the check is given up.
+const MAX_REFERENCE_SHIFT: f64 = 1e2;
 
 /// Per node, where it touches the tool (on-tool nodes always; free nodes near the tool).
 type Feet = Vec<Option<Foot>>;
@@ -337,11 +373,76 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     // The reach of a step (spacings) and whether the last step needed the convex model.
     let mut reach = MAX_STEP_SPACINGS;
     let mut prefer_convex = false;
-    for it in 0..settings.max_iterations {
+    let mut stability: Option<StabilityCheck> = None;
+    // The last saddle escaped from and its check, restored if the iterations from there fail.
+    let mut saddle: Option<(Vec<Point>, StabilityCheck)> = None;
+    let mut it = 0;
+    loop {
         if residual <= settings.tolerance || red.is_empty() {
+            if settings.stability_check && !red.is_empty() {
+                let t_check = std::time::Instant::now();
+                let found = least_curvature(objective, cons, &rep, &red, &state, x, &masses, mean_mass, &mut engine);
+                let check = stability.get_or_insert_with(|| StabilityCheck {
+                    verdict: Stability::Unresolved,
+                    least_eigenvalue: f64::NAN,
+                    relative_eigenvalue: f64::NAN,
+                    reference_eigenvalue: f64::NAN,
+                    lanczos_iterations: 0,
+                    lanczos_converged: false,
+                    checks: 0,
+                    escapes: Vec::new(),
+                    time_ms: 0.0,
+                });
+                check.checks += 1;
+                let escape = match &found {
+                    Some(c) => {
+                        check.least_eigenvalue = c.lumped;
+                        check.relative_eigenvalue = c.relative;
+                        check.reference_eigenvalue = c.mode.value;
+                        check.lanczos_iterations = c.mode.iterations;
+                        check.lanczos_converged = c.mode.converged;
+                        check.verdict =
+                            if c.mode.value < -NEGATIVE_CURVATURE { Stability::Saddle } else { Stability::Minimum };
+                        if check.verdict == Stability::Saddle && check.escapes.len() < MAX_ESCAPES {
+                            escape_move(objective, cons, x, &state, &red, &c.mode.vector)
+                        } else {
+                            None
+                        }
+                    }
+                    None => {
+                        check.verdict = Stability::Unresolved;
+                        None
+                    }
+                };
+                if let Some((trial, feet, energy_moved, move_spacings)) = escape {
+                    check.escapes.push(Escape {
+                        after_iteration: it,
+                        least_eigenvalue: check.least_eigenvalue,
+                        energy_saddle: state.eval.energy,
+                        energy_moved,
+                        move_spacings,
+                        kept: true,
+                    });
+                    check.time_ms += t_check.elapsed().as_secs_f64() * 1e3;
+                    saddle = Some((x.to_vec(), check.clone()));
+                    x.copy_from_slice(&trial);
+                    state = adopt(objective, cons, &rep, &full, &pairs, x, Some(feet), &mut red);
+                    // Iterate from there as from a new start.
+                    shift = settings.initial_shift;
+                    reach = MAX_STEP_SPACINGS;
+                    prefer_convex = false;
+                    residual = residual_of(&red, &state, force_scale);
+                    continue;
+                }
+                check.time_ms += t_check.elapsed().as_secs_f64() * 1e3;
+            }
             outcome = Outcome::Converged;
             break;
         }
+        if it >= settings.max_iterations {
+            break;
+        }
+        it += 1;
         let t_it = std::time::Instant::now();
         let solve_ms_before = engine.time_ms;
         let mut trial_ms = 0.0;
@@ -479,22 +580,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             Some((trial, feet, ratio, corrected)) => {
                 let step = x.iter().zip(&trial).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max) / cons.spacing;
                 x.copy_from_slice(&trial);
-                let eval = objective.evaluate(x, true);
-                let feet = feet_at(cons, x, Some(feet));
-                let (bases, sliding) = bases_at(cons, &rep, &eval, &feet);
-                state = State { eval, feet, bases, sliding };
-                let dofs = dofs_of(&state.bases, &rep);
-                if dofs.as_slice() != red.dofs() {
-                    if red.fits(&dofs) {
-                        red.set_dofs(dofs);
-                    } else {
-                        // Slots for the nodes that outgrew theirs: all their freedoms.
-                        let cap = (red.capacity().iter().zip(&dofs).zip(&full))
-                            .map(|((&c, &d), &f)| if d > c { f.max(d) } else { c })
-                            .collect();
-                        red = Reduction::new(cap, dofs, rep.clone(), &pairs);
-                    }
-                }
+                state = adopt(objective, cons, &rep, &full, &pairs, x, Some(feet), &mut red);
                 if ratio >= GOOD_RATIO && !corrected {
                     shift = (shift / 8.0).max(MIN_SHIFT);
                 } else if ratio < 0.1 {
@@ -512,7 +598,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         }
         residual = residual_of(&red, &state, force_scale);
         iterations.push(IterationLog {
-            iteration: it + 1,
+            iteration: it,
             energy: state.eval.energy,
             residual,
             step,
@@ -527,8 +613,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             trial_ms,
         });
         if residual <= settings.tolerance {
-            outcome = Outcome::Converged;
-            break;
+            // Converged: checked at the top of the loop.
+            continue;
         }
         if !accepted_flag {
             outcome = match &failure {
@@ -538,6 +624,24 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             };
             last_failure = failure;
             break;
+        }
+    }
+    if outcome != Outcome::Converged {
+        if let Some((at_saddle, check)) = saddle {
+            // The iterations from the escape did not reach equilibrium: the saddle is an
+            // equilibrium at least, and the report says what it is.
+            x.copy_from_slice(&at_saddle);
+            state = adopt(objective, cons, &rep, &full, &pairs, x, None, &mut red);
+            residual = residual_of(&red, &state, force_scale);
+            let time_ms = stability.as_ref().map_or(check.time_ms, |s| s.time_ms);
+            let mut check = check;
+            check.time_ms = time_ms;
+            if let Some(e) = check.escapes.last_mut() {
+                e.kept = false;
+            }
+            stability = Some(check);
+            outcome = Outcome::Converged;
+            last_failure = None;
         }
     }
     let unbalanced =
@@ -557,7 +661,153 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         time_ms: start.elapsed().as_secs_f64() * 1e3,
         unbalanced,
         subproblem_status,
+        stability: if outcome == Outcome::Converged { stability } else { None },
     }
+}
+
+/// Makes `x` (already moved) the solve's state: its evaluation, feet (those found by the move
+/// when given), bases, and the reduction's freedoms (a new pattern when a node outgrew its
+/// slots).
+#[allow(clippy::too_many_arguments)] // the solve's own locals, passed as they are
+fn adopt(
+    objective: &dyn Objective,
+    cons: &Constraints,
+    rep: &[usize],
+    full: &[u8],
+    pairs: &[(usize, usize)],
+    x: &[Point],
+    feet: Option<Feet>,
+    red: &mut Reduction,
+) -> State {
+    let eval = objective.evaluate(x, true);
+    let feet = feet_at(cons, x, feet);
+    let (bases, sliding) = bases_at(cons, rep, &eval, &feet);
+    let state = State { eval, feet, bases, sliding };
+    let dofs = dofs_of(&state.bases, rep);
+    if dofs.as_slice() != red.dofs() {
+        if red.fits(&dofs) {
+            red.set_dofs(dofs);
+        } else {
+            // Slots for the nodes that outgrew theirs: all their freedoms.
+            let cap = (red.capacity().iter().zip(&dofs).zip(full))
+                .map(|((&c, &d), &f)| if d > c { f.max(d) } else { c })
+                .collect();
+            *red = Reduction::new(cap, dofs, rep.to_vec(), pairs);
+        }
+    }
+    state
+}
+
+/// A converged state's least curvature (see [`super::stability`]).
+struct Curvature {
+    /// The least eigenpair of the pencil (exact Hessian, positive definite reference).
+    mode: LeastMode,
+    /// Its Rayleigh quotient over the lumped masses, 1/s^2.
+    lumped: f64,
+    /// `lumped` over the mean stiffness per mean mass.
+    relative: f64,
+}
+
+/// The least eigenvalue of the exact reduced Hessian at `s` (the tool's curvature included, no
+/// shift) relative to a positive definite reference: the elements' convex parts plus a small
+/// mass shift (or, for an objective without convex parts, the Hessian shifted past its
+/// Gershgorin bound). None where no reference could be factorised.
+#[allow(clippy::too_many_arguments)] // the solve's own locals, passed as they are
+fn least_curvature(
+    objective: &dyn Objective,
+    cons: &Constraints,
+    rep: &[usize],
+    red: &Reduction,
+    s: &State,
+    x: &[Point],
+    masses: &[f64],
+    mean_mass: f64,
+    engine: &mut QpEngine,
+) -> Option<Curvature> {
+    let hess = s.eval.hessian.as_deref()?;
+    let mut h = red.values(hess, &s.bases);
+    add_contact_curvature(cons, rep, red, s, &mut h, false);
+    let unit = red.mean_diagonal(&h).max(f64::MIN_POSITIVE) / mean_mass.max(f64::MIN_POSITIVE);
+    let mut lumped = vec![0.0; h.len()];
+    red.add_diagonal(&mut lumped, masses, 1.0);
+    let reference = match objective.convex_hessian(x) {
+        Some(c) => {
+            let mut v = red.values(c.as_ref(), &s.bases);
+            add_contact_curvature(cons, rep, red, s, &mut v, true);
+            v
+        }
+        None => {
+            // |H| row sums over the live variables bound its least eigenvalue (Gershgorin):
+            // twice that in masses makes H + shift diagonally dominant.
+            let mut live = vec![0.0; h.len()];
+            for k in (0..x.len()).filter(|&k| red.rep(k) == k) {
+                let (o, m) = red.vars(k);
+                live[o..o + m].fill(1.0);
+            }
+            let rows = red.mul(&h.iter().map(|v| v.abs()).collect::<Vec<_>>(), &live);
+            let diag = red.mul(&lumped, &live);
+            let bound = rows.iter().zip(&diag).filter(|(_, &d)| d > 0.0).map(|(r, d)| r / d).fold(0.0, f64::max);
+            let mut v = h.clone();
+            red.add_diagonal(&mut v, masses, 2.0 * bound);
+            v
+        }
+    };
+    let per_node: Vec<Vector> =
+        (0..x.len()).map(|k| Vector::new(spread(3 * k), spread(3 * k + 1), spread(3 * k + 2))).collect();
+    let start = red.reduce(&per_node, &s.bases);
+    let mut shift = REFERENCE_SHIFT;
+    while shift <= MAX_REFERENCE_SHIFT {
+        let mut m = reference.clone();
+        red.add_diagonal(&mut m, masses, shift * unit);
+        match least_mode(red, engine, &h, &m, &lumped, &start, LANCZOS_ITERATIONS) {
+            Ok(Some(mode)) => {
+                return Some(Curvature { relative: mode.least / unit, lumped: mode.least, mode });
+            }
+            Ok(None) => return None,
+            // Too near singular to factorise: a larger shift.
+            Err(_) => shift *= 100.0,
+        }
+    }
+    None
+}
+
+/// The state moved off a saddle along `v` (reduced, a direction of negative curvature): the
+/// largest node move [`ESCAPE_STEP_SPACINGS`], halved while neither sign lowers the energy
+/// beyond rounding (the straight move meets the stiff fibres' higher-order terms), with the
+/// nodes kept on or off the tool as in a step. Returns the lower state (state, feet, energy,
+/// largest move in spacings), None if no move lowered the energy.
+fn escape_move(
+    objective: &dyn Objective,
+    cons: &Constraints,
+    x: &[Point],
+    s: &State,
+    red: &Reduction,
+    v: &[f64],
+) -> Option<(Vec<Point>, Feet, f64, f64)> {
+    let delta = red.expand(v, &s.bases);
+    let largest = delta.iter().map(|d| d.norm()).fold(0.0, f64::max);
+    if !(largest > 0.0) || !largest.is_finite() {
+        return None;
+    }
+    let noise = ENERGY_ROUNDING * s.eval.energy.abs().max(f64::MIN_POSITIVE);
+    let mut size = ESCAPE_STEP_SPACINGS * cons.spacing;
+    for _ in 0..=ESCAPE_HALVINGS {
+        let best = [1.0, -1.0]
+            .into_iter()
+            .map(|sign| {
+                let d: Vec<Vector> = delta.iter().map(|d| d * (sign * size / largest)).collect();
+                let (trial, feet) = moved(cons, x, &d, &s.sliding);
+                let e = objective.energy(&trial);
+                (trial, feet, e)
+            })
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .expect("two signs");
+        if best.2 < s.eval.energy - ROUNDING_BAND * noise {
+            return Some((best.0, best.1, best.2, size / cons.spacing));
+        }
+        size /= 2.0;
+    }
+    None
 }
 
 /// The accepted step `y` doubled while the energy keeps falling and no node moves further than
@@ -961,6 +1211,174 @@ mod tests {
         let sphere = Point::from(target.coords.normalize());
         let facets = tool.closest_point(&target).point;
         assert!((x[0] - sphere).norm() < (facets - sphere).norm() / 5.0, "{} vs {}", x[0], sphere);
+    }
+
+    /// Springs of one stiffness between node pairs, of given rest lengths, on nodes of one
+    /// mass under gravity (-z).
+    struct SpringNet {
+        springs: Vec<(usize, usize, f64)>,
+        k: f64,
+        mass: f64,
+        gravity: f64,
+        nodes: usize,
+    }
+    /// 3x3 blocks by node pair (a <= b).
+    struct Blocks(std::collections::HashMap<(usize, usize), Matrix3<f64>>);
+    impl HessianBlocks for Blocks {
+        fn block(&self, a: usize, b: usize) -> Matrix3<f64> {
+            match (self.0.get(&(a, b)), self.0.get(&(b, a))) {
+                (Some(m), _) => *m,
+                (None, Some(m)) => m.transpose(),
+                _ => Matrix3::zeros(),
+            }
+        }
+    }
+    impl SpringNet {
+        /// Per spring (a, b, stiffness block along and across it: k n n^T + T/r (I - n n^T)),
+        /// with only the non-negative part when `convex`.
+        fn hessian(&self, x: &[Point], convex: bool) -> Blocks {
+            let mut blocks = std::collections::HashMap::new();
+            for &(a, b, rest) in &self.springs {
+                let d = x[b] - x[a];
+                let r = d.norm();
+                let n = d / r;
+                let nn = n * n.transpose();
+                let across = self.k * (r - rest) / r;
+                let across = if convex { across.max(0.0) } else { across };
+                let kb = nn * self.k + (Matrix3::identity() - nn) * across;
+                for (p, q, sign) in [(a, a, 1.0), (b, b, 1.0), (a.min(b), a.max(b), -1.0)] {
+                    *blocks.entry((p, q)).or_insert_with(Matrix3::zeros) += kb * sign;
+                }
+            }
+            Blocks(blocks)
+        }
+    }
+    impl Objective for SpringNet {
+        fn evaluate(&self, x: &[Point], hessian: bool) -> Evaluation {
+            let mut internal = vec![Vector::zeros(); x.len()];
+            let mut energy = 0.0;
+            for &(a, b, rest) in &self.springs {
+                let d = x[b] - x[a];
+                let r = d.norm();
+                let f = d / r * (self.k * (r - rest));
+                internal[b] += f;
+                internal[a] -= f;
+                energy += 0.5 * self.k * (r - rest).powi(2);
+            }
+            energy += x.iter().map(|p| self.mass * self.gravity * p.z).sum::<f64>();
+            Evaluation {
+                energy,
+                internal,
+                external: vec![Vector::new(0.0, 0.0, -self.mass * self.gravity); x.len()],
+                hessian: hessian.then(|| Box::new(self.hessian(x, false)) as Box<dyn HessianBlocks>),
+            }
+        }
+        fn convex_hessian(&self, x: &[Point]) -> Option<Box<dyn HessianBlocks>> {
+            Some(Box::new(self.hessian(x, true)))
+        }
+        fn coupled_pairs(&self) -> Vec<(usize, usize)> {
+            let mut pairs: Vec<(usize, usize)> = (0..self.nodes).map(|k| (k, k)).collect();
+            pairs.extend(self.springs.iter().map(|&(a, b, _)| (a.min(b), a.max(b))));
+            pairs
+        }
+        fn masses(&self) -> Vec<f64> {
+            vec![self.mass; self.nodes]
+        }
+    }
+
+    /// A bob of 2 kg on a stiff spring of rest length 1 m from a fixed node at the origin.
+    const PENDULUM: (f64, f64, f64) = (1.0, 2.0, 9.81);
+
+    fn pendulum() -> SpringNet {
+        let (length, mass, gravity) = PENDULUM;
+        SpringNet { springs: vec![(0, 1, length)], k: 1e3 * mass * gravity / length, mass, gravity, nodes: 2 }
+    }
+
+    #[test]
+    fn an_upright_pendulum_is_found_unstable_and_falls_to_hang_below() {
+        let (length, mass, gravity) = PENDULUM;
+        let obj = pendulum();
+        // Upright, the spring shortened by the weight: the forces balance exactly.
+        let sag = mass * gravity / obj.k;
+        let mut x = vec![Point::origin(), Point::new(0.0, 0.0, length - sag)];
+        let c = cons(vec![Freedom::Fixed, Freedom::Free], ContactMode::None, None, 0.25);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10));
+        assert!(report.ok(), "{report:?}");
+        let check = report.stability.as_ref().expect("checked");
+        assert_eq!(check.escapes.len(), 1, "{check:?}");
+        let escape = &check.escapes[0];
+        assert_eq!(escape.after_iteration, 0);
+        assert!(escape.kept && escape.energy_moved < escape.energy_saddle);
+        // Across the compressed spring the stiffness is its force over its length, -m g / r;
+        // over the mass, -g / r.
+        let upright = -gravity / (length - sag);
+        assert!((escape.least_eigenvalue - upright).abs() < 1e-6 * upright.abs(), "{}", escape.least_eigenvalue);
+        // It ends hanging below, stretched by the weight, 2 m g L lower.
+        let below = Point::new(0.0, 0.0, -(length + sag));
+        assert!((x[1] - below).norm() < 1e-6, "{}", x[1]);
+        let fall = report.energy_start - report.energy_end;
+        assert!((fall - 2.0 * mass * gravity * length).abs() < 1e-9, "{fall}");
+        assert_eq!(check.verdict, Stability::Minimum);
+        let hanging = gravity / (length + sag);
+        assert!((check.least_eigenvalue - hanging).abs() < 1e-6 * hanging, "{}", check.least_eigenvalue);
+        assert_eq!(check.checks, 2);
+    }
+
+    #[test]
+    fn a_hanging_pendulum_is_stable() {
+        let (length, mass, gravity) = PENDULUM;
+        let obj = pendulum();
+        let sag = mass * gravity / obj.k;
+        let below = Point::new(0.0, 0.0, -(length + sag));
+        let mut x = vec![Point::origin(), below];
+        let c = cons(vec![Freedom::Fixed, Freedom::Free], ContactMode::None, None, 0.25);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10));
+        assert!(report.ok(), "{report:?}");
+        assert!(report.iterations.is_empty());
+        let check = report.stability.as_ref().expect("checked");
+        assert_eq!(check.verdict, Stability::Minimum);
+        assert!(check.escapes.is_empty() && check.lanczos_converged);
+        let hanging = gravity / (length + sag);
+        assert!((check.least_eigenvalue - hanging).abs() < 1e-6 * hanging, "{}", check.least_eigenvalue);
+        assert_eq!(x[1], below);
+        // Switched off, there is no check.
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10).stability_check(false));
+        assert!(report.ok() && report.stability.is_none());
+    }
+
+    /// A node between two fixed nodes 2 a apart, on springs of rest length `rest` (no gravity).
+    fn in_line(a: f64, rest: f64) -> (SpringNet, Vec<Point>, SolverSettings) {
+        let obj = SpringNet { springs: vec![(0, 1, rest), (1, 2, rest)], k: 100.0, mass: 0.5, gravity: 0.0, nodes: 3 };
+        let x = vec![Point::new(-a, 0.0, 0.0), Point::origin(), Point::new(a, 0.0, 0.0)];
+        let settings = SolverSettings { force_scale: Some(obj.k * a), ..SolverSettings::default().tolerance(1e-10) };
+        (obj, x, settings)
+    }
+
+    #[test]
+    fn a_node_between_stretched_springs_is_stable_and_between_compressed_ones_buckles() {
+        let a = 1.0;
+        let c = cons(vec![Freedom::Fixed, Freedom::Free, Freedom::Fixed], ContactMode::None, None, 0.2);
+        // Stretched: across the line each spring stiffens by its tension over its length.
+        let (obj, mut x, settings) = in_line(a, 0.8 * a);
+        let report = solve(&obj, &mut x, &c, &settings);
+        let check = report.stability.as_ref().expect("checked");
+        assert!(report.ok() && check.is_minimum() && check.escapes.is_empty(), "{report:?}");
+        let across = 2.0 * obj.k * (a - 0.8 * a) / a / obj.mass;
+        assert!((check.least_eigenvalue - across).abs() < 1e-6 * across, "{}", check.least_eigenvalue);
+        // Compressed: the straight line is a saddle; the node buckles aside until both springs
+        // are at rest (energy 0), sqrt(rest^2 - a^2) off the line.
+        let rest = 1.25 * a;
+        let (obj, mut x, settings) = in_line(a, rest);
+        let report = solve(&obj, &mut x, &c, &settings);
+        let check = report.stability.as_ref().expect("checked");
+        assert!(report.ok() && check.is_minimum(), "{report:?}");
+        assert_eq!(check.escapes.len(), 1);
+        let across = 2.0 * obj.k * (a - rest) / a / obj.mass;
+        let found = check.escapes[0].least_eigenvalue;
+        assert!((found - across).abs() < 1e-6 * across.abs(), "{found} vs {across}");
+        assert!(report.energy_end.abs() < 1e-12, "{}", report.energy_end);
+        let off = (x[1].y.powi(2) + x[1].z.powi(2)).sqrt();
+        assert!((off - (rest * rest - a * a).sqrt()).abs() < 1e-6 && x[1].x.abs() < 1e-6, "{}", x[1]);
     }
 
     #[test]
