@@ -422,6 +422,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                         energy_moved,
                         move_spacings,
                         kept: true,
+                        abandoned: None,
                     });
                     check.time_ms += t_check.elapsed().as_secs_f64() * 1e3;
                     saddle = Some((x.to_vec(), check.clone()));
@@ -630,6 +631,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         if let Some((at_saddle, check)) = saddle {
             // The iterations from the escape did not reach equilibrium: the saddle is an
             // equilibrium at least, and the report says what it is.
+            let abandoned = (state.eval.energy, residual);
             x.copy_from_slice(&at_saddle);
             state = adopt(objective, cons, &rep, &full, &pairs, x, None, &mut red);
             residual = residual_of(&red, &state, force_scale);
@@ -638,6 +640,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             check.time_ms = time_ms;
             if let Some(e) = check.escapes.last_mut() {
                 e.kept = false;
+                e.abandoned = Some(abandoned);
             }
             stability = Some(check);
             outcome = Outcome::Converged;
@@ -1344,6 +1347,25 @@ mod tests {
         // Switched off, there is no check.
         let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10).stability_check(false));
         assert!(report.ok() && report.stability.is_none());
+    }
+
+    #[test]
+    fn a_saddle_left_without_reaching_equilibrium_is_restored_and_reported() {
+        // Two iterations are too few to swing the pendulum down from upright.
+        let (length, mass, gravity) = PENDULUM;
+        let obj = pendulum();
+        let upright = Point::new(0.0, 0.0, length - mass * gravity / obj.k);
+        let mut x = vec![Point::origin(), upright];
+        let c = cons(vec![Freedom::Fixed, Freedom::Free], ContactMode::None, None, 0.25);
+        let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10).max_iterations(2));
+        assert!(report.ok() && report.saddle(), "{report:?}");
+        assert_eq!(x[1], upright);
+        assert_eq!(report.energy_end, report.energy_start);
+        let check = report.stability.as_ref().expect("checked");
+        assert_eq!(check.escapes.len(), 1);
+        let (energy, _) = check.escapes[0].abandoned.expect("the lower state it gave up");
+        assert!(!check.escapes[0].kept && energy < report.energy_end);
+        assert!(check.describe().starts_with("UNSTABLE"), "{}", check.describe());
     }
 
     /// A node between two fixed nodes 2 a apart, on springs of rest length `rest` (no gravity).
