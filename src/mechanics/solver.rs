@@ -418,6 +418,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     check.escapes.push(Escape {
                         after_iteration: it,
                         least_eigenvalue: check.least_eigenvalue,
+                        reference_eigenvalue: check.reference_eigenvalue,
                         energy_saddle: state.eval.energy,
                         energy_moved,
                         move_spacings,

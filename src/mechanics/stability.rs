@@ -45,6 +45,8 @@ pub struct Escape {
     pub after_iteration: usize,
     /// The saddle's least eigenvalue (see [`StabilityCheck::least_eigenvalue`]), 1/s^2.
     pub least_eigenvalue: f64,
+    /// ... and relative to the check's reference (see [`StabilityCheck::reference_eigenvalue`]).
+    pub reference_eigenvalue: f64,
     /// Energy at the saddle (J).
     pub energy_saddle: f64,
     /// Energy just after the move (J).
