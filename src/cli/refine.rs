@@ -50,6 +50,10 @@ pub struct RefineArgs {
     /// (seed 000's tables restrain the nodes on them).
     #[arg(long)]
     pub stick: bool,
+    /// Move off an equilibrium the solver's stability check finds a saddle and iterate on to a
+    /// lower one (default: only report it).
+    #[arg(long)]
+    pub escape_saddles: bool,
     /// Solver iteration limit per load step.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
@@ -82,7 +86,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         pressed_surface: if a.facets { PressedSurface::Facets } else { PressedSurface::Smooth },
         gravity: Vector::from(a.gravity),
         load_steps: a.load_steps,
-        solver: SolverSettings::default().max_iterations(a.max_iterations),
+        solver: SolverSettings::default().max_iterations(a.max_iterations).escape_saddles(a.escape_saddles),
         sheet: Default::default(),
         stick: a.stick,
     };

@@ -132,6 +132,8 @@ pub struct Refinement {
     pub sheet: SheetFeatures,
     /// Free drape: nodes the tool holds up stay where they touch.
     pub stick: bool,
+    /// Move off saddles the solver's stability check finds ([`SolverSettings::escape_saddles`]).
+    pub escape_saddles: bool,
 }
 
 impl Refinement {
@@ -147,6 +149,7 @@ impl Refinement {
             max_iterations: DEFAULT_SOLVER_ITERATIONS,
             sheet: SheetFeatures::default(),
             stick: false,
+            escape_saddles: false,
         }
     }
 
@@ -155,7 +158,7 @@ impl Refinement {
         RefineSettings {
             mode: self.mode,
             load_steps: self.load_steps,
-            solver: SolverSettings::default().max_iterations(self.max_iterations),
+            solver: SolverSettings::default().max_iterations(self.max_iterations).escape_saddles(self.escape_saddles),
             sheet: self.sheet.clone(),
             stick: self.stick,
             ..RefineSettings::default()

@@ -52,6 +52,8 @@
 //! # max_iterations = 500      # solver iterations per load step (default 500)
 //! # stick = false             # free drape: nodes the tool holds up stay where they touch
 //!                             # (seed 000's tables restrain the nodes on them; default: slide)
+//! # escape_saddles = false    # move off an equilibrium the stability check finds a saddle
+//!                             # and iterate on to a lower one (default: only report it)
 //! # [[ply.reinforcement]]     # regions with multiplied properties (seed 000's bands):
 //! # edges = 0.03              #   a band this wide along the edges; or axes = W (bands along
 //! #                           #   the fibres through the origin node); or u = [u0, u1],
@@ -189,6 +191,7 @@ struct PlyFile {
     load_steps: Option<usize>,
     max_iterations: Option<usize>,
     stick: Option<bool>,
+    escape_saddles: Option<bool>,
     #[serde(default)]
     reinforcement: Vec<ReinforcementFile>,
     seam: Option<SeamFile>,
@@ -390,6 +393,7 @@ fn refinement(
             }
             (s, _) => s.unwrap_or(false),
         },
+        escape_saddles: p.escape_saddles.unwrap_or(false),
     })
 }
 
@@ -595,6 +599,7 @@ impl Scene {
                         ("load_steps", p.load_steps.is_some()),
                         ("max_iterations", p.max_iterations.is_some()),
                         ("stick", p.stick.is_some()),
+                        ("escape_saddles", p.escape_saddles.is_some()),
                         ("reinforcement", !p.reinforcement.is_empty()),
                         ("seam", p.seam.is_some()),
                         ("fold", p.fold.is_some()),
