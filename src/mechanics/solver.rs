@@ -21,6 +21,10 @@
 //!    curved valley, a straight step leaves it to second order and the fibres' stiffness
 //!    multiplies that error; the correction steps back into the valley. Only then is the shift
 //!    raised (a shorter, more cautious step).
+//! 4. At convergence, a second-order check ([`super::stability`]): the least eigenvalue of the
+//!    exact Hessian over the free directions against a positive definite reference. A saddle
+//!    (an unstable equilibrium) is reported; with [`SolverSettings::escape_saddles`] the state
+//!    is moved along its negative curvature and the iterations go on from there.
 use super::contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use super::qp::HessianBlocks;
 use super::qp::{norm, QpEngine, QpFailure, Reduction};

@@ -180,8 +180,10 @@ pub(super) fn least_mode(
     let last = max_iterations.max(1);
     // The basis Q (M-orthonormal) with M Q, H Q and D Q, and the projections T = Q^T H Q and
     // G = Q^T D Q, grown a column at a time.
-    let (mut qs, mut mqs, mut hqs, mut dqs): (Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<Vec<f64>>) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut qs: Vec<Vec<f64>> = Vec::new();
+    let mut mqs: Vec<Vec<f64>> = Vec::new();
+    let mut hqs: Vec<Vec<f64>> = Vec::new();
+    let mut dqs: Vec<Vec<f64>> = Vec::new();
     let mut t = DMatrix::zeros(last, last);
     let mut g = DMatrix::zeros(last, last);
     let mut previous = f64::NAN;
