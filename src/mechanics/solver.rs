@@ -85,6 +85,10 @@ pub struct SolverSettings {
     pub initial_shift: f64,
     /// Try a second-order correction before shortening a rejected step.
     pub second_order_correction: bool,
+    /// Stop early, with [`Outcome::Settled`], once an accepted iteration moves the nodes by at
+    /// most this share of the largest move of one iteration so far (from the second iteration
+    /// on): a probe of how far equilibrium lies, not a solve (`method = "auto"`).
+    pub settle_share: Option<f64>,
 }
 
 impl Default for SolverSettings {
@@ -95,6 +99,7 @@ impl Default for SolverSettings {
             force_scale: None,
             initial_shift: 1e-6,
             second_order_correction: true,
+            settle_share: None,
         }
     }
 }
@@ -158,6 +163,8 @@ pub enum Outcome {
     LineSearchFailed,
     /// Clarabel could not solve a subproblem.
     SubproblemFailed,
+    /// Stopped as asked once the nodes settled ([`SolverSettings::settle_share`]): a probe.
+    Settled,
 }
 
 impl Outcome {
@@ -169,6 +176,7 @@ impl Outcome {
             Outcome::IterationLimit => "iteration limit reached before the forces balanced",
             Outcome::LineSearchFailed => "no step lowered the energy, however short",
             Outcome::SubproblemFailed => "a quadratic subproblem could not be solved",
+            Outcome::Settled => "stopped once the nodes settled (a probe, not an equilibrium)",
         }
     }
 }
@@ -337,6 +345,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     // The reach of a step (spacings) and whether the last step needed the convex model.
     let mut reach = MAX_STEP_SPACINGS;
     let mut prefer_convex = false;
+    // The largest move of one iteration so far, spacings (for `settle_share`).
+    let mut largest_step = 0.0f64;
     for it in 0..settings.max_iterations {
         if residual <= settings.tolerance || red.is_empty() {
             outcome = Outcome::Converged;
@@ -529,6 +539,13 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         if residual <= settings.tolerance {
             outcome = Outcome::Converged;
             break;
+        }
+        if let (Some(share), true) = (settings.settle_share, accepted_flag) {
+            largest_step = largest_step.max(step);
+            if it > 0 && step <= share * largest_step {
+                outcome = Outcome::Settled;
+                break;
+            }
         }
         if !accepted_flag {
             outcome = match &failure {
