@@ -106,7 +106,7 @@ pub struct ChoiceIndicators {
     /// on the facets and the step from that net was above the model's share of the tolerance.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub smooth_equilibrium_step_deg: Option<f64>,
-    /// |F - P| / |P| of the mechanical model after that step.
+    /// |F - P| / |P| of the mechanical model where that probe stopped.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual_after_step: Option<f64>,
     /// Iterations of the mechanical model that step took (it goes on until the energy settles,
