@@ -75,7 +75,7 @@ fn auto_keeps_the_kinematic_net_on_a_developable_tool() {
     let run = drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
     let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
     assert!(stdout.contains("auto: kinematic"), "{stdout}");
-    assert!(stdout.contains("auto: ply 'p0' ran kinematic: one step towards mechanical equilibrium"), "{stdout}");
+    assert!(stdout.contains("auto: ply 'p0' ran kinematic: 2 steps towards mechanical equilibrium change"), "{stdout}");
     let table = read_json(&out.join("layup.json"));
     let row = &table["plies"][0];
     assert_eq!(row["method"], "kinematic");
@@ -164,7 +164,9 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
     let choice = &row["method_choice"];
     assert_eq!(choice["chosen"], "mechanical");
     assert!(choice["indicators"]["equilibrium_step_deg"].as_f64().unwrap() > 0.005, "{choice}");
-    assert!(choice["reason"].as_str().unwrap().starts_with("one step towards mechanical equilibrium changes"));
+    let reason = choice["reason"].as_str().unwrap();
+    let steps = choice["indicators"]["probe_iterations"].as_u64().unwrap();
+    assert!(reason.starts_with(&format!("{steps} steps towards mechanical equilibrium change the shear")), "{reason}");
     assert_eq!(choice["spacing_m"], 0.004);
     let net = read_json(&out.join("p0.drape.json"));
     assert_eq!(net["method"], "mechanical");
@@ -194,7 +196,7 @@ fn the_kinematic_net_auto_keeps_is_within_the_tolerance_of_mechanics() {
     assert!(choice.reason.contains("past the 30 deg locking angle"), "the locked share is named: {}", choice.reason);
     let difference = largest_shear_difference(&nets[0], &nets[1]);
     assert!(difference <= choice.tolerance_deg, "{difference} deg from the pressed drape");
-    // The one-step indicator did not understate the change by more than its safety margin.
+    // The probe did not understate the change by more than its safety margin.
     assert!(difference <= 2.0 * choice.indicators.equilibrium_step_deg.unwrap() + 0.05, "{difference}");
 }
 
@@ -224,7 +226,11 @@ fn the_study_reports_the_error_auto_keeps_and_the_cost_it_saves() {
         .find(|p| p.method == "kinematic-geodesic" && p.surface == "facets" && p.spacing == 0.004)
         .unwrap();
     assert!((at.error_max_deg.unwrap() - kinematic.error_max_deg.unwrap()).abs() < 1e-9);
-    assert!(at.cost_ratio.unwrap() < 1.0, "auto cost {:?} of mechanics", at.cost_ratio);
+    // Its cost is reported against mechanics at the same spacing (the figures themselves are
+    // the study's to measure, not a test's: see docs/ARCHITECTURE.md).
+    let (t, m) = (at.time_s, at.mechanical_time_s.unwrap());
+    assert!(t > 0.0 && m > 0.0, "{t} s, {m} s");
+    assert!((at.cost_ratio.unwrap() - t / m).abs() < 1e-12, "{:?}", at.cost_ratio);
     assert!(stdout.contains("auto at d = 0.00400 m ran kinematic"), "{stdout}");
 }
 
@@ -273,7 +279,10 @@ fn the_bundled_plate_scene_runs_auto_and_keeps_the_kinematic_net() {
     let out = dir.path().join("run");
     let run = drape().arg("run").arg(repo("geometries/plate/scene.toml")).arg("--out").arg(&out).assert().success();
     let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
-    assert!(stdout.contains("auto: ply 'p0' ran kinematic: one step towards mechanical equilibrium"), "{stdout}");
+    assert!(
+        stdout.contains("auto: ply 'p0' ran kinematic: the kinematic net is in mechanical equilibrium already"),
+        "{stdout}"
+    );
     let row = &read_json(&out.join("layup.json"))["plies"][0];
     assert_eq!(row["method"], "kinematic");
     assert!(row["max_abs_shear_deg"].as_f64().unwrap() < 1e-6, "{row}");
@@ -358,9 +367,12 @@ fn the_study_says_why_auto_does_not_apply_to_a_free_drape() {
 }
 
 /// Where auto misses (recorded in docs/ARCHITECTURE.md): on the bundled cone the pressed drape
-/// slides the ply down the slant under gravity, shearing it by up to 0.78 deg (15 iterations),
-/// while one step of the model moves it by 0.03 deg. At a 0.5 deg tolerance auto keeps the
-/// kinematic net; the study says it is outside the tolerance and claims no saving for it.
+/// slides the ply down the slant under gravity and turns it about its seed, one way or the other
+/// (the scene is symmetric; the 3 mm and 1.5 mm drapes turn opposite ways), shearing it by up to
+/// 0.5-0.8 deg. Auto's probe sees the slide (some seven iterations, about 0.9 deg) and runs
+/// mechanics at the ply's 3 mm; at a 0.1 deg tolerance that is outside the reference at 1.5 mm
+/// on either branch (about 1.2 deg turned the same way, 0.25 deg mirrored), and the study says
+/// so and claims no saving for it.
 #[test]
 fn the_study_says_so_where_auto_is_outside_its_tolerance() {
     let dir = tempfile::tempdir().unwrap();
@@ -368,20 +380,64 @@ fn the_study_says_so_where_auto_is_outside_its_tolerance() {
     let scene = scene
         .replace("tool = \"cone.obj\"", &format!("tool = {:?}", repo("geometries/cone/cone.obj")))
         .replace("../../materials/carbon-twill.toml", &repo("materials/carbon-twill.toml").display().to_string())
-        .replace("\nmethod = \"auto\"", "\ntolerance_deg = 0.5\nmethod = \"auto\"");
-    assert!(scene.contains("tolerance_deg = 0.5"));
+        .replace("\nmethod = \"auto\"", "\ntolerance_deg = 0.1\nmethod = \"auto\"");
+    assert!(scene.contains("tolerance_deg = 0.1"));
     let path = dir.path().join("cone.toml");
     std::fs::write(&path, scene).unwrap();
     let out = dir.path().join("study");
     let (stdout, sa) = study(&path, &out, "0.003", "0.003,0.0015");
     assert_eq!(sa.reference.spacing, 0.0015);
     let a = sa.auto.iter().find(|a| a.spacing == 0.003).unwrap();
-    assert_eq!(a.chosen, "kinematic", "{}", a.reason);
-    assert_eq!(a.tolerance_deg, 0.5);
+    assert_eq!(a.chosen, "mechanical", "{}", a.reason);
+    assert!(a.reason.contains("steps towards mechanical equilibrium change the shear by up to"), "{}", a.reason);
+    assert_eq!(a.tolerance_deg, 0.1);
     let e = a.error_max_deg.unwrap();
-    assert!((0.7..0.85).contains(&e), "{e} deg from the pressed drape");
+    assert!((0.15..1.4).contains(&e), "{e} deg from the pressed drape");
     assert_eq!(a.within_tolerance, Some(false));
     assert!(stdout.contains("(OUTSIDE)"), "{stdout}");
     assert!(stdout.contains("auto is not within it here, so it saves nothing against that"), "{stdout}");
-    assert!(!stdout.contains("auto costs"), "no saving claimed for a result outside the tolerance: {stdout}");
+    // No saving claimed for the result outside the tolerance (auto at 1.5 mm is the reference
+    // itself, within, and has its cost stated).
+    let at_3mm = stdout.split("auto at d = ").find(|block| block.starts_with("0.00300 m")).unwrap();
+    assert!(!at_3mm.contains("auto costs"), "no saving claimed for a result outside the tolerance: {stdout}");
+}
+
+/// The bundled cone asks for auto. Its kinematic net is symmetric and unsheared, but under
+/// gravity the pressed ply slides down the slant and turns about its seed, which takes the full
+/// solve 15 iterations and changes the shear by 0.5-0.8 deg; one step of the model shows 0.03 deg
+/// of it. The probe goes on until the nodes settle, so it sees the slide, auto runs mechanics,
+/// and mechanics goes on from where the probe stopped (its start lies below the kinematic net's
+/// energy) to equilibrium.
+#[test]
+fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    drape().arg("run").arg(repo("geometries/cone/scene.toml")).arg("--out").arg(&out).assert().success();
+    let row = &read_json(&out.join("layup.json"))["plies"][0];
+    assert_eq!(row["method"], "mechanical");
+    assert_eq!(row["converged"], true);
+    let choice = &row["method_choice"];
+    let ind = &choice["indicators"];
+    let steps = ind["probe_iterations"].as_u64().unwrap();
+    assert!((4..=drape::layup::auto::PROBE_MAX_ITERATIONS as u64).contains(&steps), "{ind}");
+    let probe = ind["equilibrium_step_deg"].as_f64().unwrap();
+    assert!((0.5..1.2).contains(&probe), "{ind}");
+    let net = read_json(&out.join("p0.drape.json"));
+    let solver = &net["meta"]["solver"];
+    assert_eq!(solver["converged"], true);
+    let (kinematic, start, end) = (
+        solver["energy_kinematic"].as_f64().unwrap(),
+        solver["energy_start"].as_f64().unwrap(),
+        solver["energy_final"].as_f64().unwrap(),
+    );
+    assert!(end <= start && start < kinematic, "{kinematic} -> {start} -> {end}");
+    // What the probe saw is what mechanics did: the refined net's largest change of cell shear
+    // from the kinematic net agrees with the probe's to a tenth of the model's budget.
+    let change = net["meta"]["change_from_kinematic"]["shear_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|v| v.as_f64())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!((change - probe).abs() < 0.05, "mechanics changed the shear by {change} deg, the probe saw {probe} deg");
 }

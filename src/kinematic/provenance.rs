@@ -97,18 +97,22 @@ pub struct ChoiceIndicators {
     /// The spacing that error estimate asks for to stay within its share of the tolerance, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing_needed_m: Option<f64>,
-    /// Largest cell-shear change of one step of the mechanical model from the kinematic net,
-    /// degrees: the kinematic net's out-of-balance forces under the ply's card, turned into
-    /// shear by the model's stiffness (absent when the step could not be taken).
+    /// Largest cell-shear change of the steps of the mechanical model from the kinematic net
+    /// until its energy settles, degrees: how far the kinematic net lies from equilibrium under
+    /// the ply's card (absent when no step could be taken).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub equilibrium_step_deg: Option<f64>,
     /// The same step from the kinematic net on the smooth surface, degrees, when the ply lies
     /// on the facets and the step from that net was above the model's share of the tolerance.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub smooth_equilibrium_step_deg: Option<f64>,
-    /// |F - P| / |P| of the mechanical model after that step.
+    /// |F - P| / |P| of the mechanical model where that probe stopped.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual_after_step: Option<f64>,
+    /// Iterations of the mechanical model that step took (it goes on until the energy settles,
+    /// see `layup::auto`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe_iterations: Option<usize>,
     /// Share of the draped area sheared at or past the locking angle.
     pub locking_share: f64,
     /// Time spent measuring these, ms.

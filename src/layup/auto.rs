@@ -2,10 +2,11 @@
 //!
 //! The kinematic net is drawn first, as always. Three cheap measurements on it decide whether it
 //! is the answer or mechanics must run, and at what spacing:
-//! - **the model**: one step of the mechanical model (the ply's card, pressed) from the
-//!   kinematic net. The net's out-of-balance forces divided by the model's stiffness are how far
-//!   equilibrium lies, and that step's largest cell-shear change says it in degrees. Above the
-//!   model's share of the tolerance ([`SPACING_SHARE`]), mechanics runs;
+//! - **the model**: steps of the mechanical model (the ply's card, pressed) from the kinematic
+//!   net until the nodes settle ([`PROBE_SETTLED_SHARE`]; two on a net near equilibrium, seven
+//!   on the cone, where gravity slides the ply down the slant). Their largest cell-shear change
+//!   says in degrees how far equilibrium lies. Above the model's share of the tolerance
+//!   ([`SPACING_SHARE`]), mechanics runs, going on from where the probe stopped;
 //!   When the ply lies on the facets and that step is too large, the kinematic net on the smooth
 //!   surface (the one pressed contact slides on) is weighed the same way, and kept if within:
 //!   on a coarse tool most of the difference is the facets', not the model's;
@@ -27,7 +28,7 @@
 //! and in `layup.json`, and shown in the layup table and the report.
 use super::{AutoModel, Refinement};
 use crate::geometry::smooth::SmoothSurface;
-use crate::geometry::ToolSurface;
+use crate::geometry::{Point, ToolSurface};
 use crate::kinematic::fabric_field::ShearField;
 use crate::kinematic::fishnet::{drape_on, drape_smooth, DrapeError};
 use crate::kinematic::{ChoiceIndicators, DrapeNet, KinematicSettings, MethodChoice, SurfaceKind};
@@ -57,6 +58,9 @@ pub struct AutoDrape {
     pub net: DrapeNet,
     /// What was chosen and why.
     pub choice: MethodChoice,
+    /// Where mechanics, when chosen, starts: the positions (one per node of `net`) at which the
+    /// probe towards equilibrium stopped, so that its iterations are not done again.
+    pub start: Option<Vec<Point>>,
 }
 
 impl AutoDrape {
@@ -131,8 +135,12 @@ pub fn drape_auto(
 ) -> Result<AutoResult, AutoError> {
     let surfaces = Surfaces::new(surface);
     let a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
-    let refined =
-        if a.mechanical() { Some(refinement.run(&a.net, surface, surfaces.for_refinement(refinement))?) } else { None };
+    let refined = if a.mechanical() {
+        let start = a.start.as_deref().unwrap_or(&a.net.positions);
+        Some(refinement.run_from(&a.net, start, surface, surfaces.for_refinement(refinement))?)
+    } else {
+        None
+    };
     Ok(AutoResult { kinematic: a.net, refined, choice: a.choice })
 }
 
@@ -153,51 +161,63 @@ pub fn choose(
     let d = settings.spacing;
     let stats = own.shear_stats(locking_angle);
     let locking_share = if stats.area > 0.0 { stats.area_over_locking / stats.area } else { 0.0 };
-    let step = equilibrium_step(surfaces, &own, refinement);
+    let step = equilibrium_probe(surfaces, &own, refinement);
     // Pressed mechanics slides on the smooth surface over the facets: on a coarse tool most of
     // the step from a net on the facets is the facets' own error, which the kinematic net on
     // the smooth surface does not have (double dome, d = 5 mm: 2.4 deg from the pressed drape
     // on the facets, 0.03 deg on the smooth surface). That net is the next model up.
     let mut smooth = None;
-    if settings.surface == SurfaceKind::Facets && matches!(step, Ok((deg, _)) if deg > model_budget) {
+    if settings.surface == SurfaceKind::Facets && matches!(&step, Ok(p) if p.change_deg > model_budget) {
         let s = KinematicSettings { surface: SurfaceKind::Smooth, ..settings.clone() };
         if let Ok(net) = surfaces.drape(&s) {
-            if let Ok(smooth_step) = equilibrium_step(surfaces, &net, refinement) {
+            if let Ok(smooth_step) = equilibrium_probe(surfaces, &net, refinement) {
                 smooth = Some((net, s, smooth_step));
             }
         }
     }
     let mut indicators = ChoiceIndicators {
         spacing_m: d,
-        equilibrium_step_deg: step.as_ref().ok().map(|s| s.0),
-        residual_after_step: step.as_ref().ok().map(|s| s.1),
-        smooth_equilibrium_step_deg: smooth.as_ref().map(|s| s.2 .0),
+        equilibrium_step_deg: step.as_ref().ok().map(|p| p.change_deg),
+        residual_after_step: step.as_ref().ok().map(|p| p.residual),
+        probe_iterations: step.as_ref().ok().map(|p| p.iterations),
+        smooth_equilibrium_step_deg: smooth.as_ref().map(|s| s.2.change_deg),
         locking_share,
         ..ChoiceIndicators::default()
     };
     let locking_deg = locking_angle.to_degrees();
-    let smooth_within = smooth.as_ref().is_some_and(|s| s.2 .0 <= model_budget);
+    let smooth_within = smooth.as_ref().is_some_and(|s| s.2.change_deg <= model_budget);
+    let steps = |p: &Probe| match p.iterations {
+        0 => "the kinematic net is in mechanical equilibrium already (no step taken); the model changes".to_string(),
+        1 => "one step towards mechanical equilibrium changes".to_string(),
+        n => format!("{n} steps towards mechanical equilibrium change"),
+    };
     let (mechanical, mut reason) = match &step {
-        Ok((deg, _)) if *deg > model_budget && smooth_within => (
+        Ok(p) if p.change_deg > model_budget && smooth_within => (
             false,
             format!(
-                "one step towards mechanical equilibrium changes the shear of the net on the facets by up to {deg:.2} deg, but of the net on the smooth surface by at most {:.3} deg (the model's share of the {tolerance} deg tolerance is {model_budget:.2} deg): the kinematic net on the smooth surface is kept",
+                "{} the shear of the net on the facets by up to {:.2} deg, but of the net on the smooth surface by at most {:.3} deg (the model's share of the {tolerance} deg tolerance is {model_budget:.2} deg): the kinematic net on the smooth surface is kept",
+                steps(p),
+                p.change_deg,
                 indicators.smooth_equilibrium_step_deg.unwrap_or_default()
             ),
         ),
-        Ok((deg, _)) if *deg > model_budget => (
+        Ok(p) if p.change_deg > model_budget => (
             true,
             format!(
-                "one step towards mechanical equilibrium changes the shear by up to {deg:.2} deg{}, more than the model's {model_budget:.2} deg of the {tolerance} deg tolerance",
+                "{} the shear by up to {:.2} deg{}, more than the model's {model_budget:.2} deg of the {tolerance} deg tolerance",
+                steps(p),
+                p.change_deg,
                 indicators
                     .smooth_equilibrium_step_deg
                     .map_or(String::new(), |s| format!(" ({s:.2} deg from the net on the smooth surface)"))
             ),
         ),
-        Ok((deg, _)) => (
+        Ok(p) => (
             false,
             format!(
-                "one step towards mechanical equilibrium changes the shear by at most {deg:.3} deg (the model's share of the {tolerance} deg tolerance is {model_budget:.2} deg): the kinematic net is kept"
+                "{} the shear by at most {:.3} deg (the model's share of the {tolerance} deg tolerance is {model_budget:.2} deg): the kinematic net is kept",
+                steps(p),
+                p.change_deg
             ),
         ),
         Err(why) => (false, format!("the mechanical model could not take a step from the kinematic net ({why}): the kinematic net is kept")),
@@ -264,7 +284,10 @@ pub fn choose(
         reason,
         indicators,
     };
-    Ok(AutoDrape { net, choice })
+    // Mechanics goes on from where the probe of `net` (the ply's own net: a mechanical choice
+    // never keeps the smooth one or drapes anew) stopped.
+    let start = if mechanical { step.ok().map(|p| p.state) } else { None };
+    Ok(AutoDrape { net, choice, start })
 }
 
 /// Richardson's estimate of the largest cell-shear error of `net` (drawn with `settings`) from
@@ -280,15 +303,51 @@ fn discretisation_error(surfaces: &Surfaces, settings: &KinematicSettings, net: 
     Some(largest / (2f64.powf(FISHNET_ORDER) - 1.0))
 }
 
-/// One step of the mechanical model from `net`: the largest cell-shear change, degrees, and
-/// |F - P| / |P| after it; or why no step could be taken.
-fn equilibrium_step(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Result<(f64, f64), String> {
+/// Most iterations the probe takes before it calls the nodes settled.
+pub const PROBE_MAX_ITERATIONS: usize = 20;
+/// The probe stops once an iteration moves the nodes by at most this share of the largest move
+/// of one iteration so far: the rest of the way is short. (Not the energy: the first iteration
+/// relaxes the facets' strain and bending, a fall hundreds of times that of a slow slide.)
+pub const PROBE_SETTLED_SHARE: f64 = 0.1;
+
+/// What the probe towards mechanical equilibrium found.
+struct Probe {
+    /// Largest cell-shear change from the kinematic net, degrees.
+    change_deg: f64,
+    /// |F - P| / |P| at the end.
+    residual: f64,
+    /// Iterations taken.
+    iterations: usize,
+    /// The positions where it stopped, one per node of the net it started from.
+    state: Vec<Point>,
+}
+
+/// Steps of the mechanical model from `net` until the nodes settle (an iteration moves them by
+/// at most [`PROBE_SETTLED_SHARE`] of the largest move so far), it converges, or
+/// [`PROBE_MAX_ITERATIONS`] pass. One step is not enough where the way to equilibrium is long:
+/// on the cone, gravity slides the ply down the slant over some ten iterations, and the first
+/// moves the shear by 0.03 of the 0.78 deg it changes in all. Where the kinematic net lies near
+/// equilibrium (the hemisphere) the second iteration moves the nodes by 1/50 of the first and
+/// the probe ends there.
+fn equilibrium_probe(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Result<Probe, String> {
     let mut settings = r.settings();
     settings.load_steps = 1;
-    settings.solver = SolverSettings { max_iterations: 1, ..settings.solver };
+    settings.solver = SolverSettings {
+        max_iterations: PROBE_MAX_ITERATIONS,
+        settle_share: Some(PROBE_SETTLED_SHARE),
+        // The solve that goes on from the probe's state checks its stability.
+        stability_check: false,
+        ..settings.solver
+    };
     let refined =
         refine_on(net, surfaces.tool, surfaces.for_refinement(r), &r.material, &settings).map_err(|e| e.to_string())?;
-    let change =
+    let report = refined.steps.last().ok_or("the mechanical model took no load step")?;
+    let change_deg =
         cell_changes(net, &refined.net).into_iter().flatten().map(|(g, _)| g.abs().to_degrees()).fold(0.0, f64::max);
-    Ok((change, refined.steps.last().map_or(0.0, |s| s.residual)))
+    Ok(Probe {
+        change_deg,
+        residual: report.residual,
+        iterations: report.iterations.len(),
+        state: refined.net.positions,
+    })
 }

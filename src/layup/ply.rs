@@ -2,10 +2,10 @@
 //! whether it is refined mechanically. A scene file ([`crate::pipeline::scene`]) is one way to
 //! make them.
 use crate::geometry::smooth::SmoothSurface;
-use crate::geometry::{ToolSurface, Vector};
+use crate::geometry::{Point, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, KinematicSettings};
 use crate::material::MaterialCard;
-use crate::mechanics::refine::{annotate, refine_on, RefineError, RefineSettings, Refined};
+use crate::mechanics::refine::{annotate, refine_from, RefineError, RefineSettings, Refined};
 use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::{ContactMode, SolverSettings};
 use std::path::PathBuf;
@@ -174,8 +174,20 @@ impl Refinement {
         surface: &ToolSurface,
         smooth: Option<&SmoothSurface>,
     ) -> Result<(DrapeNet, Refined), RefineError> {
+        self.run_from(net, &net.positions, surface, smooth)
+    }
+
+    /// [`Refinement::run`] with the solver starting from `start` (a position per node of `net`,
+    /// e.g. where a probe towards equilibrium stopped); `net` stays the kinematic reference.
+    pub fn run_from(
+        &self,
+        net: &DrapeNet,
+        start: &[Point],
+        surface: &ToolSurface,
+        smooth: Option<&SmoothSurface>,
+    ) -> Result<(DrapeNet, Refined), RefineError> {
         let t = Instant::now();
-        let result = refine_on(net, surface, smooth, &self.material, &self.settings())?;
+        let result = refine_from(net, start, surface, smooth, &self.material, &self.settings())?;
         let mut out = result.net.clone();
         annotate(&mut out, net, &result, &self.material_path);
         out.timing.load_ms = net.timing.load_ms;

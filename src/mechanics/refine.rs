@@ -233,6 +233,21 @@ pub fn refine_on<L: Laws + ?Sized>(
     laws: &L,
     settings: &RefineSettings,
 ) -> Result<Refined, RefineError> {
+    refine_from(kinematic, &kinematic.positions, tool, smooth, laws, settings)
+}
+
+/// [`refine_on`] with the solver starting from `start` (one position per node of `kinematic`,
+/// e.g. a state part of the way to equilibrium) instead of the kinematic net's positions; the
+/// kinematic net stays the reference (`energy_kinematic`, the grid and its statuses).
+pub fn refine_from<L: Laws + ?Sized>(
+    kinematic: &DrapeNet,
+    start: &[Point],
+    tool: &ToolSurface,
+    smooth: Option<&SmoothSurface>,
+    laws: &L,
+    settings: &RefineSettings,
+) -> Result<Refined, RefineError> {
+    assert_eq!(start.len(), kinematic.positions.len(), "one start position per node");
     if settings.load_steps == 0 {
         return Err(RefineError::LoadSteps);
     }
@@ -257,7 +272,7 @@ pub fn refine_on<L: Laws + ?Sized>(
         Some(s) => s,
         None => tool,
     };
-    let mut x = kinematic.positions.clone();
+    let mut x = start.to_vec();
     if let (Some(smooth), ContactMode::Pressed) = (smooth, settings.mode) {
         use rayon::prelude::*;
         x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);

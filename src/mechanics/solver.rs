@@ -98,6 +98,10 @@ pub struct SolverSettings {
     /// far slide fabric past the tool's open edges onto the smooth surface's continuation (see
     /// docs/ARCHITECTURE.md, "picks a stable equilibrium"), at tens of times the solve's time.
     pub escape_saddles: bool,
+    /// Stop early, with [`Outcome::Settled`], once an accepted iteration moves the nodes by at
+    /// most this share of the largest move of one iteration so far (from the second iteration
+    /// on): a probe of how far equilibrium lies, not a solve (`method = "auto"`).
+    pub settle_share: Option<f64>,
 }
 
 impl Default for SolverSettings {
@@ -110,6 +114,7 @@ impl Default for SolverSettings {
             second_order_correction: true,
             stability_check: true,
             escape_saddles: false,
+            settle_share: None,
         }
     }
 }
@@ -183,6 +188,8 @@ pub enum Outcome {
     LineSearchFailed,
     /// Clarabel could not solve a subproblem.
     SubproblemFailed,
+    /// Stopped as asked once the nodes settled ([`SolverSettings::settle_share`]): a probe.
+    Settled,
 }
 
 impl Outcome {
@@ -194,6 +201,7 @@ impl Outcome {
             Outcome::IterationLimit => "iteration limit reached before the forces balanced",
             Outcome::LineSearchFailed => "no step lowered the energy, however short",
             Outcome::SubproblemFailed => "a quadratic subproblem could not be solved",
+            Outcome::Settled => "stopped once the nodes settled (a probe, not an equilibrium)",
         }
     }
 }
@@ -397,6 +405,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let mut saddle: Option<(Vec<Point>, StabilityCheck)> = None;
     let mut it = 0;
     loop {
+        // The largest move of one iteration so far, spacings (for `settle_share`).
+        let mut largest_step = 0.0f64;
         if residual <= settings.tolerance || red.is_empty() {
             if settings.stability_check && !red.is_empty() {
                 let t_check = std::time::Instant::now();
@@ -637,6 +647,13 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         if residual <= settings.tolerance {
             // Converged: checked at the top of the loop.
             continue;
+        }
+        if let (Some(share), true) = (settings.settle_share, accepted_flag) {
+            largest_step = largest_step.max(step);
+            if it > 1 && step <= share * largest_step {
+                outcome = Outcome::Settled;
+                break;
+            }
         }
         if !accepted_flag {
             outcome = match &failure {
