@@ -328,16 +328,7 @@ impl Reduction {
 
     /// |P y + q| for the upper-triangular `values`.
     pub fn model_residual(&self, values: &[f64], y: &[f64], q: &[f64]) -> f64 {
-        let mut r = q.to_vec();
-        for c in 0..self.n {
-            let entries = self.colptr[c]..self.colptr[c + 1];
-            for (&row, &value) in self.rowval[entries.clone()].iter().zip(&values[entries]) {
-                r[row] += value * y[c];
-                if row != c {
-                    r[c] += value * y[row];
-                }
-            }
-        }
+        let r: Vec<f64> = self.mul(values, y).iter().zip(q).map(|(py, q)| py + q).collect();
         norm(&r)
     }
 
@@ -491,6 +482,11 @@ impl QpEngine {
         red.clear_pinned(&mut y);
         Ok(y)
     }
+}
+
+/// The dot product of two reduced vectors.
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// The Euclidean norm of a reduced vector.

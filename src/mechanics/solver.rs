@@ -27,7 +27,7 @@
 //!    is moved along its negative curvature and the iterations go on from there.
 use super::contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use super::qp::HessianBlocks;
-use super::qp::{norm, QpEngine, QpFailure, Reduction};
+use super::qp::{dot, norm, QpEngine, QpFailure, Reduction};
 use super::stability::{least_mode, spread, Escape, LeastMode, Stability, StabilityCheck, LANCZOS_ITERATIONS};
 use crate::geometry::{Point, Vector};
 use rayon::prelude::*;
@@ -1109,10 +1109,6 @@ fn unbalanced_nodes(objective: &dyn Objective, x: &[Point], red: &Reduction, s: 
             UnbalancedNode { node, force, dominant_term }
         })
         .collect()
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]

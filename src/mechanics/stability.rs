@@ -10,7 +10,7 @@
 //! factorised once and applied with the solver's own engine (triangular solves on its
 //! factorisation). By Sylvester's law of inertia, the pencil has as many negative eigenvalues as
 //! H, so the sign of its least one tells a saddle from a minimum.
-use super::qp::{QpEngine, QpFailure, Reduction};
+use super::qp::{dot, QpEngine, QpFailure, Reduction};
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
 
@@ -264,10 +264,6 @@ pub(super) fn spread(i: usize) -> f64 {
     // sine so neighbouring indices are not correlated.
     let t = ((i as f64 + 1.0) * 0.618_033_988_749_895).fract();
     (((t * 12.9898).sin() * 43_758.545_3).fract()) * 2.0 - 1.0
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]
