@@ -495,12 +495,13 @@ pub(super) fn norm(v: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};
 
-    /// Two free nodes coupled by a fixed symmetric positive definite 6 x 6 matrix.
-    struct Dense(DMatrix<f64>);
+    /// Nodes coupled by a fixed symmetric matrix, 3 rows and columns a node (the stability
+    /// check's tests use it too).
+    pub(in crate::mechanics) struct Dense(pub DMatrix<f64>);
     impl HessianBlocks for Dense {
         fn block(&self, a: usize, b: usize) -> Matrix3<f64> {
             Matrix3::from_fn(|i, j| self.0[(3 * a + i, 3 * b + j)])

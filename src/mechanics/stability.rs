@@ -270,16 +270,7 @@ pub(super) fn spread(i: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::mechanics::contact::NodeBasis;
-    use crate::mechanics::qp::HessianBlocks;
-    use nalgebra::Matrix3;
-
-    /// Two free nodes with a fixed symmetric 6 x 6 matrix.
-    struct Dense(DMatrix<f64>);
-    impl HessianBlocks for Dense {
-        fn block(&self, a: usize, b: usize) -> Matrix3<f64> {
-            Matrix3::from_fn(|i, j| self.0[(3 * a + i, 3 * b + j)])
-        }
-    }
+    use crate::mechanics::qp::tests::Dense;
 
     #[test]
     fn lanczos_finds_the_least_eigenvalue_of_the_pencil() {
