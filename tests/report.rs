@@ -608,6 +608,11 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
     }
     let layup = drape::report::read_layup(&out).unwrap().unwrap();
     assert!(layup.files.contains(&"p0.kinematic.json".to_string()), "{:?}", layup.files);
+    // The pressed p0 converges to a shallow saddle of the energy (the stability check's pencil
+    // eigenvalue about -0.07; docs/ARCHITECTURE.md): said in the row, the net and the report.
+    assert_eq!(layup.plies[0].stability.as_deref(), Some("saddle"), "{:?}", layup.plies[0]);
+    assert_eq!(refined.meta.solver.as_ref().unwrap().stability.as_deref(), Some("saddle"));
+    assert!(layup.plies[1..].iter().all(|p| p.stability.is_none()), "kinematic plies are not checked");
     // The export record: the mesh, its size, the formats and each ply's covered elements, as
     // flow.csv (one row an element and ply) has them.
     let e = layup.export.as_ref().expect("the scene exports onto a flow mesh");
@@ -638,6 +643,8 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
     check_picture(&report.join("p0-kinematic.png"));
     let html = std::fs::read_to_string(report.join("index.html")).unwrap();
     assert_eq!(html.matches("<section class=\"compare\"").count(), 1, "only the mechanical ply");
+    assert_eq!(html.matches("(unstable: a saddle)").count(), 1, "the layup table marks p0");
+    assert!(html.contains("UNSTABLE: a saddle"), "the ply's facts say it");
     let compare = html.split("id=\"compare-p0\">").nth(1).unwrap();
     let compare = &compare[..compare.find("</section>").unwrap()];
     assert_eq!(compare.matches("<img ").count(), 2, "kinematic and mechanical side by side: {compare}");

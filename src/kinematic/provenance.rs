@@ -98,7 +98,7 @@ pub struct ChoiceIndicators {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing_needed_m: Option<f64>,
     /// Largest cell-shear change of the steps of the mechanical model from the kinematic net
-    /// until its energy settles, degrees: how far the kinematic net lies from equilibrium under
+    /// until the nodes settle, degrees: how far the kinematic net lies from equilibrium under
     /// the ply's card (absent when no step could be taken).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub equilibrium_step_deg: Option<f64>,
@@ -109,7 +109,7 @@ pub struct ChoiceIndicators {
     /// |F - P| / |P| of the mechanical model where that probe stopped.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual_after_step: Option<f64>,
-    /// Iterations of the mechanical model that step took (it goes on until the energy settles,
+    /// Iterations of the mechanical model that probe took (it goes on until the nodes settle,
     /// see `layup::auto`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub probe_iterations: Option<usize>,

@@ -106,6 +106,10 @@ pub struct LayupRow {
     /// balance.
     #[serde(default)]
     pub solver_failure: Option<String>,
+    /// For a mechanical ply that converged: the second-order check of its state, `minimum` or
+    /// `saddle` (an equilibrium the energy falls away from: an unstable one), or `unresolved`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stability: Option<String>,
     /// Thickness as laid flat, m.
     #[serde(default)]
     pub thickness_m: Option<f64>,
@@ -236,6 +240,7 @@ impl LayupRow {
             method_choice: result.choice.clone(),
             converged: result.refined.as_ref().map(|r| r.ok()),
             solver_failure: result.refined.as_ref().filter(|r| !r.ok()).map(|r| r.describe_failure()),
+            stability: result.refined.as_ref().and_then(|r| r.stability_verdict()),
             thickness_m: ply.thickness,
             locking_angle_deg: Some(ply.locking_angle.to_degrees()),
             locking_angle_source: Some(ply.locking_source),

@@ -160,6 +160,13 @@ pub struct Refined {
 }
 
 impl Refined {
+    /// The stability check's verdict on the final state (`minimum`, `saddle`, `unresolved`),
+    /// when it ran (the last load step converged and the check was on).
+    pub fn stability_verdict(&self) -> Option<String> {
+        let check = self.steps.last()?.stability.as_ref()?;
+        serde_json::to_value(check.verdict).ok()?.as_str().map(str::to_string)
+    }
+
     /// Whether every load step reached equilibrium.
     pub fn ok(&self) -> bool {
         self.steps.iter().all(SolveReport::ok)
@@ -488,10 +495,7 @@ pub fn annotate(out: &mut DrapeNet, kinematic: &DrapeNet, refined: &Refined, mat
         energy_kinematic: refined.energy_kinematic,
         energy_start: refined.energy_start,
         energy_final: refined.energy_final,
-        stability: last
-            .and_then(|s| s.stability.as_ref())
-            .and_then(|c| serde_json::to_value(c.verdict).ok())
-            .and_then(|v| v.as_str().map(str::to_string)),
+        stability: refined.stability_verdict(),
         load_steps: serde_json::to_value(&refined.steps).unwrap_or_default(),
     });
 }

@@ -54,6 +54,15 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
             let why = s.reason.clone().unwrap_or_else(|| s.outcome.clone());
             f.push(("NOT CONVERGED".to_string(), format!("the last accepted state, not an equilibrium: {why}")));
         }
+        match s.stability.as_deref() {
+            Some("saddle") => f.push((
+                "stability".to_string(),
+                "UNSTABLE: a saddle, an equilibrium the energy falls away from along some direction (the second-order check at convergence; the figures are in the net's meta.solver)".to_string(),
+            )),
+            Some("minimum") => f.push(("stability".to_string(), "a minimum of the energy (second-order check)".to_string())),
+            Some(other) => f.push(("stability".to_string(), other.to_string())),
+            None => {}
+        }
     }
     if let Some(c) = &m.change_from_kinematic {
         let max = c
@@ -255,16 +264,7 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             escape(&r.name),
             escape(material.as_deref().unwrap_or("—")),
             num(r.angle_deg, 1),
-            match (r.converged, &r.method_choice) {
-                (Some(false), _) => format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or(""))),
-                (_, Some(c)) => format!(
-                    "{} <span class=\"small\" title=\"{}\">(auto, ±{}°)</span>",
-                    escape(r.method.as_deref().unwrap_or(&c.chosen)),
-                    escape(&c.reason),
-                    c.tolerance_deg
-                ),
-                _ => escape(r.method.as_deref().unwrap_or("—")),
-            },
+            method_cell(r),
             match r.locking_angle_source {
                 Some(source) if source != crate::layup::LockingSource::Ply =>
                     format!("{} <span class=\"small\">({})</span>", num(r.locking_angle_deg, 1), source.tag()),
@@ -436,6 +436,29 @@ fn compare_text(ply: &PlyReport, change: Option<&str>) -> String {
         t += &format!(" Changes within ±{:.2}° are the solver's noise and drawn as none.", n.floor_deg);
     }
     t
+}
+
+/// The layup table's method cell: what ran, marked when it did not converge or ended on a
+/// saddle, with auto's choice in a tooltip.
+fn method_cell(r: &LayupRow) -> String {
+    if r.converged == Some(false) {
+        return format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or("")));
+    }
+    let mut cell = match &r.method_choice {
+        Some(c) => format!(
+            "{} <span class=\"small\" title=\"{}\">(auto, ±{}°)</span>",
+            escape(r.method.as_deref().unwrap_or(&c.chosen)),
+            escape(&c.reason),
+            c.tolerance_deg
+        ),
+        None => escape(r.method.as_deref().unwrap_or("—")),
+    };
+    if r.stability.as_deref() == Some("saddle") {
+        cell.push_str(
+            " <span class=\"small\" title=\"the converged state is a saddle of the energy, not a minimum\">(unstable: a saddle)</span>",
+        );
+    }
+    cell
 }
 
 #[cfg(test)]
