@@ -403,10 +403,10 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let mut stability: Option<StabilityCheck> = None;
     // The last saddle escaped from and its check, restored if the iterations from there fail.
     let mut saddle: Option<(Vec<Point>, StabilityCheck)> = None;
+    // The largest move of one iteration so far, spacings (for `settle_share`).
+    let mut largest_step = 0.0f64;
     let mut it = 0;
     loop {
-        // The largest move of one iteration so far, spacings (for `settle_share`).
-        let mut largest_step = 0.0f64;
         if residual <= settings.tolerance || red.is_empty() {
             if settings.stability_check && !red.is_empty() {
                 let t_check = std::time::Instant::now();
