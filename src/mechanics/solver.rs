@@ -479,9 +479,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         let solve_ms_before = engine.time_ms;
         let mut trial_ms = 0.0;
         let g = red.reduce(&unbalanced(&state.eval), &state.bases);
-        let hess = state.eval.hessian.as_deref().expect("the Hessian is evaluated with every accepted state");
-        let mut base_values = red.values(hess, &state.bases);
-        add_contact_curvature(cons, &rep, &red, &state, &mut base_values, false);
+        let mut base_values =
+            exact_model(cons, &rep, &red, &state).expect("the Hessian is evaluated with every accepted state");
         let exact_values = base_values.clone();
         let mut convex = false;
         let stiffness = red.mean_diagonal(&base_values).max(f64::MIN_POSITIVE);
@@ -491,9 +490,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         // still descend along a saddle; then only a larger shift helps.
         let fallback = |shift: &mut f64, values: &mut Vec<f64>, convex: &mut bool| {
             if !*convex {
-                if let Some(h) = objective.convex_hessian(x) {
-                    *values = red.values(h.as_ref(), &state.bases);
-                    add_contact_curvature(cons, &rep, &red, &state, values, true);
+                if let Some(v) = convex_model(objective, cons, &rep, &red, &state, x) {
+                    *values = v;
                     *convex = true;
                     return;
                 }
@@ -706,6 +704,30 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     }
 }
 
+/// The exact model at `s`: its reduced Hessian with the tool's curvature term (None when the
+/// state was evaluated without its Hessian).
+fn exact_model(cons: &Constraints, rep: &[usize], red: &Reduction, s: &State) -> Option<Vec<f64>> {
+    let mut values = red.values(s.eval.hessian.as_deref()?, &s.bases);
+    add_contact_curvature(cons, rep, red, s, &mut values, false);
+    Some(values)
+}
+
+/// The convex model at `s` (positions `x`): the elements' convex parts, reduced, with the tool's
+/// curvature term kept positive; None for an objective without convex parts.
+fn convex_model(
+    objective: &dyn Objective,
+    cons: &Constraints,
+    rep: &[usize],
+    red: &Reduction,
+    s: &State,
+    x: &[Point],
+) -> Option<Vec<f64>> {
+    let h = objective.convex_hessian(x)?;
+    let mut values = red.values(h.as_ref(), &s.bases);
+    add_contact_curvature(cons, rep, red, s, &mut values, true);
+    Some(values)
+}
+
 /// Makes `x` (already moved) the solve's state: its evaluation, feet (those found by the move
 /// when given), bases, and the reduction's freedoms (a new pattern when a node outgrew its
 /// slots).
@@ -765,18 +787,12 @@ fn least_curvature(
     mean_mass: f64,
     engine: &mut QpEngine,
 ) -> Option<Curvature> {
-    let hess = s.eval.hessian.as_deref()?;
-    let mut h = red.values(hess, &s.bases);
-    add_contact_curvature(cons, rep, red, s, &mut h, false);
+    let h = exact_model(cons, rep, red, s)?;
     let unit = red.mean_diagonal(&h).max(f64::MIN_POSITIVE) / mean_mass.max(f64::MIN_POSITIVE);
     let mut lumped = vec![0.0; h.len()];
     red.add_diagonal(&mut lumped, masses, 1.0);
-    let reference = match objective.convex_hessian(x) {
-        Some(c) => {
-            let mut v = red.values(c.as_ref(), &s.bases);
-            add_contact_curvature(cons, rep, red, s, &mut v, true);
-            v
-        }
+    let reference = match convex_model(objective, cons, rep, red, s, x) {
+        Some(v) => v,
         None => {
             // |H| row sums over the live variables bound its least eigenvalue (Gershgorin):
             // twice that in masses makes H + shift diagonally dominant.
