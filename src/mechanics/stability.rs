@@ -154,8 +154,9 @@ pub(super) struct LeastMode {
 /// positive definite) by Lanczos on M^{-1} H in M's inner product, fully reorthogonalised, from
 /// `start` (zero on pinned slots), at most `max_iterations` iterations; then the least of
 /// H v = lambda D v on the Krylov space it built (D the positive definite `metric`, e.g. the
-/// lumped masses). M^{-1} is applied by the engine (one factorisation, then triangular solves).
-/// None: `start` has no component to iterate on.
+/// lumped masses). M^{-1} is applied by the engine: one factorisation, then triangular solves
+/// without iterative refinement (the Ritz values are computed with the true H and M; only the
+/// subspace depends on the solves). None: `start` has no component to iterate on.
 pub(super) fn least_mode(
     red: &Reduction,
     engine: &mut QpEngine,
@@ -168,7 +169,7 @@ pub(super) fn least_mode(
     // The engine minimises 1/2 y^T M y + q^T y: y = -M^{-1} q.
     let mut solve_m = |r: &[f64]| -> Result<Vec<f64>, QpFailure> {
         let q: Vec<f64> = r.iter().map(|v| -v).collect();
-        engine.solve(red, m, &q)
+        engine.solve_unrefined(red, m, &q)
     };
     // One solve first: M^{-1} damps the stiff directions of a rough start.
     let mut z = solve_m(start)?;
