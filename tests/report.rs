@@ -5,6 +5,7 @@
 //! plies; views that see the hat box's walls; the page must show every picture.
 use drape::geometry::{shapes, Point, Vector};
 use drape::io::{write_net, Format};
+use drape::kinematic::provenance::Stability;
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, Method};
 use drape::report::{bin_shares, bin_width, colour_limit, shear_colour, write_report, ReportError, HEIGHT, WIDTH};
 use std::collections::{HashMap, HashSet};
@@ -585,11 +586,12 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("run");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("geometries/hemisphere/scene.toml");
-    assert_cmd::Command::cargo_bin("drape")
+    let run = assert_cmd::Command::cargo_bin("drape")
         .unwrap()
         .args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--format", "json"])
         .assert()
         .success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
     assert!(out.join("p0.kinematic.json").is_file(), "the mechanical ply's kinematic net is kept");
     for k in ["p45", "p90", "m45"] {
         assert!(!out.join(format!("{k}.kinematic.json")).exists(), "{k} is kinematic");
@@ -610,8 +612,12 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
     assert!(layup.files.contains(&"p0.kinematic.json".to_string()), "{:?}", layup.files);
     // The pressed p0 converges to a shallow saddle of the energy (the stability check's pencil
     // eigenvalue about -0.07; docs/ARCHITECTURE.md): said in the row, the net and the report.
-    assert_eq!(layup.plies[0].stability.as_deref(), Some("saddle"), "{:?}", layup.plies[0]);
-    assert_eq!(refined.meta.solver.as_ref().unwrap().stability.as_deref(), Some("saddle"));
+    assert_eq!(layup.plies[0].stability, Some(Stability::Saddle), "{:?}", layup.plies[0]);
+    assert_eq!(refined.meta.solver.as_ref().unwrap().stability, Some(Stability::Saddle));
+    let row = stdout.lines().find(|l| l.starts_with("p0 ")).expect("the layup table's p0 row");
+    assert!(row.contains("mechanical (saddle)"), "{row}");
+    assert!(stdout.contains("UNSTABLE: ply 'p0' is an equilibrium but a saddle"), "{stdout}");
+    assert!(!stdout.contains("UNSTABLE: ply 'p45'"), "{stdout}");
     assert!(layup.plies[1..].iter().all(|p| p.stability.is_none()), "kinematic plies are not checked");
     // The export record: the mesh, its size, the formats and each ply's covered elements, as
     // flow.csv (one row an element and ply) has them.

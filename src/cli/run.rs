@@ -7,6 +7,7 @@ use super::refine::print_solver;
 use super::summary::summary;
 use super::{compute, input, Failure};
 use crate::io::Format;
+use crate::kinematic::provenance::Stability;
 use crate::layup::stack::PlyResult;
 use crate::layup::table::CoverageOf;
 use crate::layup::{LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
@@ -134,7 +135,7 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
 /// The layup table: one row per ply in stacking order.
 fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     let mut out = format!(
-        "layup: {} plies on {}\n{:<12} {:>7} {:<16} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "layup: {} plies on {}\n{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
         scene.layup.plies.len(),
         scene.tool.display(),
         "ply",
@@ -151,13 +152,13 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         "offset"
     );
     out += &format!(
-        "{:<12} {:>7} {:<16} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
         "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm"
     );
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         let s = &r.stats;
         out += &format!(
-            "{:<12} {:>7} {:<16} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
+            "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
             format!(
@@ -165,6 +166,7 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 if r.choice.is_some() { "auto: " } else { "" },
                 match &r.refined {
                     Some(refined) if !refined.ok() => "UNCONVERGED",
+                    Some(refined) if refined.stability_verdict() == Some(Stability::Saddle) => "mechanical (saddle)",
                     Some(_) => "mechanical",
                     None => "kinematic",
                 }
@@ -190,6 +192,14 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 "UNCONVERGED: ply '{}' is the solver's last accepted state, not an equilibrium: {}\n",
                 ply.settings.name,
                 refined.describe_failure()
+            );
+        }
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if r.refined.as_ref().is_some_and(|f| f.ok() && f.stability_verdict() == Some(Stability::Saddle)) {
+            out += &format!(
+                "UNSTABLE: ply '{}' is an equilibrium but a saddle of the energy, not a minimum (the second-order check on its solver: line); the ply key escape_saddles = true moves it off\n",
+                ply.settings.name
             );
         }
     }

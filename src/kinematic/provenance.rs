@@ -160,10 +160,22 @@ pub struct SolverRecord {
     /// unstable one) or `unresolved`; absent when not checked (switched off, not converged).
     /// The figures are in the last load step's `stability`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stability: Option<String>,
+    pub stability: Option<Stability>,
     /// The solver's log, one entry per load step.
     #[serde(default)]
     pub load_steps: Value,
+}
+
+/// What the second-order check found of a converged mechanical state (`mechanics::stability`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stability {
+    /// No direction of negative curvature beyond the tolerance: a (local) minimum.
+    Minimum,
+    /// A direction of negative curvature: the state is an unstable equilibrium.
+    Saddle,
+    /// The check could not run (the reference model could not be factorised).
+    Unresolved,
 }
 
 /// A node whose forces do not balance, in a [`SolverRecord`].

@@ -6,6 +6,7 @@ use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
 use crate::kinematic::coverage::SurfaceCoverage;
+use crate::kinematic::provenance::Stability;
 use crate::kinematic::MethodChoice;
 use serde::{Deserialize, Serialize};
 
@@ -109,7 +110,7 @@ pub struct LayupRow {
     /// For a mechanical ply that converged: the second-order check of its state, `minimum` or
     /// `saddle` (an equilibrium the energy falls away from: an unstable one), or `unresolved`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stability: Option<String>,
+    pub stability: Option<Stability>,
     /// Thickness as laid flat, m.
     #[serde(default)]
     pub thickness_m: Option<f64>,

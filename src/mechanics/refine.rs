@@ -6,7 +6,7 @@ use super::qp::HessianBlocks;
 use super::sheet::{SheetError, SheetFeatures, SheetLayout};
 use super::solver::{solve, Constraints, Evaluation, Objective, Outcome, SolveReport, SolverSettings};
 use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
-use crate::kinematic::provenance::{CellChanges, SolverRecord, UnbalancedRecord};
+use crate::kinematic::provenance::{CellChanges, SolverRecord, Stability, UnbalancedRecord};
 use crate::kinematic::{DrapeNet, Method, NodeStatus};
 
 /// Which Hessian the quadratic models use: the exact one (the solver's shift handles its
@@ -162,9 +162,8 @@ pub struct Refined {
 impl Refined {
     /// The stability check's verdict on the final state (`minimum`, `saddle`, `unresolved`),
     /// when it ran (the last load step converged and the check was on).
-    pub fn stability_verdict(&self) -> Option<String> {
-        let check = self.steps.last()?.stability.as_ref()?;
-        serde_json::to_value(check.verdict).ok()?.as_str().map(str::to_string)
+    pub fn stability_verdict(&self) -> Option<Stability> {
+        Some(self.steps.last()?.stability.as_ref()?.verdict)
     }
 
     /// Whether every load step reached equilibrium.

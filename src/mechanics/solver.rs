@@ -28,7 +28,9 @@
 use super::contact::{ContactMode, ContactSurface, Foot, Freedom, NodeBasis};
 pub use super::qp::HessianBlocks;
 use super::qp::{dot, norm, QpEngine, QpFailure, Reduction};
-use super::stability::{least_mode, spread, Escape, LeastMode, Stability, StabilityCheck, LANCZOS_ITERATIONS};
+use super::stability::{
+    least_mode, spread, Escape, LeastEigenvalue, LeastMode, Stability, StabilityCheck, LANCZOS_ITERATIONS,
+};
 use crate::geometry::{Point, Vector};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -413,11 +415,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 let found = least_curvature(objective, cons, &rep, &red, &state, x, &masses, mean_mass, &mut engine);
                 let check = stability.get_or_insert_with(|| StabilityCheck {
                     verdict: Stability::Unresolved,
-                    least_eigenvalue: f64::NAN,
-                    relative_eigenvalue: f64::NAN,
-                    reference_eigenvalue: f64::NAN,
-                    lanczos_iterations: 0,
-                    lanczos_converged: false,
+                    found: None,
                     checks: 0,
                     escapes: Vec::new(),
                     time_ms: 0.0,
@@ -425,11 +423,13 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 check.checks += 1;
                 let escape = match &found {
                     Some(c) => {
-                        check.least_eigenvalue = c.lumped;
-                        check.relative_eigenvalue = c.relative;
-                        check.reference_eigenvalue = c.mode.value;
-                        check.lanczos_iterations = c.mode.iterations;
-                        check.lanczos_converged = c.mode.converged;
+                        check.found = Some(LeastEigenvalue {
+                            least_eigenvalue: c.lumped,
+                            relative_eigenvalue: c.relative,
+                            reference_eigenvalue: c.mode.value,
+                            lanczos_iterations: c.mode.iterations,
+                            lanczos_converged: c.mode.converged,
+                        });
                         check.verdict =
                             if c.mode.value < -NEGATIVE_CURVATURE { Stability::Saddle } else { Stability::Minimum };
                         let may_escape = settings.escape_saddles && check.escapes.len() < MAX_ESCAPES;
@@ -441,14 +441,15 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     }
                     None => {
                         check.verdict = Stability::Unresolved;
+                        check.found = None;
                         None
                     }
                 };
-                if let Some((trial, feet, energy_moved, move_spacings)) = escape {
+                if let (Some((trial, feet, energy_moved, move_spacings)), Some(found)) = (escape, check.found) {
                     check.escapes.push(Escape {
                         after_iteration: it,
-                        least_eigenvalue: check.least_eigenvalue,
-                        reference_eigenvalue: check.reference_eigenvalue,
+                        least_eigenvalue: found.least_eigenvalue,
+                        reference_eigenvalue: found.reference_eigenvalue,
                         energy_saddle: state.eval.energy,
                         energy_moved,
                         move_spacings,
@@ -1376,7 +1377,11 @@ mod tests {
         assert!((fall - 2.0 * mass * gravity * length).abs() < 1e-9, "{fall}");
         assert_eq!(check.verdict, Stability::Minimum);
         let hanging = gravity / (length + sag);
-        assert!((check.least_eigenvalue - hanging).abs() < 1e-6 * hanging, "{}", check.least_eigenvalue);
+        assert!(
+            (check.found.unwrap().least_eigenvalue - hanging).abs() < 1e-6 * hanging,
+            "{}",
+            check.found.unwrap().least_eigenvalue
+        );
         assert_eq!(check.checks, 2);
     }
 
@@ -1393,9 +1398,13 @@ mod tests {
         assert!(report.iterations.is_empty());
         let check = report.stability.as_ref().expect("checked");
         assert_eq!(check.verdict, Stability::Minimum);
-        assert!(check.escapes.is_empty() && check.lanczos_converged);
+        assert!(check.escapes.is_empty() && check.found.unwrap().lanczos_converged);
         let hanging = gravity / (length + sag);
-        assert!((check.least_eigenvalue - hanging).abs() < 1e-6 * hanging, "{}", check.least_eigenvalue);
+        assert!(
+            (check.found.unwrap().least_eigenvalue - hanging).abs() < 1e-6 * hanging,
+            "{}",
+            check.found.unwrap().least_eigenvalue
+        );
         assert_eq!(x[1], below);
         // Switched off, there is no check.
         let report = solve(&obj, &mut x, &c, &SolverSettings::default().tolerance(1e-10).stability_check(false));
@@ -1443,7 +1452,11 @@ mod tests {
         let check = report.stability.as_ref().expect("checked");
         assert!(report.ok() && check.is_minimum() && check.escapes.is_empty(), "{report:?}");
         let across = 2.0 * obj.k * (a - 0.8 * a) / a / obj.mass;
-        assert!((check.least_eigenvalue - across).abs() < 1e-6 * across, "{}", check.least_eigenvalue);
+        assert!(
+            (check.found.unwrap().least_eigenvalue - across).abs() < 1e-6 * across,
+            "{}",
+            check.found.unwrap().least_eigenvalue
+        );
         // Compressed: the straight line is a saddle; the node buckles aside until both springs
         // are at rest (energy 0), sqrt(rest^2 - a^2) off the line.
         let rest = 1.25 * a;

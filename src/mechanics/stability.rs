@@ -26,26 +26,16 @@ const LANCZOS_TOLERANCE: f64 = 1e-2;
 /// space is exhausted (a small problem), its Ritz values are exact.
 const LANCZOS_BREAKDOWN: f64 = 1e-12;
 
-/// What a stability check found of a converged state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stability {
-    /// No direction of negative curvature beyond the tolerance: a (local) minimum.
-    Minimum,
-    /// A direction of negative curvature: the state is an unstable equilibrium.
-    Saddle,
-    /// The check could not run (the reference model could not be factorised).
-    Unresolved,
-}
+pub use crate::kinematic::provenance::Stability;
 
 /// A move off a saddle along its direction of negative curvature.
 #[derive(Debug, Clone, Serialize)]
 pub struct Escape {
     /// Iterations done before it (the saddle's iteration).
     pub after_iteration: usize,
-    /// The saddle's least eigenvalue (see [`StabilityCheck::least_eigenvalue`]), 1/s^2.
+    /// The saddle's least eigenvalue (see [`LeastEigenvalue::least_eigenvalue`]), 1/s^2.
     pub least_eigenvalue: f64,
-    /// ... and relative to the check's reference (see [`StabilityCheck::reference_eigenvalue`]).
+    /// ... and relative to the check's reference (see [`LeastEigenvalue::reference_eigenvalue`]).
     pub reference_eigenvalue: f64,
     /// Energy at the saddle (J).
     pub energy_saddle: f64,
@@ -67,6 +57,20 @@ pub struct Escape {
 pub struct StabilityCheck {
     /// Whether the final state is a minimum, a saddle, or could not be checked.
     pub verdict: Stability,
+    /// What the last check found; absent when it could not run (`unresolved`).
+    #[serde(flatten)]
+    pub found: Option<LeastEigenvalue>,
+    /// Checks run (one per converged state: one more per escape).
+    pub checks: usize,
+    /// Moves off saddles, in order.
+    pub escapes: Vec<Escape>,
+    /// Time spent in the checks and the escape moves (not the iterations after them), ms.
+    pub time_ms: f64,
+}
+
+/// The least eigenvalue a stability check found, in its three scales.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LeastEigenvalue {
     /// The least eigenvalue found, relative to the lumped masses: the Rayleigh quotient
     /// v^T H v / v^T M_lumped v of the softest mode v (1/s^2: a stable mode's angular frequency
     /// squared, minus an unstable one's growth rate squared). An estimate from above.
@@ -78,17 +82,11 @@ pub struct StabilityCheck {
     /// M >= H, so mu <= 1): how far H curves down along some direction as a fraction of how
     /// far the reference curves up. The verdict is judged on it.
     pub reference_eigenvalue: f64,
-    /// Lanczos iterations of the last check.
+    /// Lanczos iterations of the check.
     pub lanczos_iterations: usize,
-    /// Whether the last check's Lanczos iteration met its tolerance (else it stopped at the
-    /// limit, [`LANCZOS_ITERATIONS`]).
+    /// Whether the Lanczos iteration met its tolerance (else it stopped at the limit,
+    /// [`LANCZOS_ITERATIONS`]).
     pub lanczos_converged: bool,
-    /// Checks run (one per converged state: one more per escape).
-    pub checks: usize,
-    /// Moves off saddles, in order.
-    pub escapes: Vec<Escape>,
-    /// Time spent in the checks and the escape moves (not the iterations after them), ms.
-    pub time_ms: f64,
 }
 
 impl StabilityCheck {
@@ -104,16 +102,15 @@ impl StabilityCheck {
             Stability::Saddle => "UNSTABLE (a saddle, not a minimum)".to_string(),
             Stability::Unresolved => "stability not checked (the reference model could not be factorised)".to_string(),
         };
-        let mut s = if self.verdict == Stability::Unresolved {
-            what
-        } else {
-            format!(
+        let mut s = match (&self.verdict, &self.found) {
+            (Stability::Unresolved, _) | (_, None) => what,
+            (_, Some(f)) => format!(
                 "{what}: least eigenvalue {:.3e} 1/s^2 ({:.1e} of the mean stiffness), {} Lanczos iterations{}",
-                self.least_eigenvalue,
-                self.relative_eigenvalue,
-                self.lanczos_iterations,
-                if self.lanczos_converged { "" } else { " (at the limit)" }
-            )
+                f.least_eigenvalue,
+                f.relative_eigenvalue,
+                f.lanczos_iterations,
+                if f.lanczos_converged { "" } else { " (at the limit)" }
+            ),
         };
         for e in &self.escapes {
             s.push_str(&format!(

@@ -1,6 +1,7 @@
 //! The report page: one self-contained HTML file (inline CSS; pictures linked by file name from
 //! the same folder, flat patterns inlined).
 use super::{method_name, LayupRow, Page, PlyReport};
+use crate::kinematic::provenance::Stability;
 use crate::kinematic::DrapeNet;
 use crate::layup::flat::CutWarning;
 use std::fmt::Write;
@@ -54,13 +55,18 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
             let why = s.reason.clone().unwrap_or_else(|| s.outcome.clone());
             f.push(("NOT CONVERGED".to_string(), format!("the last accepted state, not an equilibrium: {why}")));
         }
-        match s.stability.as_deref() {
-            Some("saddle") => f.push((
+        match s.stability {
+            Some(Stability::Saddle) => f.push((
                 "stability".to_string(),
                 "UNSTABLE: a saddle, an equilibrium the energy falls away from along some direction (the second-order check at convergence; the figures are in the net's meta.solver)".to_string(),
             )),
-            Some("minimum") => f.push(("stability".to_string(), "a minimum of the energy (second-order check)".to_string())),
-            Some(other) => f.push(("stability".to_string(), other.to_string())),
+            Some(Stability::Minimum) => {
+                f.push(("stability".to_string(), "a minimum of the energy (second-order check)".to_string()))
+            }
+            Some(Stability::Unresolved) => f.push((
+                "stability".to_string(),
+                "not checked: the second-order check's reference model could not be factorised".to_string(),
+            )),
             None => {}
         }
     }
@@ -453,7 +459,7 @@ fn method_cell(r: &LayupRow) -> String {
         ),
         None => escape(r.method.as_deref().unwrap_or("—")),
     };
-    if r.stability.as_deref() == Some("saddle") {
+    if r.stability == Some(Stability::Saddle) {
         cell.push_str(
             " <span class=\"small\" title=\"the converged state is a saddle of the energy, not a minimum\">(unstable: a saddle)</span>",
         );
