@@ -198,7 +198,7 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         if r.refined.as_ref().is_some_and(|f| f.ok() && f.stability_verdict() == Some(Stability::Saddle)) {
             out += &format!(
-                "UNSTABLE: ply '{}' is an equilibrium but a saddle of the energy, not a minimum (the second-order check on its solver: line); the ply key escape_saddles = true moves it off\n",
+                "UNSTABLE: ply '{}' is an equilibrium but a saddle of the energy, not a minimum (the second-order check on its solver: line); the ply key escape_saddles = true tries to move it off (off by default: it can slide fabric past the tool's open edges)\n",
                 ply.settings.name
             );
         }
