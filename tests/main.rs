@@ -34,3 +34,4 @@ mod offset_bladelike;
 mod report;
 mod sphere_chebyshev;
 mod study;
+mod symmetric_reference;

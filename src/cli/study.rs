@@ -222,20 +222,37 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
     match &finished {
         Finished::SpeedAccuracy(s) => {
             println!("reference: {} ({}, d = {:.4} m)", s.reference.method, s.reference.kind, s.reference.spacing);
+            // On a symmetric scene each run names the image of the reference it is measured in.
+            let symmetric = !s.reference.symmetries.is_empty();
+            if symmetric {
+                let names: Vec<&str> = s.reference.symmetries.iter().map(|m| m.name()).collect();
+                println!(
+                    "the ply's drape problem is symmetric ({}): each run is measured against the reference or its image nearest to it (\"image\")",
+                    names.join(", ")
+                );
+            }
+            let image = |x: &str| if symmetric { format!(" {x:>12}") } else { String::new() };
             println!(
-                "{:<22} {:>9} {:>8} {:>10} {:>11} {:>11}  outcome",
-                "method", "d (m)", "surface", "time (s)", "err max", "err rms"
+                "{:<22} {:>9} {:>8} {:>10} {:>11} {:>11}{}  outcome",
+                "method",
+                "d (m)",
+                "surface",
+                "time (s)",
+                "err max",
+                "err rms",
+                image("image")
             );
             for p in &s.points {
                 let e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.4}"));
                 println!(
-                    "{:<22} {:>9.5} {:>8} {:>10.4} {:>11} {:>11}  {}{}",
+                    "{:<22} {:>9.5} {:>8} {:>10.4} {:>11} {:>11}{}  {}{}",
                     p.method,
                     p.spacing,
                     p.surface,
                     p.time_s,
                     e(p.error_max_deg),
                     e(p.error_rms_deg),
+                    image(p.reference_image.map_or("-", |m| m.name())),
                     p.outcome,
                     if p.pareto { "  (Pareto)" } else { "" }
                 );

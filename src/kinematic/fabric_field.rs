@@ -18,6 +18,57 @@ pub struct ShearField {
     pub shear_deg: Vec<Option<f64>>,
 }
 
+/// A map of fabric coordinates onto themselves that a mirror-symmetric drape problem respects:
+/// the mirror image of a drape, its fibre families kept, is the same ply's drape seen through
+/// this map ([`ShearField::image`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FabricImage {
+    /// The identity.
+    AsIs,
+    /// The mirror in the plane of the warp and the normal at the seed: (u, v) -> (u, -v).
+    WarpMirror,
+    /// The mirror in the plane of the weft and the normal at the seed: (u, v) -> (-u, v).
+    WeftMirror,
+    /// Both mirrors, a half turn about the normal at the seed: (u, v) -> (-u, -v).
+    Rotated,
+}
+
+impl FabricImage {
+    /// The two mirrors.
+    pub const MIRRORS: [FabricImage; 2] = [FabricImage::WarpMirror, FabricImage::WeftMirror];
+
+    /// Its name in files and tables: `as-is`, `warp-mirror`, `weft-mirror` or `rotated`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FabricImage::AsIs => "as-is",
+            FabricImage::WarpMirror => "warp-mirror",
+            FabricImage::WeftMirror => "weft-mirror",
+            FabricImage::Rotated => "rotated",
+        }
+    }
+
+    /// Whether the map reverses u, whether it reverses v.
+    fn flips(self) -> (bool, bool) {
+        match self {
+            FabricImage::AsIs => (false, false),
+            FabricImage::WarpMirror => (false, true),
+            FabricImage::WeftMirror => (true, false),
+            FabricImage::Rotated => (true, true),
+        }
+    }
+
+    /// The group a set of mirrors generates, the identity left out: each mirror, and the half
+    /// turn when both hold.
+    pub fn group_of(mirrors: &[FabricImage]) -> Vec<FabricImage> {
+        let mut g: Vec<FabricImage> = FabricImage::MIRRORS.into_iter().filter(|m| mirrors.contains(m)).collect();
+        if g.len() == 2 {
+            g.push(FabricImage::Rotated);
+        }
+        g
+    }
+}
+
 /// Bilinear weights below this are rounding: the point sits on a cell centre or the line
 /// between two.
 const ZERO_WEIGHT: f64 = 1e-9;
@@ -76,6 +127,28 @@ impl ShearField {
         )
     }
 
+    /// The field of the drape's mirror image under `image` (fibre families kept):
+    /// `s'(u, v) = -s(u, -v)` for the warp mirror, `-s(-u, v)` for the weft mirror and
+    /// `s(-u, -v)` for the half turn. A mirror reverses one fibre family's direction against the
+    /// other's, so the angle between them becomes its supplement and the shear changes sign.
+    /// Exact: the cells are relabelled, nothing is interpolated.
+    pub fn image(&self, image: FabricImage) -> ShearField {
+        let (fu, fv) = image.flips();
+        let sign = if fu != fv { -1.0 } else { 1.0 };
+        let (cu, cv) = (self.cu, self.cv);
+        let mut shear_deg = vec![None; cu * cv];
+        for i in 0..cu {
+            for j in 0..cv {
+                let (a, b) = (if fu { cu - 1 - i } else { i }, if fv { cv - 1 - j } else { j });
+                shear_deg[a * cv + b] = self.shear_deg[i * cv + j].map(|s| sign * s);
+            }
+        }
+        // Node n goes to node (cells - n): the origin node with it.
+        let (o0, o1) = self.origin_node;
+        let origin_node = (if fu { cu - o0 } else { o0 }, if fv { cv - o1 } else { o1 });
+        ShearField { spacing: self.spacing, cu, cv, origin_node, shear_deg }
+    }
+
     /// The fabric coordinates of every complete cell's centre.
     pub fn complete_cell_centres(&self) -> Vec<(f64, f64)> {
         let mut out = Vec::new();
@@ -107,6 +180,25 @@ mod tests {
         for (u, v) in [(0.0, 0.0), (0.1, -0.2), (-0.6, 0.3)] {
             let s = f.at(u, v).unwrap();
             assert!((s - (3.0 * u + 2.0 * v)).abs() < 1e-12, "at ({u},{v}): {s}");
+        }
+    }
+
+    #[test]
+    fn images_map_fabric_points_and_change_the_sign_under_one_mirror() {
+        let f = field(|i, j| if (i, j) == (0, 2) { None } else { Some((i * 10 + j) as f64 + 1.0) });
+        for (u, v) in f.complete_cell_centres() {
+            let s = f.at(u, v).unwrap();
+            assert_eq!(f.image(FabricImage::AsIs).at(u, v), Some(s));
+            assert_eq!(f.image(FabricImage::WarpMirror).at(u, -v), Some(-s));
+            assert_eq!(f.image(FabricImage::WeftMirror).at(-u, v), Some(-s));
+            assert_eq!(f.image(FabricImage::Rotated).at(-u, -v), Some(s));
+        }
+        // The missing cell goes with its point.
+        let (u, v) = f.cell_centre(0, 2);
+        assert_eq!(f.image(FabricImage::Rotated).at(-u, -v), None);
+        // Each image undoes itself.
+        for m in [FabricImage::WarpMirror, FabricImage::WeftMirror, FabricImage::Rotated] {
+            assert_eq!(f.image(m).image(m), f);
         }
     }
 

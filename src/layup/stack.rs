@@ -175,7 +175,7 @@ pub fn resolve_warp(
 /// Unit normal of `surface` at its point `p`: the facet's normal inside a facet, the mean of the
 /// facets' normals when `p` lies on an edge or a vertex (a seed is often placed on a vertex, and
 /// the angle of a ply should not depend on which facet the search happened to return).
-fn seed_normal(surface: &ToolSurface, p: &Point) -> Vector {
+pub(crate) fn seed_normal(surface: &ToolSurface, p: &Point) -> Vector {
     let eps = SEED_CONTACT_REL * surface.diagonal();
     let mut n = Vector::zeros();
     for t in surface.triangles_near(p, eps) {

@@ -2,6 +2,7 @@
 //! (`speed_accuracy.svg/png`), and the outcome map over two swept parameters
 //! (`stability.svg/png`).
 use super::render::{register_fonts, to_png, to_svg, DrawResult};
+use crate::kinematic::fabric_field::FabricImage;
 use crate::study::speed_accuracy::SpeedAccuracy;
 use crate::study::stability::Stability;
 use crate::study::Finished;
@@ -251,6 +252,26 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                 if s.reference.kind == "mechanical" { format!("{} at d = {:.4} m", s.reference.method, s.reference.spacing) } else { "each method's Richardson limit".into() },
                 s.reference.kind
             );
+            // On a symmetric scene: the symmetries, and the runs measured in an image of the
+            // reference rather than in the reference as it fell.
+            let summary = if s.reference.symmetries.is_empty() {
+                summary
+            } else {
+                let names: Vec<&str> = s.reference.symmetries.iter().map(|m| m.name()).collect();
+                let imaged: Vec<String> = s
+                    .points
+                    .iter()
+                    .filter_map(|p| {
+                        let m = p.reference_image.filter(|m| *m != FabricImage::AsIs)?;
+                        Some(format!("{} ({}, d = {:.4} m): {}", p.method, p.surface, p.spacing, m.name()))
+                    })
+                    .collect();
+                format!(
+                    "{summary} The ply's drape problem is symmetric ({}), so a mechanical drape may break the symmetry either way: each run is measured against the reference or its image nearest to it; {}.",
+                    names.join(", "),
+                    if imaged.is_empty() { "every run against the reference as it fell".to_string() } else { format!("against an image: {}", imaged.join("; ")) }
+                )
+            };
             // What method = "auto" kept and saved, in words under the chart.
             let auto: String = s
                 .auto

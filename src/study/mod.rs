@@ -11,6 +11,7 @@ pub mod plan;
 pub mod runner;
 pub mod speed_accuracy;
 pub mod stability;
+pub mod symmetry;
 
 pub use plan::{Plan, Shard, StudyKind, StudyMethod};
 

@@ -2,6 +2,7 @@
 //! written to `DIR/study.json` before any case runs; shards and resumed runs read it back, so
 //! every process of one study agrees on what case `k` is.
 use super::StudyError;
+use crate::kinematic::fabric_field::FabricImage;
 use crate::kinematic::SurfaceKind;
 use crate::layup::Ply;
 use crate::pipeline::Scene;
@@ -178,6 +179,10 @@ pub struct Plan {
     /// The two swept parameters of the stability map.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axes: Option<[String; 2]>,
+    /// The symmetries of the ply's drape problem on the scene's tool, the identity left out
+    /// ([`super::symmetry`]): a mechanical reference is compared in each of its images.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub symmetries: Vec<FabricImage>,
     /// The cases, in order.
     pub cases: Vec<Case>,
 }

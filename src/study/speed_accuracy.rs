@@ -11,8 +11,9 @@
 //! as a user of that net would.
 use super::plan::{absolute, find_ply, study_tools, Case, Plan, StudyKind, StudyMethod, Variant};
 use super::runner::CaseRecord;
-use super::StudyError;
-use crate::kinematic::fabric_field::ShearField;
+use super::{symmetry, StudyError};
+use crate::io::read_tool;
+use crate::kinematic::fabric_field::{FabricImage, ShearField};
 use crate::kinematic::{GeneratorKind, SurfaceKind};
 use crate::layup::Ply;
 use crate::mechanics::ContactMode;
@@ -86,8 +87,17 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
     let kin = spacings(&opts.spacings, &KINEMATIC_SPACING_FACTORS)?;
     let mech = spacings(&opts.mechanical_spacings, &MECHANICAL_SPACING_FACTORS)?;
     let tools = study_tools(scene, &opts.tools)?;
+    let methods = methods_for(ply);
+    // Only a mechanical reference can break the scene's symmetries (a kinematic net is a
+    // function of the ply, so as symmetric as its problem): look for them only then.
+    let symmetries = if methods.iter().any(|m| m.is_mechanical()) {
+        let tool = read_tool(&tools[0], scene.scale).map_err(|e| StudyError::Input(e.to_string()))?;
+        symmetry::symmetries(ply, &scene.layup, &tool)
+    } else {
+        Vec::new()
+    };
     let mut cases = Vec::new();
-    for method in methods_for(ply) {
+    for method in methods {
         let (ds, ts, repeats) =
             if method.may_run_mechanics() { (&mech, &tools[..1], 1) } else { (&kin, &tools[..], opts.repeats.max(1)) };
         // The kinematic methods step on the facets and on the smooth surface over them.
@@ -106,6 +116,7 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
         scene: absolute(&scene.path)?,
         ply: ply.settings.name.clone(),
         axes: None,
+        symmetries,
         cases,
     })
 }
@@ -119,6 +130,10 @@ pub struct Reference {
     pub spacing: f64,
     /// `mechanical` or `extrapolated`.
     pub kind: String,
+    /// The symmetries of the ply's drape problem, the identity left out: a mechanical reference
+    /// that broke one is as good as its image, and each run is measured against the nearer.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub symmetries: Vec<FabricImage>,
 }
 
 /// One method's own extrapolated limit.
@@ -166,6 +181,9 @@ pub struct SpeedPoint {
     /// For an `auto` run: the method it ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub chosen: Option<String>,
+    /// On a symmetric scene: the image of the reference the errors are measured against.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_image: Option<FabricImage>,
 }
 
 /// What `method = "auto"` saved at one spacing: its result against the reference and its cost
@@ -248,6 +266,56 @@ impl RefField {
     }
 }
 
+/// Largest errors (degrees) of two images closer than this are a tie, which the reference as it
+/// fell wins: differences of rounding (the same arithmetic on a mirrored grid) choose nothing.
+const IMAGE_TIE_DEG: f64 = 1e-9;
+
+/// A run's error against a reference field, measured in the image of the reference nearest to
+/// it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Comparison {
+    /// The image of the reference used.
+    pub image: FabricImage,
+    /// Largest |shear - reference| over the compared points, degrees (absent without any).
+    pub error_max_deg: Option<f64>,
+    /// Root mean square of the same, degrees.
+    pub error_rms_deg: Option<f64>,
+    /// Points compared.
+    pub compared: usize,
+}
+
+/// A reference field and its images under the symmetries of the ply's drape problem: where the
+/// problem is symmetric, the reference's mirror image is an equally valid drape, and a run that
+/// broke the symmetry the other way is measured against that.
+pub struct ReferenceImages {
+    images: Vec<(FabricImage, RefField)>,
+}
+
+impl ReferenceImages {
+    /// `reference` as it fell and its images under `symmetries` (the identity left out).
+    pub fn new(reference: &ShearField, symmetries: &[FabricImage]) -> ReferenceImages {
+        let images = std::iter::once(FabricImage::AsIs)
+            .chain(symmetries.iter().copied().filter(|&s| s != FabricImage::AsIs))
+            .map(|s| (s, RefField { grid: reference.image(s) }))
+            .collect();
+        ReferenceImages { images }
+    }
+
+    /// `field` against each image: the one with the least largest error over the whole field
+    /// (the reference as it fell on a tie, [`IMAGE_TIE_DEG`]).
+    pub fn compare(&self, field: &ShearField) -> Comparison {
+        let mut best = Comparison { image: FabricImage::AsIs, error_max_deg: None, error_rms_deg: None, compared: 0 };
+        for (image, reference) in &self.images {
+            let (error_max_deg, error_rms_deg, compared) = reference.compare(field);
+            let Some(e) = error_max_deg else { continue };
+            if best.error_max_deg.is_none_or(|b| e < b - IMAGE_TIE_DEG) {
+                best = Comparison { image: *image, error_max_deg, error_rms_deg, compared };
+            }
+        }
+        best
+    }
+}
+
 /// The Richardson limit of one method's runs, finest last: `None` with fewer than two fields.
 fn extrapolate(runs: &[(f64, &ShearField)]) -> Option<(RefField, [f64; 2], f64, bool)> {
     let n = runs.len();
@@ -316,20 +384,24 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
             outcome: r.result.outcome.clone(),
             pareto: false,
             chosen: r.result.choice.as_ref().map(|c| c.chosen.clone()),
+            reference_image: None,
         })
         .collect();
     let reference = if let Some(m) = mech {
-        let reference =
-            RefField { grid: m.result.field.clone().unwrap_or_else(|| unreachable!("filtered on a field")) };
+        let grid = field(m).unwrap_or_else(|| unreachable!("filtered on a field"));
+        let reference = ReferenceImages::new(grid, &plan.symmetries);
         for (p, r) in points.iter_mut().zip(records) {
             if let Some(f) = field(r) {
-                (p.error_max_deg, p.error_rms_deg, p.compared) = reference.compare(f);
+                let c = reference.compare(f);
+                (p.error_max_deg, p.error_rms_deg, p.compared) = (c.error_max_deg, c.error_rms_deg, c.compared);
+                p.reference_image = (!plan.symmetries.is_empty()).then_some(c.image);
             }
         }
         Reference {
             method: m.case.variant.method.name().into(),
             spacing: m.case.variant.spacing,
             kind: "mechanical".into(),
+            symmetries: plan.symmetries.clone(),
         }
     } else {
         // Each method (on each surface and tool) against its own limit.
@@ -364,6 +436,7 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
             method: "own".into(),
             spacing: if finest.is_finite() { finest } else { 0.0 },
             kind: "extrapolated".into(),
+            symmetries: Vec::new(),
         }
     };
     mark_pareto(&mut points);
