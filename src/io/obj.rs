@@ -210,7 +210,16 @@ fn parse_pieces(bytes: &[u8], piece: usize) -> Result<Pieces, ObjSyntaxError> {
     let read: Vec<Option<(ObjText, usize, Vec<CountBack>)>> = bounds
         .par_windows(2)
         .map(|w| {
-            let (mut text, mut back) = (ObjText::default(), Some(Vec::new()));
+            // Room for as many statements as the piece can hold (`v 0 0 0` and `f 1 2 3` lines
+            // of 8 bytes): memory is only taken where written, and the arrays never move.
+            let n = (w[1] - w[0]) / 8 + 1;
+            let mut text = ObjText {
+                vertices: Vec::with_capacity(n),
+                faces: Vec::with_capacity(n),
+                corners: Vec::with_capacity(3 * n),
+                ..Default::default()
+            };
+            let mut back = Some(Vec::new());
             let lines = read_statements(&bytes[w[0]..w[1]], true, &mut text, &mut back).ok()?;
             Some((text, lines, back.unwrap_or_default()))
         })
