@@ -116,13 +116,17 @@ impl TriangleBvh {
         use rayon::prelude::*;
         let boxes: Vec<Box3> =
             triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect();
-        let centroids: Vec<[f64; 3]> = boxes
+        // Each triangle's centroid beside its index, so that the splits compare and move them
+        // without looking anything up elsewhere in memory.
+        let mut centroids: Vec<([f64; 3], u32)> = boxes
             .par_iter()
             .with_min_len(PARALLEL)
-            .map(|b| std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a])))
+            .enumerate()
+            .map(|(t, b)| (std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a])), t as u32))
             .collect();
-        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        split(&mut order, &centroids);
+        split(&mut centroids);
+        let order: Vec<u32> = centroids.par_iter().with_min_len(PARALLEL).map(|&(_, t)| t).collect();
+        drop(centroids);
 
         // Heap layout: node k has children 2k + 1 and 2k + 2; ranges first (top down), then
         // boxes (bottom up).
@@ -292,14 +296,14 @@ impl TriangleBvh {
     }
 }
 
-/// Order `order` by recursive median splits of the centroids (see the module documentation).
-fn split(order: &mut [u32], centroids: &[[f64; 3]]) {
+/// Order triangles (centroid, index) by recursive median splits of the centroids (see the
+/// module documentation).
+fn split(order: &mut [([f64; 3], u32)]) {
     if order.len() <= LEAF {
         return;
     }
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &t in order.iter() {
-        let c = &centroids[t as usize];
+    for (c, _) in order.iter() {
         for a in 0..3 {
             lo[a] = lo[a].min(c[a]);
             hi[a] = hi[a].max(c[a]);
@@ -312,15 +316,13 @@ fn split(order: &mut [u32], centroids: &[[f64; 3]]) {
         }
     }
     let mid = order.len() / 2;
-    order.select_nth_unstable_by(mid, |&s, &t| {
-        centroids[s as usize][axis].total_cmp(&centroids[t as usize][axis]).then(s.cmp(&t))
-    });
+    order.select_nth_unstable_by(mid, |(c, s), (d, t)| c[axis].total_cmp(&d[axis]).then(s.cmp(t)));
     let (left, right) = order.split_at_mut(mid);
     if left.len() + right.len() >= PARALLEL {
-        rayon::join(|| split(left, centroids), || split(right, centroids));
+        rayon::join(|| split(left), || split(right));
     } else {
-        split(left, centroids);
-        split(right, centroids);
+        split(left);
+        split(right);
     }
 }
 

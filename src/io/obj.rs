@@ -74,22 +74,47 @@ pub struct ObjSyntaxError {
 /// files) are read from the bytes as they are, with no allocation; a line with other bytes
 /// (read as UTF-8, invalid sequences replaced) or a continued line goes through the same
 /// statement reading as text. Both give the same statements and the same errors (tested).
+/// A large text is read in pieces in parallel ([`parse_pieces`]), with the same result.
 pub fn parse(bytes: &[u8]) -> Result<ObjText, ObjSyntaxError> {
-    parse_with(bytes, true)
+    Ok(parse_pieces(bytes, PIECE)?.into_text())
 }
 
-/// [`parse`], with the byte path for ASCII lines or (`fast` false) every line read as text.
+/// Texts longer than this are read in pieces of about this many bytes, in parallel.
+const PIECE: usize = 1 << 19;
+
+/// [`parse`], with the byte path for ASCII lines or (`fast` false) every line read as text, all
+/// in one piece.
 fn parse_with(bytes: &[u8], fast: bool) -> Result<ObjText, ObjSyntaxError> {
-    if memchr::memchr(0, bytes).is_some() {
-        return Err(ObjSyntaxError {
+    refuse_binary(bytes)?;
+    let mut text = ObjText::default();
+    read_statements(bytes, fast, &mut text, &mut None)?;
+    Ok(text)
+}
+
+/// A NUL byte means a binary file.
+fn refuse_binary(bytes: &[u8]) -> Result<(), ObjSyntaxError> {
+    match memchr::memchr(0, bytes) {
+        Some(_) => Err(ObjSyntaxError {
             line: 0,
             message: "it is a binary file, not a text (Wavefront) OBJ; binary STL, zipped or native CAD files cannot be read"
                 .into(),
-        });
+        }),
+        None => Ok(()),
     }
-    let mut text = ObjText::default();
+}
+
+/// Add the statements of `bytes` to `text`, lines numbered from 1; the number of lines.
+/// `back`: see [`resolve`].
+fn read_statements(
+    bytes: &[u8],
+    fast: bool,
+    text: &mut ObjText,
+    back: &mut Option<Vec<CountBack>>,
+) -> Result<usize, ObjSyntaxError> {
     let mut joined: Option<(usize, String)> = None;
+    let mut count = 0;
     for (number, raw) in lines(bytes) {
+        count = number;
         // Everything from the first `#` on is a comment. (`#` is ASCII, so cutting the bytes
         // there and then reading them as UTF-8 gives the text before the `#` of the line read
         // as UTF-8.)
@@ -98,7 +123,7 @@ fn parse_with(bytes: &[u8], fast: bool) -> Result<ObjText, ObjSyntaxError> {
             // ASCII bytes are valid UTF-8, and every word boundary below is an ASCII byte.
             let line = std::str::from_utf8(content).unwrap_or_default();
             if !line.trim_end_matches(is_space).ends_with('\\') {
-                statement(line, ascii_words(line), number, &mut text)?;
+                statement(line, ascii_words(line), number, text, back)?;
                 continue;
             }
         }
@@ -111,12 +136,148 @@ fn parse_with(bytes: &[u8], fast: bool) -> Result<ObjText, ObjSyntaxError> {
             continue;
         }
         line.push_str(&raw);
-        statement(&line, line.split_whitespace(), start, &mut text)?;
+        statement(&line, line.split_whitespace(), start, text, back)?;
     }
     if let Some((start, line)) = joined {
-        statement(&line, line.split_whitespace(), start, &mut text)?;
+        statement(&line, line.split_whitespace(), start, text, back)?;
     }
-    Ok(text)
+    Ok(count)
+}
+
+/// A corner that counts back from the last vertex read, in a piece read on its own: where it is
+/// in the piece's corners, how far back it counts and how many vertices the piece had read.
+#[derive(Debug, Clone, Copy)]
+struct CountBack {
+    corner: usize,
+    back: u64,
+    read: u64,
+}
+
+/// An OBJ text read in pieces ([`parse_pieces`]): each piece's statements as [`ObjText`]s, with
+/// line and vertex numbers those of the whole text, each face's corners in its own piece.
+struct Pieces {
+    texts: Vec<ObjText>,
+    /// How many vertices the pieces before each piece have.
+    vertices_before: Vec<usize>,
+}
+
+impl Pieces {
+    /// One text.
+    fn whole(text: ObjText) -> Pieces {
+        Pieces { texts: vec![text], vertices_before: vec![0] }
+    }
+
+    /// The pieces put together.
+    fn into_text(self) -> ObjText {
+        let mut texts = self.texts.into_iter();
+        let mut all = texts.next().unwrap_or_default();
+        for text in texts {
+            let shift = all.corners.len();
+            all.vertices.extend_from_slice(&text.vertices);
+            all.faces.extend(text.faces.into_iter().map(|f| ObjFace { corners: f.corners.start + shift..f.corners.end + shift, ..f }));
+            all.corners.extend_from_slice(&text.corners);
+            all.lines += text.lines;
+            all.points += text.points;
+        }
+        all
+    }
+
+    /// The number of vertices read.
+    fn vertex_count(&self) -> usize {
+        self.vertices_before.last().copied().unwrap_or(0) + self.texts.last().map_or(0, |t| t.vertices.len())
+    }
+
+    /// Vertex `k` (from 0; less than [`Self::vertex_count`]) and its line.
+    fn vertex(&self, k: usize) -> ([f64; 3], usize) {
+        let piece = self.vertices_before.partition_point(|&before| before <= k) - 1;
+        self.texts[piece].vertices[k - self.vertices_before[piece]]
+    }
+}
+
+/// [`parse`] in pieces of about `piece` bytes (cut after a line end, never inside a continued
+/// line), each read on its own in parallel and then numbered as in the whole text: its lines
+/// counted on from the pieces before it, corners that count back resolved against all
+/// vertices before them. Any error in any piece, or a corner counting back past the first
+/// vertex, and the whole text is read again in one piece, so errors are those of one reading.
+fn parse_pieces(bytes: &[u8], piece: usize) -> Result<Pieces, ObjSyntaxError> {
+    use rayon::prelude::*;
+    refuse_binary(bytes)?;
+    let bounds = piece_bounds(bytes, piece);
+    let whole = || parse_with(bytes, true).map(Pieces::whole);
+    if bounds.len() <= 2 {
+        return whole();
+    }
+    let read: Vec<Option<(ObjText, usize, Vec<CountBack>)>> = bounds
+        .par_windows(2)
+        .map(|w| {
+            // Room for as many statements as the piece can hold (`v 0 0 0` and `f 1 2 3` lines
+            // of 8 bytes): memory is only taken where written, and the arrays never move.
+            let n = (w[1] - w[0]) / 8 + 1;
+            let mut text = ObjText {
+                vertices: Vec::with_capacity(n),
+                faces: Vec::with_capacity(n),
+                corners: Vec::with_capacity(3 * n),
+                ..Default::default()
+            };
+            let mut back = Some(Vec::new());
+            let lines = read_statements(&bytes[w[0]..w[1]], true, &mut text, &mut back).ok()?;
+            Some((text, lines, back.unwrap_or_default()))
+        })
+        .collect();
+    let Some(read) = read.into_iter().collect::<Option<Vec<_>>>() else {
+        return whole();
+    };
+    // Lines and vertices before each piece.
+    let mut before = Vec::with_capacity(read.len());
+    let (mut lines, mut vertices) = (0, 0);
+    for (text, count, back) in &read {
+        if back.iter().any(|b| b.back > (vertices + b.read as usize) as u64) {
+            return whole();
+        }
+        before.push((lines, vertices));
+        lines += count;
+        vertices += text.vertices.len();
+    }
+    let texts: Vec<ObjText> = read
+        .into_par_iter()
+        .zip(&before)
+        .map(|((mut text, _, back), &(lines, vertices))| {
+            text.vertices.iter_mut().for_each(|v| v.1 += lines);
+            text.faces.iter_mut().for_each(|f| f.line += lines);
+            for b in back {
+                text.corners[b.corner] = vertices as u64 + b.read + 1 - b.back;
+            }
+            text
+        })
+        .collect();
+    Ok(Pieces { texts, vertices_before: before.into_iter().map(|(_, v)| v).collect() })
+}
+
+/// Where the pieces of [`parse_pieces`] begin, and the end: each after the first line end
+/// (`\n`) at least `piece` bytes after the start of the piece before it, whose line does not
+/// continue on the next.
+fn piece_bounds(bytes: &[u8], piece: usize) -> Vec<usize> {
+    let mut bounds = vec![0];
+    let mut at = piece.max(1);
+    while at < bytes.len() {
+        let Some(end) = memchr::memchr(b'\n', &bytes[at..]).map(|i| at + i) else { break };
+        // The line this `\n` ends (with the `\r` of `\r\n`: a `\r` before a `\n` is always one).
+        let stop = if end > 0 && bytes[end - 1] == b'\r' { end - 1 } else { end };
+        let start = memchr::memrchr2(b'\n', b'\r', &bytes[..stop]).map_or(0, |i| i + 1);
+        let line = &bytes[start..stop];
+        // The text path's test of a continued line (which the byte path agrees with, tested).
+        let content = &line[..memchr::memchr(b'#', line).unwrap_or(line.len())];
+        if String::from_utf8_lossy(content).trim_end().ends_with('\\') {
+            at = end + 1;
+            continue;
+        }
+        if end + 1 < bytes.len() {
+            bounds.push(end + 1);
+        }
+        at = end + 1 + piece;
+    }
+    bounds.push(bytes.len());
+    bounds
 }
 
 /// The lines of `bytes` with their 1-based numbers; `\n`, `\r\n` and a lone `\r` end a line.
@@ -162,6 +323,7 @@ fn statement<'a>(
     mut words: impl Iterator<Item = &'a str>,
     number: usize,
     text: &mut ObjText,
+    back: &mut Option<Vec<CountBack>>,
 ) -> Result<(), ObjSyntaxError> {
     match words.next() {
         Some("v") => {
@@ -191,7 +353,7 @@ fn statement<'a>(
             for word in words {
                 // Most words are plain vertex numbers.
                 if let Some(i) = small_number(word) {
-                    let vertex = resolve(i, text, number)?;
+                    let vertex = resolve(i, text, number, back)?;
                     text.corners.push(vertex);
                     continue;
                 }
@@ -206,7 +368,7 @@ fn statement<'a>(
                 let Some(i) = first.parse::<i64>().ok().filter(|_| well_formed && count <= 3) else {
                     return Err(face_error(line, number));
                 };
-                let vertex = resolve(i, text, number)?;
+                let vertex = resolve(i, text, number, back)?;
                 text.corners.push(vertex);
             }
             text.faces.push(ObjFace { corners: start..text.corners.len(), line: number });
@@ -259,12 +421,18 @@ fn face_error(line: &str, number: usize) -> ObjSyntaxError {
 
 /// The vertex number (from 1) that the face reference `i` of the face being read (the next
 /// one of `text`) on line `number` means: positive numbers as they are, negative ones counted
-/// back from the last vertex read.
+/// back from the last vertex read. In a piece read on its own (`back` given), a negative one is
+/// noted in `back` and stands as 0 until the vertices before the piece are counted.
 #[inline]
-fn resolve(i: i64, text: &ObjText, number: usize) -> Result<u64, ObjSyntaxError> {
+fn resolve(i: i64, text: &ObjText, number: usize, back: &mut Option<Vec<CountBack>>) -> Result<u64, ObjSyntaxError> {
     let read_so_far = text.vertices.len() as u64;
     match i {
         i if i > 0 => Ok(i as u64),
+        i if i < 0 && back.is_some() => {
+            let b = CountBack { corner: text.corners.len(), back: i.unsigned_abs(), read: read_so_far };
+            back.iter_mut().for_each(|v| v.push(b));
+            Ok(0)
+        }
         0 => Err(ObjSyntaxError {
             line: number,
             message: format!("face {} refers to vertex 0, but OBJ vertex numbers start at 1", text.faces.len() + 1),
@@ -295,22 +463,25 @@ fn quote(line: &str) -> String {
 /// with a non-finite coordinate.
 pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
     let bytes = std::fs::read(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
-    let text = parse(&bytes).map_err(|e| ToolError::Parse {
+    // The pieces as they are: putting them together would copy every statement once more.
+    let text = parse_pieces(&bytes, PIECE).map_err(|e| ToolError::Parse {
         path: path.into(),
         reason: if e.line == 0 { e.message } else { format!("line {}: {}", e.line, e.message) },
     })?;
-    let count = text.vertices.len();
-    let mut report = MeshReport { vertices_read: count, faces_read: text.faces.len(), ..Default::default() };
-    if text.faces.is_empty() {
+    let count = text.vertex_count();
+    let faces = text.texts.iter().map(|t| t.faces.len()).sum();
+    let mut report = MeshReport { vertices_read: count, faces_read: faces, ..Default::default() };
+    if faces == 0 {
         return Err(ToolError::Empty { path: path.into() });
     }
     // Vertices in the order the faces first use them.
     let mut index = vec![u32::MAX; count];
-    let mut mesh = TriangleMesh { vertices: Vec::with_capacity(count), triangles: Vec::with_capacity(text.faces.len()) };
+    let mut mesh = TriangleMesh { vertices: Vec::with_capacity(count), triangles: Vec::with_capacity(faces) };
     let mut corners = Vec::with_capacity(8);
-    for (f, face) in text.faces.iter().enumerate() {
+    let all_faces = text.texts.iter().flat_map(|t| t.faces.iter().map(move |face| t.face_corners(face)));
+    for (f, face) in all_faces.enumerate() {
         corners.clear();
-        for &v in text.face_corners(face) {
+        for &v in face {
             let k = (v as usize).checked_sub(1).filter(|&k| k < count).ok_or(ToolError::BadIndex {
                 path: path.into(),
                 face: f + 1,
@@ -318,7 +489,7 @@ pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
                 count,
             })?;
             if index[k] == u32::MAX {
-                let ([x, y, z], _) = text.vertices[k];
+                let ([x, y, z], _) = text.vertex(k);
                 if let Some(&value) = [x, y, z].iter().find(|c| !c.is_finite()) {
                     return Err(ToolError::NonFinite { path: path.into(), index: k + 1, value });
                 }
@@ -677,6 +848,77 @@ mod tests {
             let (fast, text) = (parse_with(&bytes, true), parse_with(&bytes, false));
             assert_eq!(format!("{fast:?}"), format!("{text:?}"), "{:?}", String::from_utf8_lossy(&bytes));
         }
+    }
+
+    #[test]
+    fn a_text_read_in_pieces_is_the_text_read_whole() {
+        // Random OBJ-like texts of many lines (vertices, faces with plain, slashed and negative
+        // numbers, comments, continued lines, non-ASCII bytes, all three line ends, errors of
+        // every kind), read in pieces of 1 to 60 bytes with 1, 2 and 3 threads and read whole
+        // as text: the same statements or the same error.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as usize
+        };
+        let words = ["1", "2", "3", "-1", "-2", "-4", "4/1", "2//5", "0", "x", "0.5", "1e3", "nan", "#c", "\\", "caf\u{e9}"];
+        let ends = ["\n", "\r\n", "\r", "\\\n", " \\\r\n", "\n\n"];
+        let mut texts = Vec::new();
+        for round in 0..400 {
+            let mut text = String::new();
+            for _ in 0..5 + rnd(30) {
+                match rnd(20) {
+                    0..=7 => text += &format!("v {} {} {}", rnd(9), rnd(9), 0.5 * rnd(9) as f64),
+                    8..=15 => {
+                        text += "f";
+                        for _ in 0..rnd(6) {
+                            text += " ";
+                            // Mostly valid numbers, so that most texts read to the end.
+                            text += if rnd(40) == 0 { words[rnd(words.len())] } else { ["1", "2", "-1", "-2", "3/3"][rnd(5)] };
+                        }
+                    }
+                    16..=18 => text += ["# comment", "g part", "vn 0 0 1", "l 1 2", "p 1", "f 1 2 3 # \\"][rnd(6)],
+                    _ => text += ["v 1 2 2", "v 1 \u{e9} 2"][rnd(2)],
+                }
+                text += if rnd(6) == 0 { ends[rnd(ends.len())] } else { "\n" };
+            }
+            let bytes = if round % 11 == 0 { [text.as_bytes(), b"v 1 \xff 2\n"].concat() } else { text.into_bytes() };
+            texts.push(bytes);
+        }
+        let (mut read, mut refused) = (0, 0);
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                for (round, bytes) in texts.iter().enumerate() {
+                    let whole = format!("{:?}", parse_with(bytes, false));
+                    let piece = 1 + round % 60;
+                    let pieces = format!("{:?}", parse_pieces(bytes, piece).map(Pieces::into_text));
+                    assert_eq!(pieces, whole, "pieces of {piece} bytes: {:?}", String::from_utf8_lossy(bytes));
+                    if whole.starts_with("Ok") {
+                        read += 1;
+                    } else {
+                        refused += 1;
+                    }
+                }
+            });
+        }
+        // Both outcomes are exercised.
+        assert!(read > 100 && refused > 100, "{read} read, {refused} refused");
+    }
+
+    #[test]
+    fn pieces_begin_after_a_line_end_that_does_not_continue() {
+        let text = b"v 0 0 0\nf 1 \\\n 2 3\r\nf 1 2 3 # \\\r\nv 1 1 1\rv 2 2 2\n";
+        let bounds = piece_bounds(text, 1);
+        // After `v 0 0 0`, not after the continued `f 1 \`, after the `\r\n` of ` 2 3` and of
+        // the comment; the lone `\r` is not a piece boundary.
+        assert_eq!(bounds, [0, 8, 20, 33, text.len()]);
+        let pieces = parse_pieces(text, 1).unwrap();
+        assert_eq!(pieces.texts.len(), 4);
+        assert_eq!((pieces.vertex(1), pieces.vertex(2)), (([1.0, 1.0, 1.0], 5), ([2.0, 2.0, 2.0], 6)));
+        assert_eq!(format!("{:?}", pieces.into_text()), format!("{:?}", parse_with(text, false).unwrap()));
     }
 
     #[test]
