@@ -5,8 +5,9 @@
 //! - **the model**: steps of the mechanical model (the ply's card, pressed) from the kinematic
 //!   net until the nodes settle ([`PROBE_SETTLED_SHARE`]; two on a net near equilibrium, seven
 //!   on the cone, where gravity slides the ply down the slant). Their largest cell-shear change
-//!   says in degrees how far equilibrium lies. Above the model's share of the tolerance
-//!   ([`SPACING_SHARE`]), mechanics runs, going on from where the probe stopped;
+//!   says in degrees how far equilibrium lies. Above the model's share of the tolerance (the
+//!   tolerance less the spacing's estimated error below, which takes at most
+//!   [`SPACING_SHARE`] of it), mechanics runs, going on from where the probe stopped;
 //!   When the ply lies on the facets and that step is too large, the kinematic net on the smooth
 //!   surface (the one pressed contact slides on) is weighed the same way, and kept if within:
 //!   on a coarse tool most of the difference is the facets', not the model's;
@@ -39,8 +40,9 @@ use std::time::Instant;
 
 /// Tolerance of `method = "auto"` when the ply gives none, degrees of cell shear.
 pub const DEFAULT_TOLERANCE_DEG: f64 = 1.0;
-/// Share of the tolerance the spacing may take; the rest is the model's (the kinematic net's
-/// distance from mechanical equilibrium).
+/// Most of the tolerance the spacing may take (a larger estimated error is met by draping
+/// finer); the model (the kinematic net's distance from mechanical equilibrium) gets the
+/// tolerance less the spacing's estimated error.
 pub const SPACING_SHARE: f64 = 0.5;
 /// Share of the draped area past the locking angle above which the reason warns of it.
 pub const LOCKED_NOTE_SHARE: f64 = 0.01;
@@ -156,9 +158,15 @@ pub fn choose(
     let t = Instant::now();
     let tolerance = auto.tolerance_deg;
     let spacing_budget = SPACING_SHARE * tolerance;
-    let model_budget = tolerance - spacing_budget;
     let own = surfaces.drape(settings)?;
     let d = settings.spacing;
+    // The spacing takes the share of the tolerance its estimated error needs (at most
+    // `spacing_budget`: a larger error is met by draping finer), the model the rest. On a
+    // developable tool the spacing needs almost nothing, and a model change just under the
+    // tolerance keeps the kinematic net (the cone: 0.87 deg from the probe, 0.78 deg from the
+    // finest pressed drape, where mechanics at the ply's spacing erred by 1.2 deg).
+    let own_discretisation = discretisation_error(surfaces, settings, &own);
+    let model_budget = tolerance - own_discretisation.map_or(spacing_budget, |e| e.min(spacing_budget));
     let stats = own.shear_stats(locking_angle);
     let locking_share = if stats.area > 0.0 { stats.area_over_locking / stats.area } else { 0.0 };
     let step = equilibrium_probe(surfaces, &own, refinement);
@@ -229,12 +237,14 @@ pub fn choose(
         ));
     }
     // The kinematic net that stands (or that mechanics starts from: the ply's own).
-    let (net, settings) = match smooth {
-        Some((net, s, _)) if smooth_within => (net, s),
-        _ => (own, settings.clone()),
+    let (net, settings, discretisation) = match smooth {
+        Some((net, s, _)) if smooth_within => {
+            let e = discretisation_error(surfaces, &s, &net);
+            (net, s, e)
+        }
+        _ => (own, settings.clone(), own_discretisation),
     };
     let settings = &settings;
-    let discretisation = discretisation_error(surfaces, settings, &net);
     let spacing_needed =
         discretisation.filter(|e| *e > spacing_budget).map(|e| d * (spacing_budget / e).powf(1.0 / FISHNET_ORDER));
     indicators.discretisation_deg = discretisation;
