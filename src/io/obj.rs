@@ -740,20 +740,14 @@ mod tests {
         assert!(matches!(err, ToolError::Parse { .. }), "{err}");
 
         // Random bytes and random OBJ-like words: refused (or, by chance, read), never a panic.
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
         let tokens = ["v", "f", "vt", "l", "1", "-1", "0", "2/3", "//", "/", "1e40", "nan", "\n"];
         for round in 0..240 {
             let bytes: Vec<u8> = match round % 3 {
-                0 => (0..200).map(|_| (rnd() % 256) as u8).collect(),
-                1 => (0..200).map(|_| (rnd() % 255 + 1) as u8).collect(),
+                0 => (0..200).map(|_| rnd(256) as u8).collect(),
+                1 => (0..200).map(|_| (rnd(255) + 1) as u8).collect(),
                 _ => {
-                    let words: Vec<&str> = (0..60).map(|_| tokens[(rnd() % tokens.len() as u64) as usize]).collect();
+                    let words: Vec<&str> = (0..60).map(|_| tokens[rnd(tokens.len())]).collect();
                     words.join(" ").into_bytes()
                 }
             };
@@ -801,6 +795,18 @@ mod tests {
         read(&write(&dir, "mesh.obj", text), 1.0)
     }
 
+    /// A deterministic pseudo-random index below `n` (xorshift64 from `seed`), for the random
+    /// texts of the tests.
+    fn xorshift(seed: u64) -> impl FnMut(usize) -> usize {
+        let mut state = seed;
+        move |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as usize
+        }
+    }
+
     #[test]
     fn the_flow_reading_keeps_quads_and_continues_lines() {
         let m = read_flow("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 \\\n 3 4\nf 1 2 3\n").unwrap();
@@ -816,13 +822,7 @@ mod tests {
         // Random lines of OBJ-like words, white space of every ASCII kind, comments, continued
         // lines, non-ASCII bytes and all three line ends: parsed with the byte path for ASCII
         // lines and with every line read as text, the same statements or the same error.
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rnd = move |n: usize| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % n as u64) as usize
-        };
+        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
         let words = [
             "v", "f", "vt", "l", "p", "1", "-1", "2", "-3", "0", "+4", "7/1", "2//5", "3/1/2", "1/2/3/4", "/", "//",
             "1e40", "nan", "inf", "-0.5", "2.5e-3", ".5", "1.", "x", "#", "#c", "\\", "caf\u{e9}", "\u{a0}", "9999999999999999999999",
@@ -856,13 +856,7 @@ mod tests {
         // numbers, comments, continued lines, non-ASCII bytes, all three line ends, errors of
         // every kind), read in pieces of 1 to 60 bytes with 1, 2 and 3 threads and read whole
         // as text: the same statements or the same error.
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move |n: usize| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % n as u64) as usize
-        };
+        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
         let words = ["1", "2", "3", "-1", "-2", "-4", "4/1", "2//5", "0", "x", "0.5", "1e3", "nan", "#c", "\\", "caf\u{e9}"];
         let ends = ["\n", "\r\n", "\r", "\\\n", " \\\r\n", "\n\n"];
         let mut texts = Vec::new();
