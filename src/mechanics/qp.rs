@@ -27,8 +27,12 @@ type Source = (u32, u32, u8, u8);
 /// beyond it means the model is too near singular for its step to be trusted.
 const MODEL_SOLVE_ACCURACY: f64 = 1e-6;
 
-/// Subproblems with at least this many variables are factorised on all threads.
-const PARALLEL_FACTORISATION_MIN: usize = 20_000;
+/// Subproblems with at least this many variables are factorised on all threads. Below it faer's
+/// threads cost more in waking and yielding than they save on two cores: the 91 x 91 sphere
+/// drape (25 k variables) took 43 s with one thread against 48 s with two (10 s of system time
+/// in `sched_yield`); the 301 x 301 bench (124 k) is the same either way, the hat box (22 k)
+/// too.
+const PARALLEL_FACTORISATION_MIN: usize = 100_000;
 
 /// The reduced variables: node k's components start at `offset[rep[k]]` and number
 /// `dofs[rep[k]]`, in the directions of its basis.
