@@ -3,6 +3,7 @@
 //! the net's meta, the CLI table and the report; the study's account of error kept and cost
 //! saved; bad input refused.
 use assert_cmd::Command;
+use drape::kinematic::fabric_field::ShearField;
 use drape::study::speed_accuracy::SpeedAccuracy;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -154,7 +155,7 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
         dir.path(),
         "geometries/hemisphere/hemisphere-20k.obj",
         "materials/glass-plain-weave.toml",
-        "name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.004\ngrid = [41, 41]\nmaterial = \"card\"\nmethod = \"auto\"\ntolerance_deg = 0.01",
+        "name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.004\ngrid = [41, 41]\nmaterial = \"card\"\nmethod = \"auto\"\ntolerance_deg = 0.005",
     );
     let out = dir.path().join("run");
     drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
@@ -172,6 +173,32 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
     assert_eq!(net["method"], "mechanical");
     assert_eq!(net["meta"]["solver"]["converged"], true);
     assert_eq!(net["meta"]["method_choice"], *choice);
+
+    // The pressed drape's own spacing error: Richardson's estimate against the same ply pressed
+    // at twice the spacing, computed here from that drape run on its own.
+    let coarse_dir = dir.path().join("coarse");
+    std::fs::create_dir_all(&coarse_dir).unwrap();
+    let coarse_scene = scene(
+        &coarse_dir,
+        "geometries/hemisphere/hemisphere-20k.obj",
+        "materials/glass-plain-weave.toml",
+        "name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = 0.008\ngrid = [21, 21]\nmaterial = \"card\"\nmethod = \"mechanical\"",
+    );
+    drape().arg("run").arg(&coarse_scene).arg("--out").arg(coarse_dir.join("run")).assert().success();
+    let fine = ShearField::of(&drape::io::read_net(&out.join("p0.drape.json")).unwrap());
+    let coarse = ShearField::of(&drape::io::read_net(&coarse_dir.join("run").join("p0.drape.json")).unwrap());
+    let largest = fine
+        .complete_cell_centres()
+        .into_iter()
+        .filter_map(|(u, v)| Some((fine.at(u, v)? - coarse.at(u, v)?).abs()))
+        .fold(0.0, f64::max);
+    let estimate = choice["indicators"]["mechanical_discretisation_deg"].as_f64().unwrap();
+    assert!(largest > 0.0);
+    assert!((estimate - largest / 3.0).abs() <= 1e-9 * largest, "{estimate} against {largest} / 3");
+    // Above the 0.005 deg tolerance (0.008 deg): said, with the spacing that would do (order 2).
+    let needed = choice["indicators"]["mechanical_spacing_needed_m"].as_f64().unwrap();
+    assert!((needed - 0.004 * (0.005 / estimate).sqrt()).abs() < 1e-12, "{needed}");
+    assert!(reason.contains("NOT ASSURED at this spacing"), "{reason}");
 }
 
 /// What auto keeps is within its tolerance of what mechanics gives: the hemisphere's first ply,

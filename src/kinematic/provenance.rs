@@ -97,6 +97,16 @@ pub struct ChoiceIndicators {
     /// The spacing that error estimate asks for to stay within its share of the tolerance, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing_needed_m: Option<f64>,
+    /// Where mechanics ran: the pressed drape's own estimated largest cell-shear error from its
+    /// spacing, degrees, by the same estimate from the pressed drape at twice the spacing
+    /// (absent when mechanics did not run or that drape did not converge).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanical_discretisation_deg: Option<f64>,
+    /// The spacing that estimate asks for to keep the pressed drape within the tolerance, m
+    /// (present only when the ply's spacing is too coarse; mechanics does not run finer by
+    /// itself).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanical_spacing_needed_m: Option<f64>,
     /// Largest cell-shear change of the steps of the mechanical model from the kinematic net
     /// until the nodes settle, degrees: how far the kinematic net lies from equilibrium under
     /// the ply's card (absent when no step could be taken).

@@ -136,14 +136,56 @@ pub fn drape_auto(
     auto: AutoModel,
 ) -> Result<AutoResult, AutoError> {
     let surfaces = Surfaces::new(surface);
-    let a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
+    let mut a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
     let refined = if a.mechanical() {
         let start = a.start.as_deref().unwrap_or(&a.net.positions);
-        Some(refinement.run_from(&a.net, start, surface, surfaces.for_refinement(refinement))?)
+        let refined = refinement.run_from(&a.net, start, surface, surfaces.for_refinement(refinement))?;
+        let t = Instant::now();
+        weigh_mechanical_spacing(&surfaces, settings, refinement, &refined.0, &mut a.choice);
+        a.choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
+        Some(refined)
     } else {
         None
     };
     Ok(AutoResult { kinematic: a.net, refined, choice: a.choice })
+}
+
+/// Mechanics ran at the ply's spacing: estimates the pressed drape's own spacing error from the
+/// same drape at twice the spacing (order 2, as the kinematic net's) and says in the choice
+/// whether the tolerance holds. The ply is not refined further by itself: mechanics at d/k
+/// costs k^2 the nodes and more iterations (the reason gives the spacing that would do).
+fn weigh_mechanical_spacing(
+    surfaces: &Surfaces,
+    settings: &KinematicSettings,
+    refinement: &Refinement,
+    refined: &DrapeNet,
+    choice: &mut MethodChoice,
+) {
+    let tolerance = choice.tolerance_deg;
+    let coarse = surfaces
+        .drape(&settings.at_spacing(2.0 * settings.spacing))
+        .ok()
+        .and_then(|net| refinement.run(&net, surfaces.tool, surfaces.for_refinement(refinement)).ok())
+        .filter(|(_, r)| r.ok());
+    let Some(e) = coarse.and_then(|(net, _)| richardson(refined, &net)) else {
+        choice.reason.push_str(
+            "; the pressed drape's own spacing error could not be estimated (the pressed drape at twice the spacing did not converge or has no cell to compare)",
+        );
+        return;
+    };
+    choice.indicators.mechanical_discretisation_deg = Some(e);
+    if e <= tolerance {
+        choice.reason.push_str(&format!(
+            "; the pressed drape's own spacing error is estimated at {e:.3} deg (against the same drape at twice the spacing): within the tolerance"
+        ));
+    } else {
+        let d = settings.spacing;
+        let needed = d * (tolerance / e).powf(1.0 / FISHNET_ORDER);
+        choice.indicators.mechanical_spacing_needed_m = Some(needed);
+        choice.reason.push_str(&format!(
+            "; the pressed drape's own spacing error is estimated at {e:.2} deg (against the same drape at twice the spacing), above the {tolerance} deg tolerance: NOT ASSURED at this spacing; give spacing <= {needed:.4} m for it (mechanics at d/k costs k^2 the nodes, so auto does not refine it by itself)"
+        ));
+    }
 }
 
 /// Drape `settings` on `surfaces` and choose its model (see the module doc). `refinement` is the
@@ -255,7 +297,7 @@ pub fn choose(
         // Mechanics at a finer spacing costs the square of the refinement in nodes and more
         // iterations: it runs at the ply's spacing, and the estimate is reported.
         reason.push_str(&format!(
-            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics runs at the ply's spacing, so the tolerance is not assured: the pressed drape has a spacing error of its own",
+            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics runs at the ply's spacing",
             discretisation.unwrap_or_default()
         ));
     } else if let Some(needed) = spacing_needed {
@@ -304,7 +346,14 @@ pub fn choose(
 /// its spacing, degrees: against the net at twice the spacing at `net`'s complete cell centres.
 fn discretisation_error(surfaces: &Surfaces, settings: &KinematicSettings, net: &DrapeNet) -> Option<f64> {
     let coarse = surfaces.drape(&settings.at_spacing(2.0 * settings.spacing)).ok()?;
-    let (fine, coarse) = (ShearField::of(net), ShearField::of(&coarse));
+    richardson(net, &coarse)
+}
+
+/// Richardson's estimate of the largest cell-shear error of `fine` against `coarse`, the same
+/// drape at twice the spacing, degrees: their largest difference at `fine`'s complete cell
+/// centres over 2^p - 1 (p = [`FISHNET_ORDER`]).
+fn richardson(fine: &DrapeNet, coarse: &DrapeNet) -> Option<f64> {
+    let (fine, coarse) = (ShearField::of(fine), ShearField::of(coarse));
     let largest = fine
         .complete_cell_centres()
         .into_iter()
