@@ -142,3 +142,30 @@ fn free_drape_never_leaves_a_node_inside_the_tool() {
         }
     }
 }
+
+/// A pressed refinement whose subproblems have more than 20 k variables (until 2026-11-24 faer
+/// factorised those on all threads, summing in another order, and the result moved in its last
+/// digits with the thread count) gives the same net, bit for bit, on one thread and on two.
+#[test]
+fn a_large_pressed_refinement_is_the_same_on_one_thread_and_on_two() {
+    let tool = shapes::hemisphere_with_triangles(1.0, 2000).into_surface().unwrap();
+    let (n, half) = (131, 65);
+    let d = std::f64::consts::FRAC_PI_2 / half as f64 * 0.999;
+    let net =
+        drape(&tool, &KinematicSettings::grid("h", Point::new(0.0, 0.0, 1.0), Vector::new(1.0, 0.0, 0.0), d, n, n))
+            .unwrap();
+    let placed = net.status.iter().filter(|s| **s == NodeStatus::Placed).count();
+    assert!(2 * placed > 20_000, "{placed} placed nodes: too few for a large subproblem");
+    let glass = card("glass-plain-weave.toml");
+    let settings = RefineSettings {
+        solver: SolverSettings::default().max_iterations(20).stability_check(false),
+        ..RefineSettings::default()
+    };
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| refine(&net, &tool, &glass, &settings).unwrap())
+    };
+    let (one, two) = (on(1), on(2));
+    assert!(one.ok(), "{:?}", one.outcome());
+    assert_eq!(one.net.positions, two.net.positions, "bit for bit");
+}

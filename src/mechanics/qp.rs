@@ -27,13 +27,6 @@ type Source = (u32, u32, u8, u8);
 /// beyond it means the model is too near singular for its step to be trusted.
 const MODEL_SOLVE_ACCURACY: f64 = 1e-6;
 
-/// Subproblems with at least this many variables are factorised on all threads. Below it faer's
-/// threads cost more in waking and yielding than they save on two cores: the 91 x 91 sphere
-/// drape (25 k variables) took 43 s with one thread against 48 s with two (10 s of system time
-/// in `sched_yield`); the 301 x 301 bench (124 k) is the same either way, the hat box (22 k)
-/// too.
-const PARALLEL_FACTORISATION_MIN: usize = 100_000;
-
 /// The reduced variables: node k's components start at `offset[rep[k]]` and number
 /// `dofs[rep[k]]`, in the directions of its basis.
 ///
@@ -398,7 +391,7 @@ impl QpEngine {
         Self::default()
     }
 
-    fn settings(n: usize) -> DefaultSettings<f64> {
+    fn settings() -> DefaultSettings<f64> {
         DefaultSettingsBuilder::default()
             .verbose(false)
             .max_iter(50)
@@ -408,9 +401,12 @@ impl QpEngine {
             .presolve_enable(false)
             .input_sparse_dropzeros(false)
             .direct_solve_method("faer".to_string())
-            // Threads only pay for large factorisations; on small ones they cost more in
-            // switching than they save.
-            .max_threads(if n >= PARALLEL_FACTORISATION_MIN { 0 } else { 1 })
+            // One thread: the factorisation's result then does not depend on the thread count
+            // (faer's parallel supernodes sum in another order: the sphere drape's energy moved
+            // in its last digit), and on two cores its threads cost more than they gave (the
+            // 91 x 91 sphere drape, 25 k variables: 43 s on one thread against 48 s on two, 10 s
+            // of system time in `sched_yield`; the 301 x 301 bench, 124 k: 4-8% slower on one).
+            .max_threads(1)
             .build()
             .expect("valid Clarabel settings")
     }
@@ -463,7 +459,7 @@ impl QpEngine {
             // factorisation it holds.
             let (_, solver) = self.cached.as_mut().expect("checked");
             solver.update_q(&q.to_vec()).map_err(|_| QpFailure::Setup)?;
-            let mut settings = Self::settings(n);
+            let mut settings = Self::settings();
             settings.iterative_refinement_enable = refine;
             let ok = solver.kktsystem.solve_initial_point(&mut solver.variables, &solver.data, &settings);
             let mut y = solver.variables.x.clone();
@@ -483,7 +479,7 @@ impl QpEngine {
             let p = red.matrix(values);
             let a = CscMatrix::new(0, n, vec![0; n + 1], Vec::new(), Vec::new());
             let cones: Vec<SupportedConeT<f64>> = Vec::new();
-            let solver = DefaultSolver::new(&p, q, &a, &[], &cones, Self::settings(n)).map_err(|_| QpFailure::Setup)?;
+            let solver = DefaultSolver::new(&p, q, &a, &[], &cones, Self::settings()).map_err(|_| QpFailure::Setup)?;
             self.cached = Some((red.key().to_vec(), solver));
         }
         let (_, solver) = self.cached.as_mut().expect("a solver is cached");
@@ -492,7 +488,7 @@ impl QpEngine {
         // refinement). Its termination test can still refuse that point where the model is
         // nearly singular and then fails an interior-point iteration it cannot use (1.5 s on
         // 124 k unknowns, and the solver discarded); the step's accuracy is judged here instead.
-        let settings = Self::settings(n);
+        let settings = Self::settings();
         let factorised = solver.kktsystem.update(&solver.data, &solver.cones, &settings);
         if !factorised {
             return Err(QpFailure::NotSolved("the factorisation failed (a singular model)".into()));
