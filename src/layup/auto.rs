@@ -162,12 +162,18 @@ fn weigh_mechanical_spacing(
     choice: &mut MethodChoice,
 ) {
     let tolerance = choice.tolerance_deg;
+    // Only its positions count: no stability check and no record (the ply's other settings,
+    // escapes included, kept so that it is the same drape at 2d).
+    let mut solve = refinement.settings();
+    solve.solver.stability_check = false;
     let coarse = surfaces
         .drape(&settings.at_spacing(2.0 * settings.spacing))
         .ok()
-        .and_then(|net| refinement.run(&net, surfaces.tool, surfaces.for_refinement(refinement)).ok())
-        .filter(|(_, r)| r.ok());
-    let Some(e) = coarse.and_then(|(net, _)| richardson(refined, &net)) else {
+        .and_then(|net| {
+            refine_on(&net, surfaces.tool, surfaces.for_refinement(refinement), &refinement.material, &solve).ok()
+        })
+        .filter(Refined::ok);
+    let Some(e) = coarse.and_then(|r| richardson(refined, &r.net)) else {
         choice.reason.push_str(
             "; the pressed drape's own spacing error could not be estimated (the pressed drape at twice the spacing did not converge or has no cell to compare)",
         );
