@@ -175,10 +175,24 @@ impl TriangleBvh {
     /// The triangle of smallest `distance2(t)` (a squared distance from `p`, at least the
     /// squared distance from `p` to the triangle's box up to rounding), the lowest index among
     /// equal ones, and that value. `None` only for a tree without triangles.
-    pub(crate) fn closest(&self, p: &Point, distance2: impl Fn(u32) -> f64) -> Option<(u32, f64)> {
+    /// `hint`, if given, is taken as the best so far (the nearest triangle before a small move of
+    /// the point: most boxes are then pruned at once); the answer does not depend on it, since
+    /// the bound only ever prunes boxes farther than a triangle already found.
+    pub(crate) fn closest_from(
+        &self,
+        p: &Point,
+        hint: Option<u32>,
+        distance2: impl Fn(u32) -> f64,
+    ) -> Option<(u32, f64)> {
         let mut best: Option<(u32, f64)> = None;
         // Boxes farther than this squared distance cannot hold a triangle as close as the best.
         let mut bound = f64::INFINITY;
+        if let Some(t) = hint.filter(|&t| (t as usize) < self.boxes.len()) {
+            let d = distance2(t);
+            best = Some((t, d));
+            let r = d.sqrt() + self.slack;
+            bound = if r.is_nan() { f64::INFINITY } else { r * r };
+        }
         let mut stack = [0u32; STACK];
         let mut top = 1;
         while top > 0 {
@@ -386,7 +400,11 @@ mod tests {
                 })
                 .collect();
             for tree in &trees {
-                assert_eq!(tree.closest(&p, |t| d2(t, &p)), Some(brute), "point {p:?}");
+                assert_eq!(tree.closest_from(&p, None, |t| d2(t, &p)), Some(brute), "point {p:?}");
+                // Whatever facet the search starts from, the same answer.
+                for hint in [0, q % tris.len() as u32, brute.0, tris.len() as u32 - 1] {
+                    assert_eq!(tree.closest_from(&p, Some(hint), |t| d2(t, &p)), Some(brute), "point {p:?}");
+                }
                 assert_eq!(tree.meeting(&lo, &hi), near);
                 assert_eq!(tree.any_meeting(&lo, &hi), !near.is_empty());
             }
@@ -397,7 +415,10 @@ mod tests {
         let ties: Vec<u32> = (0..tris.len() as u32).filter(|&t| d2(t, &p) == 0.0625).collect();
         assert!(ties.len() > 1, "{ties:?}");
         for tree in &trees {
-            assert_eq!(tree.closest(&p, |t| d2(t, &p)).unwrap().0, ties[0]);
+            assert_eq!(tree.closest_from(&p, None, |t| d2(t, &p)).unwrap().0, ties[0]);
+            for &hint in &ties {
+                assert_eq!(tree.closest_from(&p, Some(hint), |t| d2(t, &p)).unwrap().0, ties[0]);
+            }
         }
     }
 

@@ -27,6 +27,7 @@ use super::{Point, Vector, NO_NEIGHBOUR};
 use nalgebra::{Matrix2, Matrix3, Vector2};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use std::sync::OnceLock;
 
 /// Edges whose facets meet at more than this angle (between normals) are sharp tool edges: the
 /// smooth surface keeps them sharp (the facets on either side belong to different regions).
@@ -47,6 +48,9 @@ const BOUNDARY_TOLERANCE_REL: f64 = 1e-12;
 const CREASE_OVERSHOOT_BARYCENTRIC: f64 = 1e-9;
 /// Relative ridge added to the curvature fit (sectors with too few neighbours fit flat).
 const CURVATURE_FIT_RIDGE: f64 = 1e-6;
+/// A facet's sector list ([`SmoothSurface::near_facet`]) serves points within its bounding box
+/// grown by this fraction of its longest edge: the projections of nodes on or next to it.
+const FACET_REACH_OVER_EDGE: f64 = 0.25;
 
 /// A point on the smooth surface: where it is, the facet nearest to it (and where on it), and the
 /// surface's unit normal there (on the tool's outer side, like the facet normals).
@@ -94,6 +98,10 @@ pub struct SmoothSurface<'a> {
     /// Bounding boxes of the sectors' supports.
     bvh: Bvh,
     creases: usize,
+    /// Per facet, gathered when first asked: its bounding box grown by
+    /// [`FACET_REACH_OVER_EDGE`] and the sectors whose supports meet it, in the BVH's order (a
+    /// projection's points then need no search: the BVH query costs more than the sums).
+    near_facet: Vec<OnceLock<(Aabb, Box<[u32]>)>>,
 }
 
 /// Wendland's C2 function on [0, 1] and its derivative: (1 - r)^4 (4 r + 1).
@@ -214,7 +222,32 @@ impl<'a> SmoothSurface<'a> {
         let boxes: Vec<Aabb> =
             sectors.iter().map(|s| Aabb::new(s.x - Vector::repeat(s.h), s.x + Vector::repeat(s.h))).collect();
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
-        SmoothSurface { tool, sectors, regions, bvh, creases }
+        let near_facet = (0..tris.len()).map(|_| OnceLock::new()).collect();
+        SmoothSurface { tool, sectors, regions, bvh, creases, near_facet }
+    }
+
+    /// The sectors whose supports may hold `p`, found next to facet `t`: the facet's own list
+    /// when `p` lies in its box (a superset of what a search at `p` finds, in the same order, so
+    /// sums agree to the bit), None when `p` is further off.
+    fn near_facet(&self, t: u32, p: &Point) -> Option<&[u32]> {
+        let (bounds, sectors) = self.near_facet[t as usize].get_or_init(|| {
+            let c = self.tool.corners(t);
+            let longest = (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max);
+            let grow = Vector::repeat(FACET_REACH_OVER_EDGE * longest);
+            let lo = c[0].inf(&c[1]).inf(&c[2]) - grow;
+            let hi = c[0].sup(&c[1]).sup(&c[2]) + grow;
+            let bounds = Aabb::new(lo, hi);
+            (bounds, self.bvh.intersect_aabb(&bounds).collect())
+        });
+        bounds.contains_local_point(p).then_some(&sectors[..])
+    }
+
+    /// [`SmoothSurface::curvature`] at `p` next to facet `t` (see [`SmoothSurface::near_facet`]).
+    pub fn curvature_near(&self, region: u32, t: u32, p: &Point) -> Matrix3<f64> {
+        match self.near_facet(t, p) {
+            Some(candidates) => curvature_of(self.evaluate_among(candidates.iter().copied(), region, p, true)),
+            None => self.curvature(region, p),
+        }
     }
 
     /// The faceted tool underneath.
@@ -336,6 +369,17 @@ impl<'a> SmoothSurface<'a> {
         self.project_inner(q, foot, true)
     }
 
+    /// [`SmoothSurface::project_from`], and the curvature there if `curved`.
+    pub fn project_from_curved_if(
+        &self,
+        q: &Point,
+        foot: &SurfacePoint,
+        curved: bool,
+    ) -> (SmoothPoint, Option<Matrix3<f64>>) {
+        let (point, curvature) = self.project_inner(q, foot, curved);
+        (point, curved.then_some(curvature))
+    }
+
     fn project_inner(&self, q: &Point, foot: &SurfacePoint, curved: bool) -> (SmoothPoint, Matrix3<f64>) {
         let region = self.regions[foot.triangle as usize];
         let l = self.tool.barycentric(foot.triangle, &foot.point);
@@ -356,7 +400,10 @@ impl<'a> SmoothSurface<'a> {
         let mut reach = tol;
         let mut near = NearSectors::default();
         for _ in 0..PROJECTION_MAX_ITERATIONS {
-            let candidates = near.around(self, &p, reach);
+            let candidates = match self.near_facet(foot.triangle, &p) {
+                Some(c) => c,
+                None => near.around(self, &p, reach),
+            };
             let Some((f, g, _)) = self.evaluate_among(candidates.iter().copied(), region, &p, false) else {
                 if restarted {
                     break;
@@ -396,7 +443,10 @@ impl<'a> SmoothSurface<'a> {
             && off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
             && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
         let curvature = if curved {
-            let candidates = near.around(self, &p, reach);
+            let candidates = match self.near_facet(foot.triangle, &p) {
+                Some(c) => c,
+                None => near.around(self, &p, reach),
+            };
             curvature_of(self.evaluate_among(candidates.iter().copied(), region, &p, true))
         } else {
             Matrix3::zeros()

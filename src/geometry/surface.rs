@@ -209,9 +209,15 @@ impl ToolSurface {
     /// The closest point of the tool to `p`: on the facet nearest to `p`, and among facets at
     /// exactly the same distance the one of lowest index (whatever the BVH's shape).
     pub fn closest_point(&self, p: &Point) -> SurfacePoint {
+        self.closest_point_from(p, None)
+    }
+
+    /// [`ToolSurface::closest_point`], the search starting from facet `hint` (the facet nearest
+    /// to where the point was before a small move: faster, the same answer).
+    pub fn closest_point_from(&self, p: &Point, hint: Option<u32>) -> SurfacePoint {
         let (triangle, _) = self
             .bvh
-            .closest(p, |t| (self.project_to_triangle(t, p) - p).norm_squared())
+            .closest_from(p, hint, |t| (self.project_to_triangle(t, p) - p).norm_squared())
             .expect("a tool surface has triangles");
         let point = self.project_to_triangle(triangle, p);
         SurfacePoint { point, triangle, normal: self.normal(triangle), distance: (point - p).norm() }

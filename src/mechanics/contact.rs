@@ -17,58 +17,88 @@ pub struct Foot {
     /// Signed distance of the query point from the surface along `normal` (negative inside).
     pub gap: f64,
     /// The surface's curvature there: a point moved by a tangent vector t stays on the surface
-    /// by moving `-1/2 t^T curvature t` along the normal (zero on flat facets).
-    pub curvature: Matrix3<f64>,
+    /// by moving `-1/2 t^T curvature t` along the normal (zero on flat facets). None when not
+    /// asked for ([`ContactSurface::curve`] fills it in).
+    pub curvature: Option<Matrix3<f64>>,
+    /// The part of the surface the point is on (a [`SmoothSurface`] region; 0 on facets).
+    pub region: u32,
+    /// The tool's facet nearest to the query.
+    pub facet: u32,
+}
+
+impl Foot {
+    /// The curvature, which must have been computed.
+    pub fn curvature(&self) -> &Matrix3<f64> {
+        self.curvature.as_ref().expect("the feet of a state have their curvature")
+    }
 }
 
 /// A surface the nodes are held against (pressed) or kept out of (free).
 pub trait ContactSurface: Sync {
-    /// Where `p` meets the surface.
-    fn locate(&self, p: &Point) -> Foot;
+    /// Where `p` meets the surface; with its curvature if `curved` (trial states, which only
+    /// need their energy, skip it: on a smooth tool it costs as much as the rest). `hint`: the
+    /// facet of the point's last foot, where the search for the nearest facet starts (the same
+    /// answer, found faster after a small move).
+    fn locate(&self, p: &Point, curved: bool, hint: Option<u32>) -> Foot;
     /// Where `p` meets the surface if it is within `range` of it (a cheap test first).
-    fn locate_near(&self, p: &Point, range: f64) -> Option<Foot>;
+    fn locate_near(&self, p: &Point, range: f64, curved: bool, hint: Option<u32>) -> Option<Foot>;
+    /// Computes the curvature of a foot found without it.
+    fn curve(&self, foot: &mut Foot);
 }
 
 impl ContactSurface for ToolSurface {
-    fn locate(&self, p: &Point) -> Foot {
-        let s = self.closest_point(p);
+    fn curve(&self, foot: &mut Foot) {
+        foot.curvature.get_or_insert_with(Matrix3::zeros);
+    }
+    fn locate(&self, p: &Point, _curved: bool, hint: Option<u32>) -> Foot {
+        let s = self.closest_point_from(p, hint);
         let l = self.barycentric(s.triangle, &s.point);
         Foot {
             point: s.point,
             normal: s.normal,
             open_edges: self.open_edges_at(s.triangle, &l),
             gap: s.normal.dot(&(p - s.point)),
-            curvature: Matrix3::zeros(),
+            curvature: Some(Matrix3::zeros()),
+            region: 0,
+            facet: s.triangle,
         }
     }
-    fn locate_near(&self, p: &Point, range: f64) -> Option<Foot> {
-        let foot = self.locate(p);
+    fn locate_near(&self, p: &Point, range: f64, curved: bool, hint: Option<u32>) -> Option<Foot> {
+        let foot = self.locate(p, curved, hint);
         ((p - foot.point).norm() <= range).then_some(foot)
     }
 }
 
 impl ContactSurface for SmoothSurface<'_> {
-    fn locate(&self, p: &Point) -> Foot {
-        let (s, curvature) = self.project_curved(p);
+    fn curve(&self, foot: &mut Foot) {
+        if foot.curvature.is_none() {
+            foot.curvature = Some(self.curvature_near(foot.region, foot.facet, &foot.point));
+        }
+    }
+    fn locate(&self, p: &Point, curved: bool, hint: Option<u32>) -> Foot {
+        let facet = self.tool().closest_point_from(p, hint);
+        let (s, curvature) = self.project_from_curved_if(p, &facet, curved);
         Foot {
             point: s.point,
             normal: s.normal,
             open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric),
             gap: s.normal.dot(&(p - s.point)),
             curvature,
+            region: s.region,
+            facet: s.triangle,
         }
     }
-    fn locate_near(&self, p: &Point, range: f64) -> Option<Foot> {
+    fn locate_near(&self, p: &Point, range: f64, curved: bool, hint: Option<u32>) -> Option<Foot> {
         // The surface stays within a sagitta of the facets: test against the facets first, by
         // bounding boxes, then by distance.
         if !self.tool().any_triangle_near(p, 2.0 * range) {
             return None;
         }
-        let facet = self.tool().closest_point(p);
+        let facet = self.tool().closest_point_from(p, hint);
         if facet.distance > 2.0 * range {
             return None;
         }
-        let (s, curvature) = self.project_from_curved(p, &facet);
+        let (s, curvature) = self.project_from_curved_if(p, &facet, curved);
         let open_edges = self.tool().open_edges_at(s.triangle, &s.barycentric);
         if s.beyond_boundary || s.beyond_region {
             // Past the tool's open edge, or past a sharp edge of the region the nearest tool is the edge itself: the point is
@@ -79,10 +109,20 @@ impl ContactSurface for SmoothSurface<'_> {
                 normal,
                 open_edges,
                 gap: facet.distance,
-                curvature: Matrix3::zeros(),
+                curvature: Some(Matrix3::zeros()),
+                region: s.region,
+                facet: s.triangle,
             });
         }
-        Some(Foot { point: s.point, normal: s.normal, open_edges, gap: s.normal.dot(&(p - s.point)), curvature })
+        Some(Foot {
+            point: s.point,
+            normal: s.normal,
+            open_edges,
+            gap: s.normal.dot(&(p - s.point)),
+            curvature,
+            region: s.region,
+            facet: s.triangle,
+        })
     }
 }
 
@@ -206,7 +246,9 @@ impl Freedom {
                 normal: Vector::z(),
                 open_edges: [None; 2],
                 gap: 0.0,
-                curvature: Matrix3::zeros(),
+                curvature: Some(Matrix3::zeros()),
+                region: 0,
+                facet: 0,
             })
         };
         // The open edges the node is pushed over, as outward directions in the tangent plane.

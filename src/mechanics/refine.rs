@@ -289,7 +289,7 @@ pub fn refine_from<L: Laws + ?Sized>(
     let (i0, j0) = kinematic.origin_node;
     let origin = kinematic.index(i0, j0);
     let warp_neighbour = (i0 + 1 < kinematic.nu).then(|| kinematic.index(i0 + 1, j0)).filter(|&k| active[k]);
-    let n0 = surface.locate(&x[origin]).normal;
+    let n0 = surface.locate(&x[origin], false, None).normal;
     let plane_normal = warp_neighbour.and_then(|k| (x[k] - x[origin]).cross(&n0).try_normalize(1e-12));
     let freedom: Vec<Freedom> = (0..active.len())
         .map(|k| match (active[k] && k != origin, settings.mode, plane_normal.filter(|_| Some(k) == warp_neighbour)) {

@@ -366,7 +366,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         // Start outside the tool: nodes given inside it (a net draped on the facets is inside
         // the smooth surface wherever that bulges out) are put on its surface.
         let zero = vec![Vector::zeros(); n];
-        let (outside, _) = moved(cons, x, &zero, &vec![false; n]);
+        let (outside, _) = moved(cons, x, &zero, &vec![false; n], &vec![None; n]);
         x.copy_from_slice(&outside);
     }
     let mut state = {
@@ -548,7 +548,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             };
             let delta = red.expand(&y, &state.bases);
             let t_trial = std::time::Instant::now();
-            let (trial, trial_feet) = moved(cons, x, &delta, &state.sliding);
+            let (trial, trial_feet) = moved(cons, x, &delta, &state.sliding, &state.feet);
             let e1 = objective.energy(&trial);
             trial_ms += t_trial.elapsed().as_secs_f64() * 1e3;
             let fall = state.eval.energy - e1;
@@ -594,7 +594,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     if let Ok(z) = engine.solve(&red, &values, &g2) {
                         let (z, _) = cap_step(&red, z, &state.bases, reach * cons.spacing);
                         let dz = red.expand(&z, &state.bases);
-                        let (trial2, feet2) = moved(cons, &trial, &dz, &state.sliding);
+                        let (trial2, feet2) = moved(cons, &trial, &dz, &state.sliding, &state.feet);
                         let e2 = objective.energy(&trial2);
                         let fall2 = state.eval.energy - e2;
                         if acceptable(fall2, predicted, noise) {
@@ -854,7 +854,7 @@ fn escape_move(
             .into_iter()
             .map(|sign| {
                 let d: Vec<Vector> = delta.iter().map(|d| d * (sign * size / largest)).collect();
-                let (trial, feet) = moved(cons, x, &d, &s.sliding);
+                let (trial, feet) = moved(cons, x, &d, &s.sliding, &s.feet);
                 let e = objective.energy(&trial);
                 (trial, feet, e)
             })
@@ -886,7 +886,7 @@ fn extend_step(
     while largest * factor * 2.0 <= cap {
         factor *= 2.0;
         let step: Vec<f64> = y.iter().map(|v| v * factor).collect();
-        let (trial, feet) = moved(cons, x, &red.expand(&step, &s.bases), &s.sliding);
+        let (trial, feet) = moved(cons, x, &red.expand(&step, &s.bases), &s.sliding, &s.feet);
         let fall = s.eval.energy - objective.energy(&trial);
         if fall <= best.2 {
             break;
@@ -952,10 +952,17 @@ fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
         .par_iter()
         .zip(known)
         .enumerate()
-        .map(|(k, (f, known))| match (cons.mode, f) {
-            (ContactMode::Pressed, f) if f.on_tool() => known.or_else(|| Some(tool.locate(&x[k]))),
-            (ContactMode::Free, f) if f.dofs() > 0 => known.or_else(|| tool.locate_near(&x[k], range)),
-            _ => None,
+        .map(|(k, (f, known))| {
+            let mut foot = match (cons.mode, f) {
+                (ContactMode::Pressed, f) if f.on_tool() => known.or_else(|| Some(tool.locate(&x[k], true, None))),
+                (ContactMode::Free, f) if f.dofs() > 0 => known.or_else(|| tool.locate_near(&x[k], range, true, None)),
+                _ => None,
+            };
+            // Feet found by a trial step come without their curvature: the state's model needs it.
+            if let Some(foot) = foot.as_mut() {
+                tool.curve(foot);
+            }
+            foot
         })
         .collect()
 }
@@ -1022,7 +1029,7 @@ fn add_contact_curvature(
             continue;
         }
         let b = basis.basis;
-        let mut m = b.transpose() * foot.curvature * b * (-g[k].dot(&foot.normal));
+        let mut m = b.transpose() * foot.curvature() * b * (-g[k].dot(&foot.normal));
         if convex {
             m = clamp_to_psd(&m, basis.dofs);
         }
@@ -1070,7 +1077,7 @@ fn active_contacts(cons: &Constraints, s: &State) -> usize {
 
 /// The state `x + delta` with the nodes that slide on the tool moved back onto it and free
 /// nodes that would enter it put on its surface; returns the feet found.
-fn moved(cons: &Constraints, x: &[Point], delta: &[Vector], sliding: &[bool]) -> (Vec<Point>, Feet) {
+fn moved(cons: &Constraints, x: &[Point], delta: &[Vector], sliding: &[bool], feet: &Feet) -> (Vec<Point>, Feet) {
     let range = CONTACT_RANGE * cons.spacing;
     let mut out: Vec<Point> = x.iter().zip(delta).map(|(p, d)| p + d).collect();
     let Some(tool) = cons.tool else { return (out, vec![None; x.len()]) };
@@ -1078,14 +1085,15 @@ fn moved(cons: &Constraints, x: &[Point], delta: &[Vector], sliding: &[bool]) ->
         .par_iter_mut()
         .zip(&cons.freedom)
         .zip(sliding)
-        .map(|((p, f), &sliding)| match cons.mode {
+        .zip(feet)
+        .map(|(((p, f), &sliding), last)| match cons.mode {
             ContactMode::Pressed if f.on_tool() => {
-                let foot = tool.locate(p);
+                let foot = tool.locate(p, false, last.map(|l| l.facet));
                 *p = foot.point;
                 Some(Foot { gap: 0.0, ..foot })
             }
             ContactMode::Free if f.dofs() > 0 => {
-                let foot = tool.locate_near(p, range)?;
+                let foot = tool.locate_near(p, range, false, last.map(|l| l.facet))?;
                 if sliding || foot.gap < 0.0 {
                     *p = foot.point;
                     Some(Foot { gap: 0.0, ..foot })
