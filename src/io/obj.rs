@@ -462,7 +462,7 @@ fn quote(line: &str) -> String {
 /// degenerate ones, a face referring to a vertex the file does not have, and a used vertex
 /// with a non-finite coordinate.
 pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
-    let bytes = std::fs::read(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
+    let bytes = super::read::read_file(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
     // The pieces as they are: putting them together would copy every statement once more.
     let text = parse_pieces(&bytes, PIECE).map_err(|e| ToolError::Parse {
         path: path.into(),
