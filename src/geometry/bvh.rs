@@ -100,6 +100,9 @@ struct Node {
     hi: u32,
 }
 
+/// The boxes of a tool's triangles ([`TriangleBvh::boxes`]).
+pub(crate) struct TriangleBoxes(Vec<Box3>);
+
 /// The hierarchy (see the module documentation).
 #[derive(Debug, Clone)]
 pub(crate) struct TriangleBvh {
@@ -113,9 +116,22 @@ pub(crate) struct TriangleBvh {
 impl TriangleBvh {
     /// The hierarchy of `triangles` (corner indices into `vertices`, all valid).
     pub(crate) fn new(vertices: &[Point], triangles: &[[u32; 3]]) -> TriangleBvh {
+        TriangleBvh::from_boxes(TriangleBvh::boxes(vertices, triangles))
+    }
+
+    /// The boxes of `triangles`, for [`TriangleBvh::from_boxes`]: all that the hierarchy needs of
+    /// the triangles (so it is the same for triangles turned over).
+    pub(crate) fn boxes(vertices: &[Point], triangles: &[[u32; 3]]) -> TriangleBoxes {
         use rayon::prelude::*;
-        let boxes: Vec<Box3> =
-            triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect();
+        TriangleBoxes(
+            triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect(),
+        )
+    }
+
+    /// The hierarchy of the triangles of `boxes`.
+    pub(crate) fn from_boxes(boxes: TriangleBoxes) -> TriangleBvh {
+        use rayon::prelude::*;
+        let TriangleBoxes(boxes) = boxes;
         // Each triangle's centroid beside its index, so that the splits compare and move them
         // without looking anything up elsewhere in memory.
         let mut centroids: Vec<([f64; 3], u32)> = boxes
