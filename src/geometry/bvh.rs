@@ -8,10 +8,11 @@
 //! distance over all triangles; the box query's triangles come sorted by index. Pruning keeps
 //! a slack far above rounding, so a box is only skipped when none of its triangles can tie.
 //!
-//! The tree: triangles ordered by recursive median splits of their centroids along the longest
-//! axis (ties by index), the two halves of each split ordered in parallel; node `k` covers a
-//! range of that order, its children are nodes `2k + 1` and `2k + 2` (the two halves), and a
-//! range of at most [`LEAF`] triangles is a leaf.
+//! The tree: triangles ordered by recursive median splits of their centroids (rounded to `f32`
+//! after the lowest centroid is taken off) along the longest axis (ties by index), the two
+//! halves of each split ordered in parallel; node `k` covers a range of that order, its
+//! children are nodes `2k + 1` and `2k + 2` (the two halves), a range of at most [`LEAF`]
+//! triangles is a leaf, and the boxes are computed a depth at a time from the leaves up.
 use super::{Point, Vector};
 
 /// Most triangles in a leaf.
@@ -100,6 +101,9 @@ struct Node {
     hi: u32,
 }
 
+/// The boxes of a tool's triangles ([`TriangleBvh::boxes`]).
+pub(crate) struct TriangleBoxes(Vec<Box3>);
+
 /// The hierarchy (see the module documentation).
 #[derive(Debug, Clone)]
 pub(crate) struct TriangleBvh {
@@ -113,50 +117,81 @@ pub(crate) struct TriangleBvh {
 impl TriangleBvh {
     /// The hierarchy of `triangles` (corner indices into `vertices`, all valid).
     pub(crate) fn new(vertices: &[Point], triangles: &[[u32; 3]]) -> TriangleBvh {
+        TriangleBvh::from_boxes(TriangleBvh::boxes(vertices, triangles))
+    }
+
+    /// The boxes of `triangles`, for [`TriangleBvh::from_boxes`]: all that the hierarchy needs of
+    /// the triangles (so it is the same for triangles turned over).
+    pub(crate) fn boxes(vertices: &[Point], triangles: &[[u32; 3]]) -> TriangleBoxes {
         use rayon::prelude::*;
-        let boxes: Vec<Box3> =
-            triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect();
+        TriangleBoxes(
+            triangles.par_iter().with_min_len(PARALLEL).map(|t| Box3::of(&t.map(|i| vertices[i as usize]))).collect(),
+        )
+    }
+
+    /// The hierarchy of the triangles of `boxes`.
+    pub(crate) fn from_boxes(boxes: TriangleBoxes) -> TriangleBvh {
+        use rayon::prelude::*;
+        let TriangleBoxes(boxes) = boxes;
         // Each triangle's centroid beside its index, so that the splits compare and move them
-        // without looking anything up elsewhere in memory.
-        let mut centroids: Vec<([f64; 3], u32)> = boxes
+        // without looking anything up elsewhere in memory: as the bits of an `f32` of the
+        // centroid less the lowest centroid (not negative, so the bits are in the same order as
+        // the numbers), which halves what the splits move and makes their comparisons integer
+        // ones. Rounding makes a few ties more, broken by index like the others; the answers do
+        // not depend on the tree.
+        let centroid = |b: &Box3| -> [f64; 3] { std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a])) };
+        let lowest = boxes
+            .par_iter()
+            .with_min_len(PARALLEL)
+            .map(centroid)
+            .reduce(|| [f64::INFINITY; 3], |p, q| std::array::from_fn(|a| p[a].min(q[a])));
+        let mut centroids: Vec<([u32; 3], u32)> = boxes
             .par_iter()
             .with_min_len(PARALLEL)
             .enumerate()
-            .map(|(t, b)| (std::array::from_fn(|a| 0.5 * (b.min[a] + b.max[a])), t as u32))
+            .map(|(t, b)| {
+                let c = centroid(b);
+                (std::array::from_fn(|a| ((c[a] - lowest[a]) as f32).to_bits()), t as u32)
+            })
             .collect();
         split(&mut centroids);
         let order: Vec<u32> = centroids.par_iter().with_min_len(PARALLEL).map(|&(_, t)| t).collect();
         drop(centroids);
 
-        // Heap layout: node k has children 2k + 1 and 2k + 2; ranges first (top down), then
-        // boxes (bottom up).
+        // Heap layout: node k has children 2k + 1 and 2k + 2, the nodes of one depth side by side
+        // (depth d from 2^d - 1); each node's range from its place, then the boxes depth by depth
+        // from the leaves up, each depth in parallel.
         let n = order.len();
-        let mut size = 1;
+        let mut depths = 1;
         let mut longest = n;
         while longest > LEAF {
             longest = longest.div_ceil(2);
-            size = 2 * size + 1;
+            depths += 1;
         }
-        let empty = Node { bounds: Box3::EMPTY, lo: 0, hi: 0 };
-        let mut nodes = vec![empty; size];
-        nodes[0] = Node { bounds: Box3::EMPTY, lo: 0, hi: n as u32 };
-        for k in 0..size {
-            let Node { lo, hi, .. } = nodes[k];
-            if (hi - lo) as usize > LEAF {
-                let mid = lo + (hi - lo) / 2;
-                nodes[2 * k + 1] = Node { bounds: Box3::EMPTY, lo, hi: mid };
-                nodes[2 * k + 2] = Node { bounds: Box3::EMPTY, lo: mid, hi };
-            }
-        }
-        for k in (0..size).rev() {
-            let Node { lo, hi, .. } = nodes[k];
-            nodes[k].bounds = if hi == lo {
-                Box3::EMPTY
-            } else if (hi - lo) as usize <= LEAF {
-                order[lo as usize..hi as usize].iter().fold(Box3::EMPTY, |b, &t| b.union(&boxes[t as usize]))
-            } else {
-                nodes[2 * k + 1].bounds.union(&nodes[2 * k + 2].bounds)
-            };
+        let size = (1usize << depths) - 1;
+        let mut nodes: Vec<Node> = (0..size)
+            .into_par_iter()
+            .with_min_len(PARALLEL)
+            .map(|k| {
+                let (lo, hi) = node_range(k, n);
+                Node { bounds: Box3::EMPTY, lo, hi }
+            })
+            .collect();
+        for d in (0..depths).rev() {
+            let (upper, lower) = nodes.split_at_mut((1 << (d + 1)) - 1);
+            let first = (1usize << d) - 1;
+            upper[first..].par_iter_mut().with_min_len(PARALLEL).enumerate().for_each(|(i, node)| {
+                let Node { lo, hi, .. } = *node;
+                node.bounds = if hi == lo {
+                    Box3::EMPTY
+                } else if (hi - lo) as usize <= LEAF {
+                    order[lo as usize..hi as usize].iter().fold(Box3::EMPTY, |b, &t| b.union(&boxes[t as usize]))
+                } else {
+                    // Children 2k + 1 and 2k + 2 of node k = first + i, at 2i and 2i + 1 of the
+                    // next depth.
+                    lower[2 * i].bounds.union(&lower[2 * i + 1].bounds)
+                };
+            });
         }
         let root = nodes[0].bounds;
         let diagonal = (0..3).map(|a| (root.max[a] - root.min[a]).powi(2)).sum::<f64>().sqrt();
@@ -310,27 +345,49 @@ impl TriangleBvh {
     }
 }
 
-/// Order triangles (centroid, index) by recursive median splits of the centroids (see the
+/// The range of [`TriangleBvh::order`] that node `k` of a tree of `n` triangles covers: the
+/// root all, each child one half of its parent's (the first half the smaller), and (0, 0) below
+/// a leaf (at most [`LEAF`] triangles).
+fn node_range(k: usize, n: usize) -> (u32, u32) {
+    let (mut lo, mut hi) = (0, n as u32);
+    // The bits of k + 1 after its leading one: the way down from the root (0 left, 1 right).
+    let path = k + 1;
+    for bit in (0..path.ilog2()).rev() {
+        if (hi - lo) as usize <= LEAF {
+            return (0, 0);
+        }
+        let mid = lo + (hi - lo) / 2;
+        if (path >> bit) & 1 == 0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    (lo, hi)
+}
+
+/// Order triangles (centroid keys, index) by recursive median splits of the centroids (see the
 /// module documentation).
-fn split(order: &mut [([f64; 3], u32)]) {
+fn split(order: &mut [([u32; 3], u32)]) {
     if order.len() <= LEAF {
         return;
     }
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let (mut lo, mut hi) = ([u32::MAX; 3], [0u32; 3]);
     for (c, _) in order.iter() {
         for a in 0..3 {
             lo[a] = lo[a].min(c[a]);
             hi[a] = hi[a].max(c[a]);
         }
     }
+    let extent = |a: usize| f32::from_bits(hi[a]) - f32::from_bits(lo[a]);
     let mut axis = 0;
     for a in 1..3 {
-        if hi[a] - lo[a] > hi[axis] - lo[axis] {
+        if extent(a) > extent(axis) {
             axis = a;
         }
     }
     let mid = order.len() / 2;
-    order.select_nth_unstable_by(mid, |(c, s), (d, t)| c[axis].total_cmp(&d[axis]).then(s.cmp(t)));
+    order.select_nth_unstable_by_key(mid, |&(c, t)| (u64::from(c[axis]) << 32) | u64::from(t));
     let (left, right) = order.split_at_mut(mid);
     if left.len() + right.len() >= PARALLEL {
         rayon::join(|| split(left), || split(right));
@@ -363,6 +420,31 @@ mod tests {
             }
         }
         (v, t)
+    }
+
+    #[test]
+    fn node_ranges_are_the_halvings_from_the_root() {
+        // The ranges the tree was built with top down, node by node, before they were computed
+        // from each node's place.
+        for n in [0, 1, 4, 5, 8, 9, 17, 100, 1000, 4097] {
+            let mut size = 1;
+            let mut longest = n;
+            while longest > LEAF {
+                longest = longest.div_ceil(2);
+                size = 2 * size + 1;
+            }
+            let mut ranges = vec![(0u32, 0u32); size];
+            ranges[0] = (0, n as u32);
+            for k in 0..size {
+                let (lo, hi) = ranges[k];
+                if (hi - lo) as usize > LEAF {
+                    let mid = lo + (hi - lo) / 2;
+                    ranges[2 * k + 1] = (lo, mid);
+                    ranges[2 * k + 2] = (mid, hi);
+                }
+            }
+            assert_eq!((0..size).map(|k| node_range(k, n)).collect::<Vec<_>>(), ranges, "{n} triangles");
+        }
     }
 
     #[test]

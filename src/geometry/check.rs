@@ -45,7 +45,22 @@ pub fn mend(
     path: &Path,
     report: &mut MeshReport,
 ) -> Result<MendedMesh, ToolError> {
-    let TriangleMesh { vertices, triangles } = raw;
+    let TriangleMesh { vertices, triangles } = mend_faces(raw, weld_tolerance, path, report)?;
+    let (triangles, neighbours, _) = mend_edges(triangles, vertices.len(), report);
+    Ok(MendedMesh { vertices, triangles, neighbours })
+}
+
+/// The first stage of [`mend`]: weld the vertices, drop the degenerate faces and the vertices no
+/// kept face uses (kept vertices and faces in input order). The triangles' corners are the
+/// final ones up to the order [`mend_edges`] may turn them over in, and its dropping of
+/// duplicate faces. Done in place: the file's arrays become the mended ones.
+pub(crate) fn mend_faces(
+    raw: TriangleMesh,
+    weld_tolerance: f64,
+    path: &Path,
+    report: &mut MeshReport,
+) -> Result<TriangleMesh, ToolError> {
+    let TriangleMesh { mut vertices, mut triangles } = raw;
     let count = vertices.len();
     for (face, tri) in triangles.iter().enumerate() {
         if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
@@ -56,15 +71,14 @@ pub fn mend(
     let weld = weld_map(&vertices, weld_tolerance);
     report.vertices_welded = weld.iter().enumerate().filter(|&(i, &r)| r as usize != i).count();
 
-    // Faces: weld, drop degenerate ones (duplicates are found with the edges, below).
+    // Faces: weld, drop degenerate ones (duplicates are found with the edges, below); the kept
+    // ones moved to the front.
     let diagonal = bounding_diagonal(&vertices);
     let min_double_area = 2.0 * (DEGENERATE_AREA_REL * diagonal).powi(2);
-    let mut kept: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
-    let mut degenerate = 0;
-    for tri in &triangles {
-        let t = tri.map(|i| weld[i as usize]);
+    let mut kept = 0;
+    for k in 0..triangles.len() {
+        let t = triangles[k].map(|i| weld[i as usize]);
         if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-            degenerate += 1;
             continue;
         }
         let [a, b, c] = t.map(|i| vertices[i as usize]);
@@ -72,34 +86,51 @@ pub fn mend(
         let double_area2 = ab.cross(&ac).norm_squared();
         let longest = ab.norm_squared().max(ac.norm_squared()).max(bc.norm_squared());
         if !(double_area2 > min_double_area * min_double_area && double_area2 > (DEGENERATE_SINE * longest).powi(2)) {
-            degenerate += 1;
             continue;
         }
-        kept.push(t);
+        triangles[kept] = t;
+        kept += 1;
     }
-    report.degenerate_faces_dropped += degenerate;
-    if kept.is_empty() {
+    report.degenerate_faces_dropped += triangles.len() - kept;
+    triangles.truncate(kept);
+    drop(weld);
+    if triangles.is_empty() {
         return Err(ToolError::AllDegenerate { path: path.into() });
     }
 
-    // Keep used vertices only, in input order.
+    // Keep used vertices only, in input order (moved to the front: a vertex's new index is
+    // never above its old one).
     let mut new_index = vec![u32::MAX; count];
-    for t in &kept {
+    for t in &triangles {
         for &v in t {
             new_index[v as usize] = 0;
         }
     }
-    let mut out_vertices = Vec::new();
-    for (i, slot) in new_index.iter_mut().enumerate() {
-        if *slot == 0 {
-            *slot = out_vertices.len() as u32;
-            out_vertices.push(vertices[i]);
+    let mut used = 0;
+    for i in 0..count {
+        if new_index[i] == 0 {
+            new_index[i] = used as u32;
+            vertices[used] = vertices[i];
+            used += 1;
         }
     }
-    let mut tris: Vec<[u32; 3]> = kept.iter().map(|t| t.map(|v| new_index[v as usize])).collect();
-    drop(kept);
+    vertices.truncate(used);
+    for t in &mut triangles {
+        *t = t.map(|v| new_index[v as usize]);
+    }
+    Ok(TriangleMesh { vertices, triangles })
+}
 
-    let mut edges = adjacency(&tris, out_vertices.len());
+/// The second stage of [`mend`], on the triangles of [`mend_faces`] over `num_vertices`
+/// vertices: drop duplicate faces, build the edge adjacency, count boundary and non-manifold
+/// edges and orient the pieces. The triangles, their neighbours, and whether any duplicate was
+/// dropped (otherwise the triangles are those given, some turned over).
+pub(crate) fn mend_edges(
+    mut tris: Vec<[u32; 3]>,
+    num_vertices: usize,
+    report: &mut MeshReport,
+) -> (Vec<[u32; 3]>, Vec<[u32; 3]>, bool) {
+    let mut edges = adjacency(&tris, num_vertices);
     // Duplicate faces share all three edges, so the edge grouping finds them. Drop them (the
     // first in input order stays) and group the edges again.
     report.duplicate_faces_dropped = edges.duplicates.iter().filter(|&&d| d).count();
@@ -109,7 +140,7 @@ pub fn mend(
             t += 1;
             !edges.duplicates[t - 1]
         });
-        edges = adjacency(&tris, out_vertices.len());
+        edges = adjacency(&tris, num_vertices);
     }
     let Edges { mut neighbours, boundary, non_manifold, .. } = edges;
     report.boundary_edges = boundary;
@@ -119,8 +150,8 @@ pub fn mend(
     report.components = components;
     report.flipped_faces = flipped;
     report.triangles = tris.len();
-    report.vertices = out_vertices.len();
-    Ok(MendedMesh { vertices: out_vertices, triangles: tris, neighbours })
+    report.vertices = num_vertices;
+    (tris, neighbours, report.duplicate_faces_dropped > 0)
 }
 
 const NONE: u32 = u32::MAX;

@@ -1,7 +1,7 @@
 //! [`ToolSurface`]: a checked triangle mesh with a BVH ([`super::bvh`]), edge adjacency and
 //! per-triangle frames, answering the geometric queries the drape engine needs.
 use super::bvh::TriangleBvh;
-use super::check::{mend, MendedMesh, NO_NEIGHBOUR};
+use super::check::{mend_edges, mend_faces, NO_NEIGHBOUR};
 use super::mesh::{MeshReport, ToolError, TriangleMesh};
 use super::{Point, Vector};
 use std::path::Path;
@@ -119,20 +119,21 @@ impl ToolSurface {
     /// the surface: welding, degenerate and duplicate faces, adjacency, orientation
     /// ([`super::check::mend`]), then the BVH.
     pub fn from_mesh(mut raw: TriangleMesh, mut report: MeshReport, path: &Path) -> Result<Self, ToolError> {
+        use rayon::prelude::*;
         let diagonal = bounding_diagonal(&raw.vertices);
         snap_coordinates(&mut raw.vertices, diagonal);
-        let MendedMesh { vertices, triangles, neighbours } =
-            mend(raw, WELD_TOLERANCE_REL * diagonal, path, &mut report)?;
-        if triangles.is_empty() {
-            return Err(ToolError::AllDegenerate { path: path.into() });
-        }
+        let TriangleMesh { vertices, triangles } = mend_faces(raw, WELD_TOLERANCE_REL * diagonal, path, &mut report)?;
         // The BVH (built in parallel; its answers do not depend on its shape, see
-        // `geometry::bvh`) beside the per-triangle frames and spheres (each a pure function of
-        // its triangle, so the same whatever the thread count).
-        let (bvh, (frames, spheres)) = rayon::join(
-            || TriangleBvh::new(&vertices, &triangles),
+        // `geometry::bvh`) needs only the triangles' boxes, which turning triangles over does not
+        // change: it is built while the edges are grouped and the pieces oriented, and then
+        // beside the per-triangle frames and spheres (each a pure function of its triangle, so
+        // the same whatever the thread count). Only if duplicate faces were dropped (so the
+        // triangles are numbered anew) is it built again.
+        let boxes = TriangleBvh::boxes(&vertices, &triangles);
+        let (bvh, (triangles, neighbours, renumbered, frames, spheres)) = rayon::join(
+            || TriangleBvh::from_boxes(boxes),
             || {
-                use rayon::prelude::*;
+                let (triangles, neighbours, renumbered) = mend_edges(triangles, vertices.len(), &mut report);
                 let frames: Vec<TriangleFrame> = triangles
                     .par_iter()
                     .with_min_len(4096)
@@ -156,9 +157,10 @@ impl ToolSurface {
                         (c, r)
                     })
                     .collect();
-                (frames, spheres)
+                (triangles, neighbours, renumbered, frames, spheres)
             },
         );
+        let bvh = if renumbered { TriangleBvh::new(&vertices, &triangles) } else { bvh };
         report.triangles = triangles.len();
         report.vertices = vertices.len();
         Ok(ToolSurface { vertices, triangles, neighbours, frames, spheres, bvh, report, diagonal })
@@ -457,5 +459,72 @@ mod tests {
         let side = at(Point::new(1.2, 0.0, 0.0));
         assert_eq!(side.len(), 2);
         assert!(side.iter().all(|m| (m - Vector::x()).norm() < 1e-12), "{side:?}");
+    }
+
+    /// The BVH is built from the triangles before duplicates are dropped and pieces oriented:
+    /// its answers must be those of the final triangles (brute force), with and without
+    /// duplicate faces (which number the triangles anew) and on 1 and 3 threads.
+    #[test]
+    fn the_bvh_answers_for_the_mended_triangles() {
+        let n = 24;
+        let mut vertices = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                vertices.push(Point::new(x, y, 0.1 * (5.0 * x).sin() * (3.0 * y).cos()));
+            }
+        }
+        let at = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                // Every third triangle turned over, so that orienting the pieces flips some.
+                triangles.push(if (i + j) % 3 == 0 { [a, c, b] } else { [a, b, c] });
+                triangles.push([a, c, d]);
+            }
+        }
+        for duplicates in [false, true] {
+            let mut tris = triangles.clone();
+            // A degenerate face (dropped before the BVH is built).
+            tris.insert(7, [0, 0, 1]);
+            if duplicates {
+                tris.insert(100, tris[40]);
+                tris.push([tris[3][1], tris[3][2], tris[3][0]]);
+            }
+            for threads in [1, 3] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                let tool = pool.install(|| ToolSurface::from_triangles(vertices.clone(), tris.clone()).unwrap());
+                assert_eq!(tool.report().duplicate_faces_dropped, if duplicates { 2 } else { 0 });
+                assert_eq!(tool.report().degenerate_faces_dropped, 1);
+                assert!(tool.report().flipped_faces > 0);
+                assert_eq!(tool.num_triangles(), 2 * n * n);
+                for k in 0..300 {
+                    let f = k as f64;
+                    let p = Point::new(
+                        (f * 0.618).fract() * 1.2 - 0.1,
+                        (f * 0.382).fract() * 1.2 - 0.1,
+                        0.3 * (f * 0.7).sin(),
+                    );
+                    let brute = (0..tool.num_triangles() as u32)
+                        .map(|t| ((tool.project_to_triangle(t, &p) - p).norm_squared(), t))
+                        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+                        .unwrap();
+                    assert_eq!(tool.closest_point(&p).triangle, brute.1, "point {k}");
+                    let r = 0.05;
+                    let near: Vec<u32> = (0..tool.num_triangles() as u32)
+                        .filter(|&t| {
+                            let c = tool.corners(t);
+                            (0..3).all(|a| {
+                                let lo = c.iter().map(|q| q[a]).fold(f64::INFINITY, f64::min);
+                                let hi = c.iter().map(|q| q[a]).fold(f64::NEG_INFINITY, f64::max);
+                                lo <= p[a] + r && p[a] - r <= hi
+                            })
+                        })
+                        .collect();
+                    assert_eq!(tool.triangles_near(&p, r), near, "point {k}");
+                }
+            }
+        }
     }
 }

@@ -31,6 +31,7 @@ pub mod net;
 pub mod net_json;
 pub mod optistruct;
 pub mod points;
+mod read;
 pub mod rtmsim;
 pub(crate) mod shell_mesh;
 pub mod svg;

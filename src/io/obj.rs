@@ -462,15 +462,146 @@ fn quote(line: &str) -> String {
 /// degenerate ones, a face referring to a vertex the file does not have, and a used vertex
 /// with a non-finite coordinate.
 pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
-    let bytes = std::fs::read(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
+    let bytes = super::read::read_file(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
     // The pieces as they are: putting them together would copy every statement once more.
     let text = parse_pieces(&bytes, PIECE).map_err(|e| ToolError::Parse {
         path: path.into(),
         reason: if e.line == 0 { e.message } else { format!("line {}: {}", e.line, e.message) },
     })?;
+    drop(bytes);
+    let mut report = MeshReport { vertices_read: text.vertex_count(), ..Default::default() };
+    let mesh = tool_mesh(&text, path, &mut report)?;
+    Ok((mesh, report))
+}
+
+/// What [`tool_mesh`] finds in one piece's faces: the vertices its faces use first (before any
+/// other face of the piece), with where in the piece's corners, and its first corner naming a
+/// vertex the file does not have (face in the piece, vertex number, where in the corners).
+struct PieceUse {
+    first_use: Vec<(u32, usize)>,
+    bad: Option<(usize, u64, usize)>,
+    triangles: usize,
+}
+
+/// The tool's triangles from the faces of `text` (see the module documentation): polygons
+/// fanned, faces of fewer than three corners dropped, vertices in the order the faces first
+/// use them; the counts go into `report`. Each piece's faces are read in parallel (the
+/// vertices they use first, their first bad corner), then the pieces' first uses are taken in
+/// order (the numbering, and the first error of the faces read in order: a corner naming a
+/// vertex the file does not have, or a non-finite vertex used), then the triangles written in
+/// parallel: the mesh and errors of one reading in order ([`tool_mesh_serial`], tested).
+fn tool_mesh(text: &Pieces, path: &Path, report: &mut MeshReport) -> Result<TriangleMesh, ToolError> {
+    use rayon::prelude::*;
+    let count = text.vertex_count();
+    let faces: usize = text.texts.iter().map(|t| t.faces.len()).sum();
+    report.faces_read = faces;
+    if faces == 0 {
+        return Err(ToolError::Empty { path: path.into() });
+    }
+    let uses: Vec<PieceUse> = text
+        .texts
+        .par_iter()
+        .map(|t| {
+            let mut seen = vec![0u64; count.div_ceil(64)];
+            let mut first_use = Vec::new();
+            let mut bad = None;
+            let mut triangles = 0;
+            'faces: for (f, face) in t.faces.iter().enumerate() {
+                for (c, &v) in t.face_corners(face).iter().enumerate() {
+                    let at = face.corners.start + c;
+                    let k = match (v as usize).checked_sub(1).filter(|&k| k < count) {
+                        Some(k) => k,
+                        None => {
+                            bad = Some((f, v, at));
+                            break 'faces;
+                        }
+                    };
+                    if seen[k / 64] & (1 << (k % 64)) == 0 {
+                        seen[k / 64] |= 1 << (k % 64);
+                        first_use.push((k as u32, at));
+                    }
+                }
+                triangles += face.corners.len().saturating_sub(2);
+            }
+            PieceUse { first_use, bad, triangles }
+        })
+        .collect();
+    // The vertices in the order of first use, and the first error in the order of reading.
+    let mut index = vec![u32::MAX; count];
+    let mut order: Vec<u32> = Vec::with_capacity(count);
+    let mut faces_before = 0;
+    for (t, u) in text.texts.iter().zip(&uses) {
+        let bad_at = u.bad.map_or(usize::MAX, |(_, _, at)| at);
+        for &(k, _) in u.first_use.iter().take_while(|&&(_, at)| at < bad_at) {
+            if index[k as usize] == u32::MAX {
+                let ([x, y, z], _) = text.vertex(k as usize);
+                if let Some(&value) = [x, y, z].iter().find(|c| !c.is_finite()) {
+                    return Err(ToolError::NonFinite { path: path.into(), index: k as usize + 1, value });
+                }
+                index[k as usize] = order.len() as u32;
+                order.push(k);
+            }
+        }
+        if let Some((f, v, _)) = u.bad {
+            return Err(ToolError::BadIndex { path: path.into(), face: faces_before + f + 1, index: v as usize, count });
+        }
+        faces_before += t.faces.len();
+    }
+    let vertices: Vec<Point> = order
+        .par_iter()
+        .with_min_len(1 << 12)
+        .map(|&k| {
+            let ([x, y, z], _) = text.vertex(k as usize);
+            Point::new(x, y, z)
+        })
+        .collect();
+    drop(order);
+    // Each piece's triangles in its own part of the array.
+    let mut triangles = vec![[0u32; 3]; uses.iter().map(|u| u.triangles).sum()];
+    let mut parts = Vec::with_capacity(uses.len());
+    let mut rest = triangles.as_mut_slice();
+    for u in &uses {
+        let (part, tail) = rest.split_at_mut(u.triangles);
+        parts.push(part);
+        rest = tail;
+    }
+    let counts: Vec<(usize, usize)> = text
+        .texts
+        .par_iter()
+        .zip(parts)
+        .map(|(t, part)| {
+            let (mut degenerate, mut polygons, mut next) = (0, 0, 0);
+            for face in &t.faces {
+                let corners = t.face_corners(face);
+                match corners.len() {
+                    0..=2 => degenerate += 1,
+                    n => {
+                        polygons += usize::from(n > 3);
+                        let a = index[corners[0] as usize - 1];
+                        for pair in corners[1..].windows(2) {
+                            part[next] = [a, index[pair[0] as usize - 1], index[pair[1] as usize - 1]];
+                            next += 1;
+                        }
+                    }
+                }
+            }
+            (degenerate, polygons)
+        })
+        .collect();
+    report.degenerate_faces_dropped = counts.iter().map(|c| c.0).sum();
+    report.polygons_triangulated = counts.iter().map(|c| c.1).sum();
+    if triangles.is_empty() {
+        return Err(ToolError::AllDegenerate { path: path.into() });
+    }
+    Ok(TriangleMesh { vertices, triangles })
+}
+
+/// [`tool_mesh`] in one pass over the faces in order: what it must give.
+#[cfg(test)]
+fn tool_mesh_serial(text: &Pieces, path: &Path, report: &mut MeshReport) -> Result<TriangleMesh, ToolError> {
     let count = text.vertex_count();
     let faces = text.texts.iter().map(|t| t.faces.len()).sum();
-    let mut report = MeshReport { vertices_read: count, faces_read: faces, ..Default::default() };
+    report.faces_read = faces;
     if faces == 0 {
         return Err(ToolError::Empty { path: path.into() });
     }
@@ -513,7 +644,7 @@ pub fn read_obj(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
     if mesh.triangles.is_empty() {
         return Err(ToolError::AllDegenerate { path: path.into() });
     }
-    Ok((mesh, report))
+    Ok(mesh)
 }
 
 /// Read an OBJ file as a flow mesh (see the module documentation); lengths multiplied by `scale`.
@@ -900,6 +1031,66 @@ mod tests {
         }
         // Both outcomes are exercised.
         assert!(read > 100 && refused > 100, "{read} read, {refused} refused");
+    }
+
+    #[test]
+    fn the_tool_mesh_built_in_parallel_is_the_one_built_in_order() {
+        // Random texts of vertices (some not finite) and faces (of 0 to 6 corners, some naming
+        // vertices the file does not have, some counting back), read in pieces of 1 to 80 bytes:
+        // the parallel build gives the mesh, counts and error of the build in order, with 1, 2
+        // and 3 threads.
+        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut texts = Vec::new();
+        for _ in 0..300 {
+            let vertices = 3 + rnd(40);
+            let mut text = String::new();
+            for v in 0..vertices {
+                let x = match rnd(150) {
+                    0 => "nan".to_string(),
+                    1 => "1e999".to_string(),
+                    _ => format!("{}", v as f64 * 0.5),
+                };
+                text += &format!("v {x} {} {}\n", rnd(9), rnd(9));
+                if rnd(3) == 0 {
+                    text += "f";
+                    for _ in 0..rnd(7) {
+                        text += &match rnd(60) {
+                            0 => format!(" {}", vertices + 1 + rnd(3)),
+                            1..=5 => format!(" -{}", 1 + rnd(v + 1)),
+                            _ => format!(" {}", 1 + rnd(vertices)),
+                        };
+                    }
+                    text += "\n";
+                }
+            }
+            texts.push(text);
+        }
+        let path = Path::new("t.obj");
+        let (mut built, mut refused) = (0, 0);
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                for (round, text) in texts.iter().enumerate() {
+                    let pieces = parse_pieces(text.as_bytes(), 1 + round % 80).unwrap();
+                    let (mut a, mut b) = (MeshReport::default(), MeshReport::default());
+                    let (parallel, serial) = (tool_mesh(&pieces, path, &mut a), tool_mesh_serial(&pieces, path, &mut b));
+                    // As Debug text: NaN coordinates are not equal to themselves. (After an
+                    // error the counts are not used.)
+                    let text_of = |r: Result<TriangleMesh, ToolError>, m: MeshReport| match r {
+                        Ok(mesh) => format!("Ok({mesh:?}) {m:?}"),
+                        Err(e) => format!("{e:?}"),
+                    };
+                    let (parallel, serial) = (text_of(parallel, a), text_of(serial, b));
+                    assert_eq!(parallel, serial, "{text}");
+                    if serial.starts_with("Ok") {
+                        built += 1;
+                    } else {
+                        refused += 1;
+                    }
+                }
+            });
+        }
+        assert!(built > 200 && refused > 200, "{built} built, {refused} refused");
     }
 
     #[test]

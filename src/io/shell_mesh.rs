@@ -48,7 +48,7 @@ pub enum FlowMeshError {
 
 /// Read the whole file, naming it in the error.
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>, FlowMeshError> {
-    std::fs::read(path).map_err(|source| FlowMeshError::Io { path: path.into(), source })
+    super::read::read_file(path).map_err(|source| FlowMeshError::Io { path: path.into(), source })
 }
 
 /// Hash map keyed by file ids: ids are trusted integers, so a multiplicative hash is enough and

@@ -203,7 +203,7 @@ fn key(p: [f64; 3]) -> [u64; 3] {
 /// on the way. Refuses an unreadable or unparsable file, one without facets, and a non-finite
 /// corner.
 pub fn read_stl(path: &Path) -> Result<(TriangleMesh, MeshReport), ToolError> {
-    let bytes = std::fs::read(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
+    let bytes = super::read::read_file(path).map_err(|source| ToolError::Io { path: path.into(), source })?;
     let bad = |reason: String| ToolError::ParseStl { path: path.into(), reason };
     let text = parse(&bytes).map_err(bad)?;
     if text.facets.is_empty() {
