@@ -98,10 +98,10 @@ pub struct SmoothSurface<'a> {
     /// Bounding boxes of the sectors' supports.
     bvh: Bvh,
     creases: usize,
-    /// Per facet, gathered when first asked: its bounding box grown by
-    /// [`FACET_REACH_OVER_EDGE`] and the sectors whose supports meet it, in the BVH's order (a
-    /// projection's points then need no search: the BVH query costs more than the sums).
-    near_facet: Vec<OnceLock<(Aabb, Box<[u32]>)>>,
+    /// Per facet, gathered when first asked: the sectors whose supports meet its box
+    /// ([`SmoothSurface::facet_box`]), in the BVH's order (a projection's points then need no
+    /// search: the BVH query costs more than the sums). 24 bytes a facet until asked.
+    near_facet: Vec<OnceLock<Box<[u32]>>>,
 }
 
 /// Wendland's C2 function on [0, 1] and its derivative: (1 - r)^4 (4 r + 1).
@@ -230,16 +230,20 @@ impl<'a> SmoothSurface<'a> {
     /// when `p` lies in its box (a superset of what a search at `p` finds, in the same order, so
     /// sums agree to the bit), None when `p` is further off.
     fn near_facet(&self, t: u32, p: &Point) -> Option<&[u32]> {
-        let (bounds, sectors) = self.near_facet[t as usize].get_or_init(|| {
-            let c = self.tool.corners(t);
-            let longest = (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max);
-            let grow = Vector::repeat(FACET_REACH_OVER_EDGE * longest);
-            let lo = c[0].inf(&c[1]).inf(&c[2]) - grow;
-            let hi = c[0].sup(&c[1]).sup(&c[2]) + grow;
-            let bounds = Aabb::new(lo, hi);
-            (bounds, self.bvh.intersect_aabb(&bounds).collect())
-        });
-        bounds.contains_local_point(p).then_some(&sectors[..])
+        let bounds = self.facet_box(t);
+        if !bounds.contains_local_point(p) {
+            return None;
+        }
+        Some(self.near_facet[t as usize].get_or_init(|| self.bvh.intersect_aabb(&bounds).collect()))
+    }
+
+    /// Facet `t`'s bounding box grown by [`FACET_REACH_OVER_EDGE`] of its longest edge
+    /// (computed again at each query rather than kept: 48 bytes a facet on large tools).
+    fn facet_box(&self, t: u32) -> Aabb {
+        let c = self.tool.corners(t);
+        let longest = (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max);
+        let grow = Vector::repeat(FACET_REACH_OVER_EDGE * longest);
+        Aabb::new(c[0].inf(&c[1]).inf(&c[2]) - grow, c[0].sup(&c[1]).sup(&c[2]) + grow)
     }
 
     /// [`SmoothSurface::curvature`] at `p` next to facet `t` (see [`SmoothSurface::near_facet`]).
