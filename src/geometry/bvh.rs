@@ -222,11 +222,19 @@ impl TriangleBvh {
         let mut best: Option<(u32, f64)> = None;
         // Boxes farther than this squared distance cannot hold a triangle as close as the best.
         let mut bound = f64::INFINITY;
+        // The bound for a best triangle at squared distance d (the slack keeps rounding out).
+        let bound_of = |d: f64| {
+            let r = d.sqrt() + self.slack;
+            if r.is_nan() {
+                f64::INFINITY
+            } else {
+                r * r
+            }
+        };
         if let Some(t) = hint.filter(|&t| (t as usize) < self.boxes.len()) {
             let d = distance2(t);
             best = Some((t, d));
-            let r = d.sqrt() + self.slack;
-            bound = if r.is_nan() { f64::INFINITY } else { r * r };
+            bound = bound_of(d);
         }
         let mut stack = [0u32; STACK];
         let mut top = 1;
@@ -245,8 +253,7 @@ impl TriangleBvh {
                     };
                     if better {
                         best = Some((t, d));
-                        let r = d.sqrt() + self.slack;
-                        bound = if r.is_nan() { f64::INFINITY } else { r * r };
+                        bound = bound_of(d);
                     }
                 }
             } else {

@@ -368,11 +368,6 @@ impl<'a> SmoothSurface<'a> {
         self.project_inner(q, &self.tool.closest_point(q), true)
     }
 
-    /// [`SmoothSurface::project_from`] and the curvature there.
-    pub fn project_from_curved(&self, q: &Point, foot: &SurfacePoint) -> (SmoothPoint, Matrix3<f64>) {
-        self.project_inner(q, foot, true)
-    }
-
     /// [`SmoothSurface::project_from`], and the curvature there if `curved`.
     pub fn project_from_curved_if(
         &self,
@@ -576,6 +571,9 @@ mod tests {
                 let plain = smooth.project(&q);
                 assert_eq!(s, plain);
                 assert_eq!(curvature, smooth.curvature(s.region, &s.point), "at {q}");
+                // The same from the sectors kept beside the facet (a foot's curvature computed
+                // after its projection, `mechanics::contact`).
+                assert_eq!(curvature, smooth.curvature_near(s.region, s.triangle, &s.point), "at {q}");
             }
         }
     }
