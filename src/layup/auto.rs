@@ -186,7 +186,7 @@ fn weigh_mechanical_spacing(
         ));
     } else {
         let d = settings.spacing;
-        let needed = d * (tolerance / e).powf(1.0 / FISHNET_ORDER);
+        let needed = spacing_for(d, e, tolerance);
         choice.indicators.mechanical_spacing_needed_m = Some(needed);
         choice.reason.push_str(&format!(
             "; the pressed drape's own spacing error is estimated at {e:.2} deg (against the same drape at twice the spacing), above the {tolerance} deg tolerance: NOT ASSURED at this spacing; give spacing <= {needed:.4} m for it (mechanics at d/k costs k^2 the nodes, so auto does not refine it by itself)"
@@ -293,8 +293,7 @@ pub fn choose(
         _ => (own, settings.clone(), own_discretisation),
     };
     let settings = &settings;
-    let spacing_needed =
-        discretisation.filter(|e| *e > spacing_budget).map(|e| d * (spacing_budget / e).powf(1.0 / FISHNET_ORDER));
+    let spacing_needed = discretisation.filter(|e| *e > spacing_budget).map(|e| spacing_for(d, e, spacing_budget));
     indicators.discretisation_deg = discretisation;
     indicators.spacing_needed_m = spacing_needed;
     let mut net = net;
@@ -346,6 +345,12 @@ pub fn choose(
     // never keeps the smooth one or drapes anew) stopped.
     let start = if mechanical { step.ok().map(|p| p.state) } else { None };
     Ok(AutoDrape { net, choice, start })
+}
+
+/// The spacing at which a drape whose spacing error is `error` at spacing `d` errs by `target`
+/// (the error falling as d^p, p = [`FISHNET_ORDER`]).
+fn spacing_for(d: f64, error: f64, target: f64) -> f64 {
+    d * (target / error).powf(1.0 / FISHNET_ORDER)
 }
 
 /// Richardson's estimate of the largest cell-shear error of `net` (drawn with `settings`) from
