@@ -357,6 +357,11 @@ impl Reduction {
         out
     }
 
+    /// The upper-triangular CSC pattern of the reduced variables: (column pointers, rows).
+    pub fn upper_pattern(&self) -> (&[usize], &[usize]) {
+        (&self.colptr, &self.rowval)
+    }
+
     fn matrix(&self, values: &[f64]) -> CscMatrix<f64> {
         CscMatrix::new(self.n, self.n, self.colptr.clone(), self.rowval.clone(), values.to_vec())
     }
