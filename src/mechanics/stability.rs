@@ -150,7 +150,8 @@ impl StabilityCheck {
 
 /// Whether the symmetric matrix with upper triangle `values` in `red`'s pattern is positive
 /// definite: its sparse Cholesky factorisation (faer, AMD ordering, no regularisation) runs to
-/// the end without a non-positive pivot. None: the factorisation could not be set up.
+/// the end without a non-positive pivot. None: the matrix has non-finite entries or the
+/// factorisation could not be set up.
 ///
 /// A stability check needs no eigenvalue to give its verdict: by Sylvester's law of inertia the
 /// pencil (H, M) has no eigenvalue below -c exactly when H + c M is positive definite, so one
@@ -163,6 +164,10 @@ pub(super) fn positive_definite(red: &Reduction, values: &[f64]) -> Option<bool>
     use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymmetricOrdering};
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
     use faer::{Par, Side, Spec};
+    if !values.iter().all(|v| v.is_finite()) {
+        // No proof from a matrix with NaN or infinite entries (Lanczos then says what it can).
+        return None;
+    }
     let n = red.len();
     let (colptr, rowval) = red.upper_pattern();
     let symbolic = SymbolicSparseColMatRef::new_checked(n, n, colptr, None, rowval);
@@ -372,7 +377,10 @@ mod tests {
         }
         // Pinned slots (unit diagonal) do not spoil a positive definite matrix.
         let red = Reduction::new(vec![3, 3], vec![2, 3], vec![0, 1], &[(0, 0), (0, 1), (1, 1)]);
-        let values = red.values(&Dense(md.clone()), &bases);
+        let mut values = red.values(&Dense(md.clone()), &bases);
         assert_eq!(positive_definite(&red, &values), Some(true));
+        // A NaN proves nothing.
+        values[0] = f64::NAN;
+        assert_eq!(positive_definite(&red, &values), None);
     }
 }
