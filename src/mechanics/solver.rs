@@ -866,11 +866,16 @@ fn least_curvature(
             v
         }
     };
+    // The reference with a mass shift (relative, as the solver's).
+    let shifted = |shift: f64| {
+        let mut m = reference.clone();
+        red.add_diagonal(&mut m, masses, shift * unit);
+        m
+    };
     if !eigenvalue {
         // The verdict is a saddle when the pencil (H, M) has an eigenvalue below -c, M the
         // reference at its first shift: exactly when H + c M is not positive definite.
-        let mut m = reference.clone();
-        red.add_diagonal(&mut m, masses, REFERENCE_SHIFT * unit);
+        let m = shifted(REFERENCE_SHIFT);
         let test: Vec<f64> = h.iter().zip(&m).map(|(h, m)| h + NEGATIVE_CURVATURE * m).collect();
         if positive_definite(red, &test) == Some(true) {
             return Some(Found::PositiveDefinite);
@@ -881,8 +886,7 @@ fn least_curvature(
     let start = red.reduce(&per_node, &s.bases);
     let mut shift = REFERENCE_SHIFT;
     while shift <= MAX_REFERENCE_SHIFT {
-        let mut m = reference.clone();
-        red.add_diagonal(&mut m, masses, shift * unit);
+        let m = shifted(shift);
         match least_mode(red, engine, &h, &m, &lumped, &start, LANCZOS_ITERATIONS) {
             Ok(Some(mode)) => {
                 return Some(Found::Mode(Curvature { relative: mode.least / unit, lumped: mode.least, mode }));
