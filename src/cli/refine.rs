@@ -137,7 +137,7 @@ pub(crate) fn print_solver(r: &Refined) {
         println!("  energy: kinematic {:.6e} J -> refined {:.6e} J", r.energy_kinematic, r.energy_final);
     } else {
         println!(
-            "  energy: kinematic {:.6e} J on the facets, {:.6e} J where the solver started (the net moved onto the smooth tool, or where auto's probe stopped) -> refined {:.6e} J",
+            "  energy: kinematic {:.6e} J on the facets, {:.6e} J where the solver started (the net moved onto the smooth tool, the ply draped on the smooth surface, or where auto's probe stopped) -> refined {:.6e} J",
             r.energy_kinematic, r.energy_start, r.energy_final
         );
     }

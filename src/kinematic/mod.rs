@@ -11,7 +11,7 @@ pub mod provenance;
 pub mod sampler;
 pub mod surface;
 
-pub use fishnet::{drape, drape_on, DrapeError};
+pub use fishnet::{drape, drape_on, drape_smooth, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};
 pub use provenance::{CellChanges, ChoiceIndicators, MethodChoice, Provenance, SolverRecord, UnbalancedRecord};
 pub use surface::DrapeSurface;

@@ -33,7 +33,7 @@ use crate::geometry::{Point, ToolSurface};
 use crate::kinematic::fabric_field::ShearField;
 use crate::kinematic::fishnet::{drape_on, drape_smooth, DrapeError};
 use crate::kinematic::{ChoiceIndicators, DrapeNet, KinematicSettings, MethodChoice, SurfaceKind};
-use crate::mechanics::refine::{cell_changes, refine_on, PressedSurface, RefineError, Refined};
+use crate::mechanics::refine::{cell_changes, refine_draped, refine_on, PressedSurface, RefineError, Refined};
 use crate::mechanics::SolverSettings;
 use std::cell::OnceCell;
 use std::time::Instant;
@@ -166,11 +166,13 @@ fn weigh_mechanical_spacing(
     // escapes included, kept so that it is the same drape at 2d).
     let mut solve = refinement.settings();
     solve.solver.stability_check = false;
+    let draped = settings.at_spacing(2.0 * settings.spacing);
     let coarse = surfaces
-        .drape(&settings.at_spacing(2.0 * settings.spacing))
+        .drape(&draped)
         .ok()
         .and_then(|net| {
-            refine_on(&net, surfaces.tool, surfaces.for_refinement(refinement), &refinement.material, &solve).ok()
+            let smooth = surfaces.for_refinement(refinement);
+            refine_draped(&net, &draped, surfaces.tool, smooth, &refinement.material, &solve).ok()
         })
         .filter(Refined::ok);
     let Some(e) = coarse.and_then(|r| richardson(refined, &r.net)) else {

@@ -5,7 +5,7 @@ use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::{Point, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, KinematicSettings};
 use crate::material::MaterialCard;
-use crate::mechanics::refine::{annotate, refine_from, RefineError, RefineSettings, Refined};
+use crate::mechanics::refine::{annotate, refine_draped, refine_from, RefineError, RefineSettings, Refined};
 use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::{ContactMode, SolverSettings};
 use std::path::PathBuf;
@@ -177,6 +177,20 @@ impl Refinement {
         self.run_from(net, &net.positions, surface, smooth)
     }
 
+    /// Refine the kinematic `net` draped on `surface` with `draped`, as a scene's ply is: as
+    /// [`Refinement::run`], but a pressed refinement on the smooth patches of a net draped on
+    /// the facets starts from the ply draped on the smooth surface ([`refine_draped`]).
+    pub fn run_draped(
+        &self,
+        net: &DrapeNet,
+        surface: &ToolSurface,
+        draped: &KinematicSettings,
+    ) -> Result<(DrapeNet, Refined), RefineError> {
+        let t = Instant::now();
+        let result = refine_draped(net, draped, surface, None, &self.material, &self.settings())?;
+        Ok(self.annotated(net, result, t))
+    }
+
     /// [`Refinement::run`] with the solver starting from `start` (a position per node of `net`,
     /// e.g. where a probe towards equilibrium stopped); `net` stays the kinematic reference.
     pub fn run_from(
@@ -188,12 +202,17 @@ impl Refinement {
     ) -> Result<(DrapeNet, Refined), RefineError> {
         let t = Instant::now();
         let result = refine_from(net, start, surface, smooth, &self.material, &self.settings())?;
+        Ok(self.annotated(net, result, t))
+    }
+
+    /// The refined net of `result` annotated against the kinematic `net`, its time since `t`.
+    fn annotated(&self, net: &DrapeNet, result: Refined, t: Instant) -> (DrapeNet, Refined) {
         let mut out = result.net.clone();
         annotate(&mut out, net, &result, &self.material_path);
         out.timing.load_ms = net.timing.load_ms;
         out.timing.generators_ms = 0.0;
         out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
-        Ok((out, result))
+        (out, result)
     }
 }
 

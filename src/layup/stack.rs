@@ -297,7 +297,12 @@ pub fn drape_layup(
                         flat_start(ply, &settings, &normal, surface).map_err(|source| refine_error(source.into()))?
                     }
                 };
-                let refined = r.as_ref().map(|r| r.run(&net, surface, None)).transpose().map_err(refine_error)?;
+                let refined = match start {
+                    Start::Kinematic => r.as_ref().map(|r| r.run_draped(&net, surface, &settings)),
+                    Start::Flat { .. } => r.as_ref().map(|r| r.run(&net, surface, None)),
+                }
+                .transpose()
+                .map_err(refine_error)?;
                 (net, refined, None)
             }
         };
