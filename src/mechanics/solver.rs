@@ -177,6 +177,8 @@ pub struct IterationLog {
     pub corrected: bool,
     /// Clarabel subproblems solved in the iteration.
     pub subproblems: u32,
+    /// Of them: solved by conjugate gradients on an earlier factorisation (no new one).
+    pub lagged: u32,
     /// Of the iteration's time: assembling the quadratic models (energy, gradient and Hessian
     /// at the new state, reduced onto the free directions), ms.
     pub model_ms: f64,
@@ -288,6 +290,9 @@ pub struct Constraints<'a> {
     pub stick: bool,
 }
 
+/// After an exact-model step that moved no node further than this (spacings), the next model is
+/// solved on the last factorisation first ([`QpEngine::solve_near`]).
+const LAGGED_STEP_SPACINGS: f64 = 0.01;
 /// Below this residual the exact model is tried first even if the last step needed the convex
 /// one: near equilibrium Newton's step converges quadratically.
 const EXACT_FIRST_RESIDUAL: f64 = 1e-2;
@@ -419,6 +424,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let mut saddle: Option<(Vec<Point>, StabilityCheck)> = None;
     // The largest move of one iteration so far, spacings (for `settle_share`).
     let mut largest_step = 0.0f64;
+    // Whether the last accepted step was the exact model's and under `LAGGED_STEP_SPACINGS`.
+    let mut newton_tail = false;
     let mut it = 0;
     loop {
         if residual <= settings.tolerance || red.is_empty() {
@@ -509,6 +516,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         it += 1;
         let t_it = std::time::Instant::now();
         let solve_ms_before = engine.time_ms;
+        let lagged_before = engine.lagged_solves;
         let mut trial_ms = 0.0;
         let g = red.reduce(&unbalanced(&state.eval), &state.bases);
         let mut base_values =
@@ -545,7 +553,11 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             values.copy_from_slice(&base_values);
             red.add_diagonal(&mut values, &masses, shift * unit_shift);
             subproblems += 1;
-            let y = match engine.solve(&red, &values, &g) {
+            // After a tiny Newton step the exact model has hardly changed: its factorisation
+            // from the last iteration preconditions conjugate gradients that solve this one.
+            let near = newton_tail && !convex && subproblems == 1;
+            let solved = if near { engine.solve_near(&red, &values, &g) } else { engine.solve(&red, &values, &g) };
+            let y = match solved {
                 Ok(y) => y,
                 Err(e) => {
                     // Clarabel finds no minimum of an indefinite model: as below.
@@ -663,9 +675,13 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 }
                 reach = if step_capped && ratio >= GOOD_RATIO { (2.0 * reach).min(MAX_REACH_SPACINGS) } else { reach };
                 prefer_convex = convex;
+                newton_tail = !convex && step <= LAGGED_STEP_SPACINGS;
                 (true, corrected, step)
             }
-            None => (false, false, 0.0),
+            None => {
+                newton_tail = false;
+                (false, false, 0.0)
+            }
         };
         if refused {
             // A step was refused on the way: start small again.
@@ -682,6 +698,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             accepted: accepted_flag,
             corrected,
             subproblems,
+            lagged: engine.lagged_solves - lagged_before,
             time_ms: t_it.elapsed().as_secs_f64() * 1e3,
             model_ms: t_it.elapsed().as_secs_f64() * 1e3 - (engine.time_ms - solve_ms_before) - trial_ms,
             solve_ms: engine.time_ms - solve_ms_before,
