@@ -502,6 +502,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     shift = settings.initial_shift;
                     reach = MAX_STEP_SPACINGS;
                     prefer_convex = false;
+                    newton_tail = false;
                     residual = residual_of(&red, &state, force_scale);
                     continue;
                 }
