@@ -233,6 +233,9 @@ fn a_ply_that_did_not_converge_is_marked_everywhere_and_the_run_exits_1() {
         serde_json::from_str(&std::fs::read_to_string(out.join("sheet.drape.json")).unwrap()).unwrap();
     assert_eq!(net["meta"]["solver"]["converged"], serde_json::json!(false));
     assert!(!net["meta"]["solver"]["unbalanced"].as_array().unwrap().is_empty());
+    // The ply's whole time counts its solve (the fill of a refined net).
+    let time = |k: &str| net["timing_ms"][k].as_f64().unwrap();
+    assert!(time("fill") > 0.0 && time("total") >= time("fill"), "{}", net["timing_ms"]);
     let report = Command::cargo_bin("drape").unwrap().arg("report").arg(&out).output().unwrap();
     assert!(report.status.success(), "{}", String::from_utf8_lossy(&report.stderr));
     let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();

@@ -205,13 +205,16 @@ impl Refinement {
         Ok(self.annotated(net, result, t))
     }
 
-    /// The refined net of `result` annotated against the kinematic `net`, its time since `t`.
+    /// The refined net of `result` annotated against the kinematic `net`, the refinement's time
+    /// (since `t`) its fill.
     fn annotated(&self, net: &DrapeNet, result: Refined, t: Instant) -> (DrapeNet, Refined) {
         let mut out = result.net.clone();
         annotate(&mut out, net, &result, &self.material_path);
         out.timing.load_ms = net.timing.load_ms;
         out.timing.generators_ms = 0.0;
         out.timing.fill_ms = t.elapsed().as_secs_f64() * 1e3;
+        // The whole drape: the kinematic net's, then the refinement.
+        out.timing.total_ms = net.timing.total_ms + out.timing.fill_ms;
         (out, result)
     }
 }
