@@ -296,6 +296,25 @@ const LAGGED_STEP_SPACINGS: f64 = 0.01;
 /// Below this residual the exact model is tried first even if the last step needed the convex
 /// one: near equilibrium Newton's step converges quadratically.
 const EXACT_FIRST_RESIDUAL: f64 = 1e-2;
+/// The convex model takes over from an indefinite exact one and stays while the residual is
+/// above [`EXACT_FIRST_RESIDUAL`]. Where it creeps (its steps are tiny at the smallest shift: the
+/// elements' convex parts are far stiffer than the energy along the way down) the exact model
+/// is tested: when H - s C is positive definite, s this fraction (C the convex model with the
+/// stability check's small mass shift), the exact model is tried first again.
+const STIFF_EXACT: f64 = 1e-2;
+/// The convex model is creeping, not held back by the shift, only when the shift is below
+/// this (relative).
+const EXACT_TEST_SHIFT: f64 = 1e-6;
+/// Exact-model steps taken on that test's word must cut the residual by this factor every
+/// [`EXACT_TRIAL_ITERATIONS`] iterations, else the convex model takes over again (on the
+/// double dome's +90 deg ply a row of nodes at the tool's open edge takes turns being held and
+/// the exact model creeps as well).
+const EXACT_TRIAL_FALL: f64 = 0.5;
+/// See [`EXACT_TRIAL_FALL`].
+const EXACT_TRIAL_ITERATIONS: usize = 10;
+/// Convex steps to wait after a failed stiffness test or exact trial at most (the wait doubles
+/// each time).
+const MAX_EXACT_TEST_WAIT: usize = 64;
 /// A step is accepted when the energy falls by at least this fraction of the predicted fall.
 const ACCEPT_RATIO: f64 = 1e-4;
 /// Steps whose energy change agrees with the model this well let the shift fall.
@@ -419,6 +438,11 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     // The reach of a step (spacings) and whether the last step needed the convex model.
     let mut reach = MAX_STEP_SPACINGS;
     let mut prefer_convex = false;
+    // Convex steps to wait before the exact model's stiffness is tested again, that wait after
+    // the next failure, and the exact trial under way (its first iteration and residual).
+    let mut exact_test_wait = 0usize;
+    let mut exact_test_interval = 1usize;
+    let mut exact_trial: Option<(usize, f64)> = None;
     let mut stability: Option<StabilityCheck> = None;
     // The last saddle escaped from and its check, restored if the iterations from there fail.
     let mut saddle: Option<(Vec<Point>, StabilityCheck)> = None;
@@ -676,6 +700,18 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 }
                 reach = if step_capped && ratio >= GOOD_RATIO { (2.0 * reach).min(MAX_REACH_SPACINGS) } else { reach };
                 prefer_convex = convex;
+                let creeping = convex && shift <= EXACT_TEST_SHIFT && step <= LAGGED_STEP_SPACINGS;
+                if creeping && residual > EXACT_FIRST_RESIDUAL {
+                    if exact_test_wait > 0 {
+                        exact_test_wait -= 1;
+                    } else if exact_is_stiff(&red, &exact_values, &base_values, &masses, unit_shift) {
+                        prefer_convex = false;
+                        exact_trial = Some((it, residual));
+                    } else {
+                        exact_test_interval = (2 * exact_test_interval).min(MAX_EXACT_TEST_WAIT);
+                        exact_test_wait = exact_test_interval;
+                    }
+                }
                 newton_tail = !convex && step <= LAGGED_STEP_SPACINGS;
                 (true, corrected, step)
             }
@@ -689,6 +725,20 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             reach = MAX_STEP_SPACINGS;
         }
         residual = residual_of(&red, &state, force_scale);
+        if let Some((since, r0)) = exact_trial {
+            if prefer_convex || residual <= EXACT_FIRST_RESIDUAL {
+                exact_trial = None;
+            } else if it - since >= EXACT_TRIAL_ITERATIONS {
+                if residual > EXACT_TRIAL_FALL * r0 {
+                    prefer_convex = true;
+                    exact_trial = None;
+                    exact_test_interval = (2 * exact_test_interval).min(MAX_EXACT_TEST_WAIT);
+                    exact_test_wait = exact_test_interval;
+                } else {
+                    exact_trial = Some((it, residual));
+                }
+            }
+        }
         iterations.push(IterationLog {
             iteration: it,
             energy: state.eval.energy,
@@ -773,6 +823,16 @@ fn exact_model(cons: &Constraints, rep: &[usize], red: &Reduction, s: &State) ->
     let mut values = red.values(s.eval.hessian.as_deref()?, &s.bases);
     add_contact_curvature(cons, rep, red, s, &mut values, false);
     Some(values)
+}
+
+/// Whether the exact model `h` is at least [`STIFF_EXACT`] as stiff as the convex one `c` along
+/// every direction (`c` with the stability check's mass shift, [`REFERENCE_SHIFT`]): H - s C
+/// positive definite, proved by one Cholesky factorisation.
+fn exact_is_stiff(red: &Reduction, h: &[f64], c: &[f64], masses: &[f64], unit_shift: f64) -> bool {
+    let mut reference = c.to_vec();
+    red.add_diagonal(&mut reference, masses, REFERENCE_SHIFT * unit_shift);
+    let test: Vec<f64> = h.iter().zip(&reference).map(|(h, r)| h - STIFF_EXACT * r).collect();
+    positive_definite(red, &test) == Some(true)
 }
 
 /// The convex model at `s` (positions `x`): the elements' convex parts, reduced, with the tool's
