@@ -19,9 +19,9 @@ pub trait HessianBlocks: Sync {
     fn block(&self, a: usize, b: usize) -> Matrix3<f64>;
 }
 
-/// Where a reduced entry's value comes from: the grid blocks (node a, node b) and components (p
-/// of a, q of b).
-type Source = (u32, u32, u8, u8);
+/// Where a reduced entry's value comes from: the grid block of a coupled pair (its index in
+/// [`Reduction`]'s pairs: node a, node b) and its components (p of a, q of b).
+type Source = (u32, u8, u8);
 
 /// A subproblem's solution y is kept when |P y + q| is below this fraction of |q|: rounding
 /// beyond it means the model is too near singular for its step to be trusted.
@@ -53,9 +53,12 @@ pub struct Reduction {
     /// Upper-triangular CSC pattern over the reduced variables.
     colptr: Vec<usize>,
     rowval: Vec<usize>,
-    /// Per stored entry: the grid blocks (node a, node b) and components (p of a, q of b) whose
-    /// reduced values add up into it.
-    sources: Vec<Vec<Source>>,
+    /// The coupled grid node pairs (a <= b) the pattern was built over.
+    pairs: Vec<(u32, u32)>,
+    /// Per stored entry e: the grid blocks and components whose reduced values add up into it,
+    /// `sources[source_ptr[e]..source_ptr[e + 1]]`.
+    source_ptr: Vec<usize>,
+    sources: Vec<Source>,
     /// Position of each column's diagonal entry.
     diag: Vec<usize>,
 }
@@ -74,7 +77,7 @@ impl Reduction {
         }
         let live = dofs.iter().map(|&d| d as usize).sum();
         let mut columns: Vec<Vec<(usize, Source)>> = vec![Vec::new(); n];
-        for &(a, b) in pairs {
+        for (i, &(a, b)) in pairs.iter().enumerate() {
             let (ra, rb) = (rep[a], rep[b]);
             for p in 0..cap[ra] as usize {
                 for q in 0..cap[rb] as usize {
@@ -85,7 +88,7 @@ impl Reduction {
                     if ra == rb && p > q {
                         continue;
                     }
-                    let src = (a as u32, b as u32, p as u8, q as u8);
+                    let src = (i as u32, p as u8, q as u8);
                     if r <= c {
                         columns[c].push((r, src));
                     } else {
@@ -96,7 +99,8 @@ impl Reduction {
         }
         let mut colptr = vec![0];
         let mut rowval = Vec::new();
-        let mut sources: Vec<Vec<Source>> = Vec::new();
+        let mut source_ptr = vec![0];
+        let mut sources: Vec<Source> = Vec::new();
         let mut diag = vec![usize::MAX; n];
         for (c, mut col) in columns.into_iter().enumerate() {
             col.sort_by_key(|e| e.0);
@@ -106,16 +110,22 @@ impl Reduction {
                     if r == c {
                         diag[c] = rowval.len();
                     }
+                    if last != usize::MAX {
+                        source_ptr.push(sources.len());
+                    }
                     rowval.push(r);
-                    sources.push(Vec::with_capacity(1));
                     last = r;
                 }
-                sources.last_mut().expect("an entry was pushed").push(src);
+                sources.push(src);
+            }
+            if last != usize::MAX {
+                source_ptr.push(sources.len());
             }
             colptr.push(rowval.len());
         }
+        let pairs = pairs.iter().map(|&(a, b)| (a as u32, b as u32)).collect();
         // Every variable gets a diagonal slot (the shift goes there even without coupling).
-        let mut red = Reduction { rep, dofs, cap, offset, n, live, colptr, rowval, sources, diag };
+        let mut red = Reduction { rep, dofs, cap, offset, n, live, colptr, rowval, pairs, source_ptr, sources, diag };
         if red.diag.contains(&usize::MAX) {
             red.add_missing_diagonals();
         }
@@ -159,10 +169,10 @@ impl Reduction {
         let n = self.n;
         let mut new_colptr = vec![0];
         let mut new_rowval = Vec::with_capacity(self.rowval.len() + n);
-        let mut new_sources = Vec::with_capacity(self.rowval.len() + n);
+        // The source lists stay as they are; a new diagonal entry gets an empty one.
+        let mut new_source_ptr = Vec::with_capacity(self.rowval.len() + n + 1);
+        new_source_ptr.push(0);
         let mut diag = vec![usize::MAX; n];
-        let sources = std::mem::take(&mut self.sources);
-        let mut sources = sources.into_iter();
         for (c, dc) in diag.iter_mut().enumerate() {
             let mut has = false;
             for k in self.colptr[c]..self.colptr[c + 1] {
@@ -171,18 +181,18 @@ impl Reduction {
                     *dc = new_rowval.len();
                 }
                 new_rowval.push(self.rowval[k]);
-                new_sources.push(sources.next().expect("one source list per entry"));
+                new_source_ptr.push(self.source_ptr[k + 1]);
             }
             if !has {
                 *dc = new_rowval.len();
                 new_rowval.push(c);
-                new_sources.push(Vec::new());
+                new_source_ptr.push(*new_source_ptr.last().expect("starts with 0"));
             }
             new_colptr.push(new_rowval.len());
         }
         self.colptr = new_colptr;
         self.rowval = new_rowval;
-        self.sources = new_sources;
+        self.source_ptr = new_source_ptr;
         self.diag = diag;
     }
 
@@ -216,30 +226,34 @@ impl Reduction {
     /// a unit diagonal and nothing else.
     pub fn values(&self, h: &dyn HessianBlocks, bases: &[NodeBasis]) -> Vec<f64> {
         use rayon::prelude::*;
-        let mut out: Vec<f64> = self
-            .sources
+        // Each pair's reduced block once (up to nine entries read it), then the entries.
+        let blocks: Vec<Matrix3<f64>> = self
+            .pairs
             .par_iter()
-            .map(|srcs| {
+            .map(|&(a, b)| {
+                let (ra, rb) = (self.rep[a as usize], self.rep[b as usize]);
+                if self.dofs[ra] == 0 || self.dofs[rb] == 0 {
+                    // Every slot of one side pinned: no entry reads it.
+                    return Matrix3::zeros();
+                }
+                bases[ra].basis.transpose() * h.block(a as usize, b as usize) * bases[rb].basis
+            })
+            .collect();
+        let mut out: Vec<f64> = (0..self.rowval.len())
+            .into_par_iter()
+            .map(|e| {
                 let mut v = 0.0;
-                let mut cache: Option<((u32, u32), Matrix3<f64>)> = None;
-                for &(a, b, p, q) in srcs {
+                for &(i, p, q) in &self.sources[self.source_ptr[e]..self.source_ptr[e + 1]] {
+                    let (a, b) = self.pairs[i as usize];
                     let (ra, rb) = (self.rep[a as usize], self.rep[b as usize]);
                     if self.pinned(ra, p as usize) || self.pinned(rb, q as usize) {
                         continue;
                     }
-                    let blk = match cache {
-                        Some((key, m)) if key == (a, b) => m,
-                        _ => {
-                            let (ra, rb) = (self.rep[a as usize], self.rep[b as usize]);
-                            let m = bases[ra].basis.transpose() * h.block(a as usize, b as usize) * bases[rb].basis;
-                            cache = Some(((a, b), m));
-                            m
-                        }
-                    };
+                    let blk = &blocks[i as usize];
                     v += blk[(p as usize, q as usize)];
                     // A pair of distinct grid nodes sharing one representative lands on the
                     // diagonal block twice (a, b) and (b, a): add the mirror.
-                    if a != b && self.rep[a as usize] == self.rep[b as usize] {
+                    if a != b && ra == rb {
                         v += blk[(q as usize, p as usize)];
                     }
                 }
