@@ -405,12 +405,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         let (outside, _) = moved(cons, x, &zero, &vec![false; n], &vec![None; n]);
         x.copy_from_slice(&outside);
     }
-    let mut state = {
-        let eval = objective.evaluate(x, true);
-        let feet = feet_at(cons, x, None);
-        let (bases, sliding) = bases_at(cons, &rep, &eval, &feet);
-        State { eval, feet, bases, sliding }
-    };
+    let mut state = state_at(objective, cons, &rep, x, None);
     let movable = |k: usize| cons.freedom[rep[k]].dofs() > 0;
     let load = (0..n).filter(|&k| movable(k)).map(|k| state.eval.external[k].norm_squared()).sum::<f64>().sqrt();
     // The pattern's slots: every freedom of the nodes that can move now (a node losing some to
@@ -865,10 +860,7 @@ fn adopt(
     feet: Option<Feet>,
     red: &mut Reduction,
 ) -> State {
-    let eval = objective.evaluate(x, true);
-    let feet = feet_at(cons, x, feet);
-    let (bases, sliding) = bases_at(cons, rep, &eval, &feet);
-    let state = State { eval, feet, bases, sliding };
+    let state = state_at(objective, cons, rep, x, feet);
     let dofs = dofs_of(&state.bases, rep);
     if dofs.as_slice() != red.dofs() {
         if red.fits(&dofs) {
@@ -1119,6 +1111,26 @@ fn dofs_of(bases: &[NodeBasis], rep: &[usize]) -> Vec<u8> {
 
 /// Where each node meets the tool: on-tool nodes always (their feet from the last move when
 /// given), free nodes in free contact when within [`CONTACT_RANGE`] spacings of it.
+/// The state at `x`: its evaluation, feet (those `known` from the move that found `x`, the rest
+/// located), bases of motion, and the tool's curvature at the feet of the nodes that slide on
+/// it (the model's contact term needs it there and nowhere else: a free node near the tool but
+/// not on it would pay for a curvature nobody reads).
+fn state_at(objective: &dyn Objective, cons: &Constraints, rep: &[usize], x: &[Point], known: Option<Feet>) -> State {
+    let eval = objective.evaluate(x, true);
+    let mut feet = feet_at(cons, x, known);
+    let (bases, sliding) = bases_at(cons, rep, &eval, &feet);
+    if let Some(tool) = cons.tool {
+        feet.par_iter_mut().zip(&sliding).filter(|(_, &s)| s).for_each(|(foot, _)| {
+            if let Some(foot) = foot.as_mut() {
+                tool.curve(foot);
+            }
+        });
+    }
+    State { eval, feet, bases, sliding }
+}
+
+/// The feet at `x`: those `known` (found by the move to `x`), the rest located (without the
+/// tool's curvature, which [`state_at`] adds where it is needed).
 fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
     let Some(tool) = cons.tool else { return vec![None; x.len()] };
     let range = CONTACT_RANGE * cons.spacing;
@@ -1127,17 +1139,10 @@ fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
         .par_iter()
         .zip(known)
         .enumerate()
-        .map(|(k, (f, known))| {
-            let mut foot = match (cons.mode, f) {
-                (ContactMode::Pressed, f) if f.on_tool() => known.or_else(|| Some(tool.locate(&x[k], true, None))),
-                (ContactMode::Free, f) if f.dofs() > 0 => known.or_else(|| tool.locate_near(&x[k], range, true, None)),
-                _ => None,
-            };
-            // Feet found by a trial step come without their curvature: the state's model needs it.
-            if let Some(foot) = foot.as_mut() {
-                tool.curve(foot);
-            }
-            foot
+        .map(|(k, (f, known))| match (cons.mode, f) {
+            (ContactMode::Pressed, f) if f.on_tool() => known.or_else(|| Some(tool.locate(&x[k], false, None))),
+            (ContactMode::Free, f) if f.dofs() > 0 => known.or_else(|| tool.locate_near(&x[k], range, false, None)),
+            _ => None,
         })
         .collect()
 }
