@@ -35,17 +35,24 @@ def find_browser():
     return None
 
 
+# How long a DevTools reply may take, seconds.
+REPLY_TIMEOUT_S = 60
+
+
 class Page:
     """A Chrome DevTools Protocol session with one page; events are collected as they come."""
 
     def __init__(self, ws_url):
-        self.ws = websocket.create_connection(ws_url, timeout=60, suppress_origin=True)
+        self.ws = websocket.create_connection(ws_url, timeout=REPLY_TIMEOUT_S, suppress_origin=True)
         self.next_id = 0
         self.events = []
 
     def send(self, method, **params):
         self.next_id += 1
         my_id = self.next_id
+        # wait_for and drain leave the socket with the few milliseconds they had left: a reply
+        # gets the whole minute again (a busy machine took longer to answer an evaluate).
+        self.ws.settimeout(REPLY_TIMEOUT_S)
         self.ws.send(json.dumps({"id": my_id, "method": method, "params": params}))
         while True:
             msg = json.loads(self.ws.recv())
