@@ -71,9 +71,6 @@ pub struct SmoothPoint {
     /// open edge and it is off that edge outwards (the implicit surface runs on smoothly past
     /// the edge; pressed nodes are held back by the edge, free contact ends there).
     pub beyond_boundary: bool,
-    /// No sector's support reached the query: the point was found from the facet point instead
-    /// (past an open edge, the implicit surface's continuation ends where its sectors end).
-    pub from_facet: bool,
     /// The query point lay beyond a sharp edge or corner of its region: the region's surface
     /// would carry it across the edge (a table's top runs on as a plane past its rim), so the
     /// nearest tool is the edge itself.
@@ -382,21 +379,14 @@ impl<'a> SmoothSurface<'a> {
         (point, curved.then_some(curvature))
     }
 
-    /// Whether `q`, whose closest facet point is `foot`, lies beyond the tool's open boundary:
-    /// `foot` is on an open edge and `q` is off that edge outwards.
-    fn beyond_open_edge(&self, foot: &SurfacePoint, q: &Point) -> bool {
-        let l = self.tool.barycentric(foot.triangle, &foot.point);
-        let off = q - foot.point;
-        let tangential = off - foot.normal * foot.normal.dot(&off);
-        let outwards = |m: &Vector| tangential.dot(m) > BOUNDARY_TOLERANCE_REL * self.tool.diagonal();
-        self.tool.open_edges_at(foot.triangle, &l).iter().flatten().any(outwards)
-    }
-
     fn project_inner(&self, q: &Point, foot: &SurfacePoint, curved: bool) -> (SmoothPoint, Matrix3<f64>) {
         let region = self.regions[foot.triangle as usize];
         let l = self.tool.barycentric(foot.triangle, &foot.point);
         let off = q - foot.point;
-        let beyond_boundary = self.beyond_open_edge(foot, q);
+        let beyond_boundary = self.tool.open_edges_at(foot.triangle, &l).iter().flatten().any(|m| {
+            let tangential = off - foot.normal * foot.normal.dot(&off);
+            tangential.dot(m) > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
+        });
         let tol = PROJECTION_TOLERANCE_REL * self.tool.diagonal();
         // Newton steps along the gradient from q; from the facet point where no sector reaches q.
         let mut p = *q;
@@ -467,7 +457,6 @@ impl<'a> SmoothSurface<'a> {
             normal,
             region,
             beyond_boundary,
-            from_facet: restarted,
             beyond_region: beyond_crease || beyond_edge_or_corner,
         };
         (point, curvature)

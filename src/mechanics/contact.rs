@@ -78,23 +78,6 @@ impl ContactSurface for SmoothSurface<'_> {
     fn locate(&self, p: &Point, curved: bool, hint: Option<u32>) -> Foot {
         let facet = self.tool().closest_point_from(p, hint);
         let (s, curvature) = self.project_from_curved_if(p, &facet, curved);
-        if s.beyond_boundary && s.from_facet {
-            // Past the tool's open edge a pressed node rides on the implicit surface's
-            // continuation, which ends where the edge's sectors end; beyond that the projection
-            // fell back onto the edge itself, and a node there jumped a spacing back when it
-            // moved by a hair (no step could lower the energy: the hat box at 8 mm stalled).
-            // There the ply runs on along the surface's tangent plane at the edge instead.
-            let off = p - s.point;
-            return Foot {
-                point: p - s.normal * s.normal.dot(&off),
-                normal: s.normal,
-                open_edges: self.tool().open_edges_at(s.triangle, &s.barycentric),
-                gap: s.normal.dot(&off),
-                curvature: Some(Matrix3::zeros()),
-                region: s.region,
-                facet: s.triangle,
-            };
-        }
         Foot {
             point: s.point,
             normal: s.normal,
