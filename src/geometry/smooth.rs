@@ -68,8 +68,9 @@ pub struct SmoothPoint {
     /// The region (facets joined by smooth edges) whose surface the point is on.
     pub region: u32,
     /// The query point lay beyond the tool's open boundary: its closest facet point is on an
-    /// open edge and it is off that edge outwards (the implicit surface runs on smoothly past
-    /// the edge; pressed nodes are held back by the edge, free contact ends there).
+    /// open edge and it is off that edge outwards (the surface runs on past the edge as its
+    /// tangent plane there, see [`SmoothSurface::project`]; pressed nodes are held back by the
+    /// edge, free contact ends there).
     pub beyond_boundary: bool,
     /// The query point lay beyond a sharp edge or corner of its region: the region's surface
     /// would carry it across the edge (a table's top runs on as a plane past its rim), so the
@@ -352,7 +353,8 @@ impl<'a> SmoothSurface<'a> {
     /// The point of the smooth surface over `q`: reached from `q` (or, far from the surface,
     /// from its closest facet point) by Newton steps along the implicit function's gradient. For
     /// `q` on the surface, `q` itself. A retraction onto the surface, exact to first order, which
-    /// is what sliding contact needs.
+    /// is what sliding contact needs. Beyond an open edge of the tool, onto the surface's
+    /// continuation: the tangent plane of the surface over the query's closest point on the edge.
     pub fn project(&self, q: &Point) -> SmoothPoint {
         self.project_from(q, &self.tool.closest_point(q))
     }
@@ -383,12 +385,58 @@ impl<'a> SmoothSurface<'a> {
         let region = self.regions[foot.triangle as usize];
         let l = self.tool.barycentric(foot.triangle, &foot.point);
         let off = q - foot.point;
-        let beyond_boundary = self.tool.open_edges_at(foot.triangle, &l).iter().flatten().any(|m| {
+        let beyond_boundary = self.beyond_open_edge(q, foot, &l);
+        let (p, normal, curvature) = if beyond_boundary {
+            self.past_open_edge(q, foot, curved)
+        } else {
+            self.onto_region(q, foot, region, curved)
+        };
+        // A region's implicit surface runs on past its sharp edges (a table's top continues as a
+        // plane beyond the rim): where the point found lies across such an edge of the facet under
+        // the query, the query is beyond the region and the nearest tool is that edge.
+        // Only a query on the outer side of its facet: one inside the tool next to a convex edge
+        // is off both faces inwards and goes back out through the surface.
+        let (off_n, off_t) = (foot.normal.dot(&off), (off - foot.normal * foot.normal.dot(&off)).norm());
+        let outside = off_n >= -BOUNDARY_TOLERANCE_REL * self.tool.diagonal();
+        let lp = self.tool.barycentric(foot.triangle, &p);
+        let beyond_crease = outside
+            && (0..3).any(|k| {
+                lp[k] < -CREASE_OVERSHOOT_BARYCENTRIC
+                    && self.tool.neighbour(foot.triangle, k).is_some_and(|n| self.regions[n as usize] != region)
+            });
+        // Off a region's smooth part the query lies within the normals of its facets (which
+        // differ by less than the crease angle): a query off its facet at a steeper angle is
+        // beyond a sharp edge or corner (a sheet's node beside a table's corner).
+        let beyond_edge_or_corner = outside
+            && off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
+            && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
+        let point = SmoothPoint {
+            point: p,
+            triangle: foot.triangle,
+            barycentric: clamp_barycentric(l),
+            normal,
+            region,
+            beyond_boundary,
+            beyond_region: beyond_crease || beyond_edge_or_corner,
+        };
+        (point, curvature)
+    }
+
+    /// Whether `q` lies beyond an open edge of the tool: its closest facet point `foot`
+    /// (barycentric `l` on its facet) is on an open edge and `q` is off it outwards.
+    fn beyond_open_edge(&self, q: &Point, foot: &SurfacePoint, l: &[f64; 3]) -> bool {
+        let off = q - foot.point;
+        self.tool.open_edges_at(foot.triangle, l).iter().flatten().any(|m| {
             let tangential = off - foot.normal * foot.normal.dot(&off);
             tangential.dot(m) > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
-        });
+        })
+    }
+
+    /// `q` taken onto the implicit surface of `region` by Newton steps along its gradient (from
+    /// the facet point `foot` where no sector of the region reaches `q`): the point, its normal
+    /// and, if `curved`, its curvature.
+    fn onto_region(&self, q: &Point, foot: &SurfacePoint, region: u32, curved: bool) -> (Point, Vector, Matrix3<f64>) {
         let tol = PROJECTION_TOLERANCE_REL * self.tool.diagonal();
-        // Newton steps along the gradient from q; from the facet point where no sector reaches q.
         let mut p = *q;
         let mut normal = foot.normal;
         let mut restarted = false;
@@ -422,25 +470,6 @@ impl<'a> SmoothSurface<'a> {
             p -= g * (f / g2);
             reach = 0.5 * f.abs() / g2.sqrt() + tol;
         }
-        // A region's implicit surface runs on past its sharp edges (a table's top continues as a
-        // plane beyond the rim): where the point found lies across such an edge of the facet under
-        // the query, the query is beyond the region and the nearest tool is that edge.
-        // Only a query on the outer side of its facet: one inside the tool next to a convex edge
-        // is off both faces inwards and goes back out through the surface.
-        let (off_n, off_t) = (foot.normal.dot(&off), (off - foot.normal * foot.normal.dot(&off)).norm());
-        let outside = off_n >= -BOUNDARY_TOLERANCE_REL * self.tool.diagonal();
-        let lp = self.tool.barycentric(foot.triangle, &p);
-        let beyond_crease = outside
-            && (0..3).any(|k| {
-                lp[k] < -CREASE_OVERSHOOT_BARYCENTRIC
-                    && self.tool.neighbour(foot.triangle, k).is_some_and(|n| self.regions[n as usize] != region)
-            });
-        // Off a region's smooth part the query lies within the normals of its facets (which
-        // differ by less than the crease angle): a query off its facet at a steeper angle is
-        // beyond a sharp edge or corner (a sheet's node beside a table's corner).
-        let beyond_edge_or_corner = outside
-            && off.norm() > BOUNDARY_TOLERANCE_REL * self.tool.diagonal()
-            && off_t > off_n.abs() * CREASE_ANGLE_DEG.to_radians().tan();
         let curvature = if curved {
             let candidates = match self.near_facet(foot.triangle, &p) {
                 Some(c) => c,
@@ -450,16 +479,58 @@ impl<'a> SmoothSurface<'a> {
         } else {
             Matrix3::zeros()
         };
-        let point = SmoothPoint {
-            point: p,
-            triangle: foot.triangle,
-            barycentric: clamp_barycentric(l),
-            normal,
-            region,
-            beyond_boundary,
-            beyond_region: beyond_crease || beyond_edge_or_corner,
-        };
-        (point, curvature)
+        (p, normal, curvature)
+    }
+
+    /// `q`, beyond an open edge of the tool, taken onto the surface's continuation there: the
+    /// tangent plane of the smooth surface over the query's closest point on the edge (the
+    /// surface runs on as it leaves the tool, with its normal continuous across the edge). The
+    /// point, its normal and, if `curved`, the continuation's curvature.
+    ///
+    /// Why not the region's implicit surface, which runs on past the edge too: it runs on only
+    /// as far as its sectors' supports reach, a ragged band whose width follows the facets along
+    /// the edge, and beyond it the Newton steps fell back to the edge itself. A pressed node
+    /// sliding along the edge at a few millimetres out met that band's border as a cliff: the
+    /// least move on past it put the node back on the edge, stretching its fibres by millimetres,
+    /// and no step that moved it that way lowered the energy (the hat box at 8 mm and +45 deg
+    /// stalled there at |F-P|/|P| 1.27).
+    fn past_open_edge(&self, q: &Point, foot: &SurfacePoint, curved: bool) -> (Point, Vector, Matrix3<f64>) {
+        let tol = PROJECTION_TOLERANCE_REL * self.tool.diagonal();
+        let mut foot = *foot;
+        let mut p = *q;
+        for _ in 0..PROJECTION_MAX_ITERATIONS {
+            let region = self.regions[foot.triangle as usize];
+            let (edge, normal, _) = self.onto_region(&foot.point, &foot, region, false);
+            let lift = normal.dot(&(p - edge));
+            if lift.abs() <= tol {
+                let curvature = if curved {
+                    // The continuation is ruled by straight lines out of the edge: no curvature
+                    // along them; across them it curves as the surface at the edge does.
+                    let c = self.curvature_near(region, foot.triangle, &edge);
+                    let out = p - edge;
+                    match (out - normal * normal.dot(&out)).try_normalize(tol) {
+                        Some(u) => c - u * u.transpose() * u.dot(&(c * u)),
+                        None => c,
+                    }
+                } else {
+                    Matrix3::zeros()
+                };
+                return (p, normal, curvature);
+            }
+            // Along the edge's normal, which on a curved tool is not the facet's: the point's
+            // closest facet point may move, and with it the edge point the plane is taken at.
+            p -= normal * lift;
+            foot = self.tool.closest_point_from(&p, Some(foot.triangle));
+            let l = self.tool.barycentric(foot.triangle, &foot.point);
+            if !self.beyond_open_edge(&p, &foot, &l) {
+                // Back over the tool (a point barely beyond an edge that curves inwards).
+                return self.onto_region(&p, &foot, self.regions[foot.triangle as usize], curved);
+            }
+        }
+        let region = self.regions[foot.triangle as usize];
+        let (edge, normal, _) = self.onto_region(&foot.point, &foot, region, false);
+        let curvature = if curved { self.curvature_near(region, foot.triangle, &edge) } else { Matrix3::zeros() };
+        (p - normal * normal.dot(&(p - edge)), normal, curvature)
     }
 }
 
@@ -574,6 +645,32 @@ mod tests {
                 // The same from the sectors kept beside the facet (a foot's curvature computed
                 // after its projection, `mechanics::contact`).
                 assert_eq!(curvature, smooth.curvature_near(s.region, s.triangle, &s.point), "at {q}");
+            }
+        }
+    }
+
+    #[test]
+    fn past_an_open_edge_the_surface_runs_on_as_its_tangent_plane_without_a_jump() {
+        // The hemisphere's rim is open and its wall about vertical there: beyond the rim the
+        // surface runs on downwards. Walked out from the rim, the projections move steadily,
+        // project onto themselves and stay by the query: the region's implicit surface ran on
+        // only as far as its sectors reached (about 0.2 here) and past that the projection
+        // jumped back onto the rim.
+        let tool = shapes::hemisphere(1.0, 12).into_surface().unwrap();
+        let smooth = SmoothSurface::new(&tool);
+        let step = 0.005;
+        for phi in [0.1f64, 0.7, 2.0, 4.4] {
+            let mut last = smooth.project(&Point::new(phi.cos(), phi.sin(), 0.0));
+            for k in 1..=100 {
+                let q = Point::new(phi.cos(), phi.sin(), -step * k as f64);
+                let s = smooth.project(&q);
+                assert!(s.beyond_boundary, "{q} is past the rim");
+                assert!((s.point - last.point).norm() < 2.0 * step, "at {q}: {} after {}", s.point, last.point);
+                assert!((s.point - q).norm() < 0.1 * (q.z.abs() + step), "at {q}: {}", s.point);
+                assert!(s.normal.angle(&last.normal) < 1e-2, "the normal turns at {q}");
+                let again = smooth.project(&s.point);
+                assert!((again.point - s.point).norm() < 1e-12, "{} vs {}", again.point, s.point);
+                last = s;
             }
         }
     }
