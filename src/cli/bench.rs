@@ -118,8 +118,8 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         );
         for i in &iterations {
             println!(
-                "  iteration {:>3}: |F-P|/|P| {:.1e}, shift {:.0e}, step {:.3} spacings, {} subproblem(s) ({} by CG on the last factorisation), {:.0} ms (models {:.0}, Clarabel {:.0}, trial steps {:.0})",
-                i.iteration, i.residual, i.shift, i.step, i.subproblems, i.lagged, i.time_ms, i.model_ms, i.solve_ms, i.trial_ms
+                "  iteration {:>3}: |F-P|/|P| {:.1e}, shift {:.0e}, step {:.3} spacings, {} subproblem(s) ({} by CG on the last factorisation, {} solved ahead), {:.0} ms (models {:.0}, Clarabel {:.0}, trial steps {:.0})",
+                i.iteration, i.residual, i.shift, i.step, i.subproblems, i.lagged, i.ahead, i.time_ms, i.model_ms, i.solve_ms, i.trial_ms
             );
         }
         let sum = |f: fn(&&crate::mechanics::solver::IterationLog) -> f64| iterations.iter().map(f).sum::<f64>() / 1e3;

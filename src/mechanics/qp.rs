@@ -393,7 +393,9 @@ pub enum QpFailure {
     NotSolved(String),
 }
 
-/// One Clarabel solver per sparsity pattern, its data updated between subproblems.
+/// One Clarabel solver per sparsity pattern, its data updated between subproblems (and a spare
+/// one that solves the next rung of the shift ahead on the other core,
+/// [`QpEngine::solve_ahead`]).
 #[derive(Default)]
 pub struct QpEngine {
     cached: Option<(Vec<u8>, DefaultSolver<f64>)>,
@@ -411,6 +413,21 @@ pub struct QpEngine {
     pub lagged_solves: u32,
     /// Time spent in Clarabel (set-up, updates and solves), ms.
     pub time_ms: f64,
+    /// A second engine, for models solved ahead on the other core ([`QpEngine::solve_ahead`]).
+    spare: Option<Box<QpEngine>>,
+    /// The model the spare engine solved ahead and holds factorised, and its result.
+    ahead: Option<Ahead>,
+    /// Subproblems answered by a solve made ahead.
+    pub solved_ahead: u32,
+}
+
+/// A subproblem solved ahead: its pattern, freedoms, matrix and forces, and its result.
+struct Ahead {
+    key: Vec<u8>,
+    dofs: Vec<u8>,
+    values: Vec<f64>,
+    q: Vec<f64>,
+    result: Result<Vec<f64>, QpFailure>,
 }
 
 impl QpEngine {
@@ -450,6 +467,56 @@ impl QpEngine {
     /// triangle `values` in `red`'s pattern). Returns y.
     pub fn solve(&mut self, red: &Reduction, values: &[f64], q: &[f64]) -> Result<Vec<f64>, QpFailure> {
         self.solve_refined(red, values, q, true)
+    }
+
+    /// As [`QpEngine::solve`], and meanwhile, on the other core, the same forces with the matrix
+    /// `next`: the model the caller tries next if this one's step is refused (the shift's next
+    /// rung). A later [`QpEngine::solve`] of exactly that model returns the result at once and
+    /// holds its factorisation (for the second-order correction). Each solve is what it would
+    /// be alone, so the caller's path is the same with one thread or two; with one, nothing is
+    /// solved ahead.
+    pub fn solve_ahead(
+        &mut self,
+        red: &Reduction,
+        values: &[f64],
+        q: &[f64],
+        next: &[f64],
+    ) -> Result<Vec<f64>, QpFailure> {
+        if rayon::current_num_threads() < 2 || red.is_empty() || self.answer_ahead(red, values, q).is_some() {
+            return self.solve(red, values, q);
+        }
+        let start = std::time::Instant::now();
+        let mut spare = self.spare.take().unwrap_or_default();
+        let (now, later) =
+            rayon::join(|| self.solve_timed(red, values, q, red.len(), true), || spare.solve(red, next, q));
+        self.spare = Some(spare);
+        self.ahead = Some(Ahead {
+            key: red.key().to_vec(),
+            dofs: red.dofs().to_vec(),
+            values: next.to_vec(),
+            q: q.to_vec(),
+            result: later,
+        });
+        self.time_ms += start.elapsed().as_secs_f64() * 1e3;
+        now
+    }
+
+    /// Whether the subproblem (`values`, `q`) was solved ahead by the spare engine.
+    fn answer_ahead(&self, red: &Reduction, values: &[f64], q: &[f64]) -> Option<&Ahead> {
+        self.ahead.as_ref().filter(|a| {
+            a.key.as_slice() == red.key() && a.dofs.as_slice() == red.dofs() && a.values == values && a.q == q
+        })
+    }
+
+    /// Takes the answer solved ahead, swapping the spare engine's factorisation in as this one's.
+    fn take_ahead(&mut self) -> Option<Result<Vec<f64>, QpFailure>> {
+        let ahead = self.ahead.take()?;
+        let spare = self.spare.as_mut()?;
+        std::mem::swap(&mut self.cached, &mut spare.cached);
+        std::mem::swap(&mut self.factored, &mut spare.factored);
+        std::mem::swap(&mut self.lagged, &mut spare.lagged);
+        self.solved_ahead += 1;
+        Some(ahead.result)
     }
 
     /// As [`QpEngine::solve`] for a matrix the caller knows to be near the one last factorised
@@ -546,6 +613,11 @@ impl QpEngine {
         let n = red.len();
         if n == 0 {
             return Ok(Vec::new());
+        }
+        if self.answer_ahead(red, values, q).is_some() {
+            if let Some(result) = self.take_ahead() {
+                return result;
+            }
         }
         let start = std::time::Instant::now();
         let result = self.solve_timed(red, values, q, n, refine);
@@ -717,6 +789,40 @@ pub(super) mod tests {
         assert_eq!(engine.lagged_solves, 2);
         let want = exact(&far);
         assert!((DVector::from_column_slice(&y) - &want).norm() < 1e-9 * want.norm());
+    }
+
+    #[test]
+    fn the_next_rung_solved_ahead_is_the_one_a_lone_solve_gives() {
+        let red = Reduction::new(vec![3, 3], vec![3, 3], vec![0, 1], &[(0, 0), (0, 1), (1, 1)]);
+        let bases = [NodeBasis::free(), NodeBasis::free()];
+        let (p, m) = (spd(0.7), DMatrix::identity(6, 6));
+        let q1 = [1.0, -2.0, 0.5, 0.25, 3.0, -1.0];
+        let q2 = [-0.5, 1.0, 2.0, -1.5, 0.0, 0.75];
+        let now = red.values(&Dense(&p + &m * 1e-3), &bases);
+        let next = red.values(&Dense(&p + &m * 4e-3), &bases);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let mut engine = QpEngine::new();
+        let (y_now, y_next, y_corrected) = pool.install(|| {
+            let y_now = engine.solve_ahead(&red, &now, &q1, &next).unwrap();
+            // The step was refused: the next rung is answered at once ...
+            let y_next = engine.solve(&red, &next, &q1).unwrap();
+            // ... and its factorisation is the one held for the correction that follows.
+            let y_corrected = engine.solve(&red, &next, &q2).unwrap();
+            (y_now, y_next, y_corrected)
+        });
+        assert_eq!(engine.solved_ahead, 1);
+        assert_eq!(engine.reused_factorisations, 1);
+        // Bit for bit what one engine solving them in turn gives: the path does not depend on
+        // whether the second core was there.
+        let mut alone = QpEngine::new();
+        assert_eq!(y_now, alone.solve(&red, &now, &q1).unwrap());
+        assert_eq!(y_next, alone.solve(&red, &next, &q1).unwrap());
+        assert_eq!(y_corrected, alone.solve(&red, &next, &q2).unwrap());
+        // Another model is not taken for the one solved ahead.
+        let other = red.values(&Dense(&p + &m * 16e-3), &bases);
+        pool.install(|| engine.solve_ahead(&red, &now, &q2, &other).unwrap());
+        assert_eq!(engine.solve(&red, &other, &q1).unwrap(), alone.solve(&red, &other, &q1).unwrap());
+        assert_eq!(engine.solved_ahead, 1);
     }
 
     #[test]
