@@ -482,7 +482,7 @@ impl QpEngine {
         q: &[f64],
         next: &[f64],
     ) -> Result<Vec<f64>, QpFailure> {
-        if rayon::current_num_threads() < 2 || red.is_empty() || self.answer_ahead(red, values, q).is_some() {
+        if rayon::current_num_threads() < 2 || red.is_empty() || self.is_ahead(red, values, q) {
             return self.solve(red, values, q);
         }
         let start = std::time::Instant::now();
@@ -502,8 +502,8 @@ impl QpEngine {
     }
 
     /// Whether the subproblem (`values`, `q`) was solved ahead by the spare engine.
-    fn answer_ahead(&self, red: &Reduction, values: &[f64], q: &[f64]) -> Option<&Ahead> {
-        self.ahead.as_ref().filter(|a| {
+    fn is_ahead(&self, red: &Reduction, values: &[f64], q: &[f64]) -> bool {
+        self.ahead.as_ref().is_some_and(|a| {
             a.key.as_slice() == red.key() && a.dofs.as_slice() == red.dofs() && a.values == values && a.q == q
         })
     }
@@ -614,7 +614,7 @@ impl QpEngine {
         if n == 0 {
             return Ok(Vec::new());
         }
-        if self.answer_ahead(red, values, q).is_some() {
+        if self.is_ahead(red, values, q) {
             if let Some(result) = self.take_ahead() {
                 return result;
             }

@@ -1133,8 +1133,6 @@ fn dofs_of(bases: &[NodeBasis], rep: &[usize]) -> Vec<u8> {
     bases.iter().enumerate().map(|(k, b)| if rep[k] == k { b.dofs as u8 } else { 0 }).collect()
 }
 
-/// Where each node meets the tool: on-tool nodes always (their feet from the last move when
-/// given), free nodes in free contact when within [`CONTACT_RANGE`] spacings of it.
 /// The state at `x`: its evaluation, feet (those `known` from the move that found `x`, the rest
 /// located), bases of motion, and the tool's curvature at the feet of the nodes that slide on
 /// it (the model's contact term needs it there and nowhere else: a free node near the tool but
@@ -1153,8 +1151,10 @@ fn state_at(objective: &dyn Objective, cons: &Constraints, rep: &[usize], x: &[P
     State { eval, feet, bases, sliding }
 }
 
-/// The feet at `x`: those `known` (found by the move to `x`), the rest located (without the
-/// tool's curvature, which [`state_at`] adds where it is needed).
+/// Where each node meets the tool at `x`: on-tool nodes always (their feet `known` from the
+/// move that found `x` when given, the rest located), free nodes in free contact when within
+/// [`CONTACT_RANGE`] spacings of it; without the tool's curvature, which [`state_at`] adds where
+/// it is needed.
 fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
     let Some(tool) = cons.tool else { return vec![None; x.len()] };
     let range = CONTACT_RANGE * cons.spacing;
