@@ -102,11 +102,22 @@ pub struct ChoiceIndicators {
     /// (absent when mechanics did not run or that drape did not converge).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mechanical_discretisation_deg: Option<f64>,
+    /// The same estimate over the cells below the locking angle in both drapes, degrees (past
+    /// it the fabric wrinkles and the shear there need not converge with the spacing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanical_discretisation_unlocked_deg: Option<f64>,
     /// The spacing that estimate asks for to keep the pressed drape within the tolerance, m
-    /// (present only when the ply's spacing is too coarse; mechanics does not run finer by
-    /// itself).
+    /// (present only when the ply's spacing is too coarse; auto then presses the ply again at
+    /// the spacing it asks for, within its node budget).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mechanical_spacing_needed_m: Option<f64>,
+    /// Where auto pressed the ply again finer: that drape's own estimated largest cell-shear
+    /// error, degrees, against the drape at the ply's spacing (Richardson with their ratio).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refined_mechanical_discretisation_deg: Option<f64>,
+    /// The same over the cells below the locking angle, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refined_mechanical_discretisation_unlocked_deg: Option<f64>,
     /// Largest cell-shear change of the steps of the mechanical model from the kinematic net
     /// until the nodes settle, degrees: how far the kinematic net lies from equilibrium under
     /// the ply's card (absent when no step could be taken).

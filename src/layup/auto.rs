@@ -21,9 +21,16 @@
 //!   the error of the ply's spacing by Richardson's estimate (difference over 2^p - 1, the
 //!   fishnet being second order). Above the spacing's share of the tolerance a kinematic ply is
 //!   draped again at a spacing d / k (k whole, so the grid keeps its nodes, at most
-//!   [`MAX_REFINEMENT`]). A mechanical ply runs at its own spacing (mechanics at d / k costs
-//!   k^2 times the nodes and more iterations: the four-ply double dome at d/3 took 43 minutes on
-//!   the loaded 2-core machine), and the spacing the kinematic net would need is reported.
+//!   [`MAX_REFINEMENT`]). A mechanical ply starts at its own spacing, and the spacing the
+//!   kinematic net would need is reported.
+//! - **the pressed drape's spacing**: where mechanics ran, the same estimate from the ply pressed
+//!   at twice the spacing. Above the tolerance the ply is draped and pressed again at d / k,
+//!   the least k the estimate says will do (at most [`MAX_REFINEMENT`]), within
+//!   [`MECHANICAL_NODE_BUDGET`] (mechanics at d / k costs k^2 the nodes and more iterations),
+//!   and that drape's own error is estimated against the one at d. Once; the reason says
+//!   `NOT ASSURED at this spacing` where the last estimate is still above the tolerance (near
+//!   locked corners the shear converges slowly: the hat box at 4 and 2 mm). Both estimates
+//!   also give the error over the cells below the locking angle.
 //!
 //! The choice, its reason and the measurements are recorded ([`MethodChoice`]) in the net's meta
 //! and in `layup.json`, and shown in the layup table and the report.
@@ -128,6 +135,9 @@ pub enum AutoError {
 }
 
 /// Choose the ply's model ([`choose`]) and run mechanics if it was chosen, on one smooth surface.
+/// Where the pressed drape's own spacing error is estimated above the tolerance, the ply is
+/// pressed again at the spacing the estimate asks for, within [`MECHANICAL_NODE_BUDGET`]
+/// ([`press_finer`]).
 pub fn drape_auto(
     surface: &ToolSurface,
     settings: &KinematicSettings,
@@ -137,30 +147,110 @@ pub fn drape_auto(
 ) -> Result<AutoResult, AutoError> {
     let surfaces = Surfaces::new(surface);
     let mut a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
-    let refined = if a.mechanical() {
-        let start = a.start.as_deref().unwrap_or(&a.net.positions);
-        let refined = refinement.run_from(&a.net, start, surface, surfaces.for_refinement(refinement))?;
-        let t = Instant::now();
-        weigh_mechanical_spacing(&surfaces, settings, refinement, &refined.0, &mut a.choice);
-        a.choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
-        Some(refined)
-    } else {
-        None
+    if !a.mechanical() {
+        return Ok(AutoResult { kinematic: a.net, refined: None, choice: a.choice });
+    }
+    let start = a.start.as_deref().unwrap_or(&a.net.positions);
+    let refined = refinement.run_from(&a.net, start, surface, surfaces.for_refinement(refinement))?;
+    let t = Instant::now();
+    let estimate = weigh_mechanical_spacing(&surfaces, settings, refinement, &refined.0, locking_angle, &mut a.choice);
+    a.choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
+    let (kinematic, refined) = match estimate {
+        Some(e) if e.largest > a.choice.tolerance_deg => {
+            press_finer(&surfaces, settings, refinement, locking_angle, e, (a.net, refined), &mut a.choice)?
+        }
+        _ => (a.net, refined),
     };
-    Ok(AutoResult { kinematic: a.net, refined, choice: a.choice })
+    Ok(AutoResult { kinematic, refined: Some(refined), choice: a.choice })
 }
 
+/// Most nodes auto presses a ply with when it refines the pressed drape's spacing by itself
+/// (the hat box at 2 mm, 43 517 nodes, presses in about 5 s; the double dome's +45 ply at
+/// 2.5 mm, 32 361 nodes, in about 3 minutes: the solver's iterations, not the nodes, set the
+/// cost). Past it, the reason gives the spacing that would do.
+pub const MECHANICAL_NODE_BUDGET: usize = 50_000;
+
+/// The pressed drape at the ply's spacing `d` is estimated to err by `estimate`, above the
+/// tolerance: drape and press the ply again at d / k, k whole (so the grid keeps its nodes),
+/// the least that the estimate (order 2) says meets the tolerance, at most [`MAX_REFINEMENT`]
+/// and within [`MECHANICAL_NODE_BUDGET`]. The finer drape's own error is then estimated from
+/// the one at `d` (Richardson with ratio k), at no further cost. Returns the kinematic and
+/// pressed nets that stand: the finer ones if that drape converged, else those at `d`.
+fn press_finer(
+    surfaces: &Surfaces,
+    settings: &KinematicSettings,
+    refinement: &Refinement,
+    locking_angle: f64,
+    estimate: SpacingError,
+    at_d: (DrapeNet, (DrapeNet, Refined)),
+    choice: &mut MethodChoice,
+) -> Result<(DrapeNet, (DrapeNet, Refined)), AutoError> {
+    let d = settings.spacing;
+    let tolerance = choice.tolerance_deg;
+    let needed = spacing_for(d, estimate.largest, tolerance);
+    // The grid at d / k (an outline's grid scales the same way).
+    let (nu, nv) = (at_d.0.nu, at_d.0.nv);
+    let nodes = |k: usize| ((nu - 1) * k + 1) * ((nv - 1) * k + 1);
+    let wanted = ((d / needed).ceil() as usize).clamp(2, MAX_REFINEMENT);
+    let Some(k) = (2..=wanted).rev().find(|&k| nodes(k) <= MECHANICAL_NODE_BUDGET) else {
+        choice.reason.push_str(&format!(
+            "; NOT ASSURED at this spacing: auto does not press it finer by itself, for at d/2 the ply has {} nodes, more than its budget of {MECHANICAL_NODE_BUDGET}",
+            nodes(2)
+        ));
+        return Ok(at_d);
+    };
+    let finer = settings.at_spacing(d / k as f64);
+    let t = Instant::now();
+    let kinematic = surfaces.drape(&finer)?;
+    let pressed = refinement.run_draped(&kinematic, surfaces.tool, surfaces.for_refinement(refinement), &finer)?;
+    if !pressed.1.ok() {
+        choice.reason.push_str(&format!(
+            "; pressed again at d/{k} = {:.4} m the ply did not converge ({}): the drape at the ply's spacing stands, NOT ASSURED",
+            finer.spacing, pressed.1.describe_failure()
+        ));
+        choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
+        return Ok(at_d);
+    }
+    let coarse = &at_d.1 .0;
+    let Some(e) = SpacingError::between(&pressed.0, coarse, k as f64, locking_angle) else {
+        choice.reason.push_str(&format!(
+            "; pressed again at d/{k} = {:.4} m its spacing error could not be estimated (no cell to compare with the drape at d): the drape at the ply's spacing stands, NOT ASSURED",
+            finer.spacing
+        ));
+        return Ok(at_d);
+    };
+    choice.spacing_m = finer.spacing;
+    choice.indicators.refined_mechanical_discretisation_deg = Some(e.largest);
+    choice.indicators.refined_mechanical_discretisation_unlocked_deg = e.unlocked;
+    choice.reason.push_str(&format!(
+        "; so the ply was draped and pressed again at d/{k} = {:.4} m ({} nodes{}), whose own spacing error, against the drape at the ply's spacing, is estimated at {}",
+        finer.spacing,
+        nodes(k),
+        if k < wanted { format!(", the finest within auto's budget of {MECHANICAL_NODE_BUDGET}") } else { String::new() },
+        e.describe()
+    ));
+    if e.largest <= tolerance {
+        choice.reason.push_str(": within the tolerance");
+    } else {
+        choice.reason.push_str(&format!(
+            ", above the {tolerance} deg tolerance: NOT ASSURED at this spacing (it would need spacing <= {:.4} m)",
+            spacing_for(finer.spacing, e.largest, tolerance)
+        ));
+    }
+    Ok((kinematic, pressed))
+}
 /// Mechanics ran at the ply's spacing: estimates the pressed drape's own spacing error from the
-/// same drape at twice the spacing (order 2, as the kinematic net's) and says in the choice
-/// whether the tolerance holds. The ply is not refined further by itself: mechanics at d/k
-/// costs k^2 the nodes and more iterations (the reason gives the spacing that would do).
+/// same drape at twice the spacing (order 2, as the kinematic net's), records it in the choice
+/// and says whether the tolerance holds. `None` when that drape did not converge or has no cell
+/// to compare.
 fn weigh_mechanical_spacing(
     surfaces: &Surfaces,
     settings: &KinematicSettings,
     refinement: &Refinement,
     refined: &DrapeNet,
+    locking_angle: f64,
     choice: &mut MethodChoice,
-) {
+) -> Option<SpacingError> {
     let tolerance = choice.tolerance_deg;
     // Only its positions count: no stability check and no record (the ply's other settings,
     // escapes included, kept so that it is the same drape at 2d).
@@ -175,24 +265,68 @@ fn weigh_mechanical_spacing(
             refine_draped(&net, &draped, surfaces.tool, smooth, &refinement.material, &solve).ok()
         })
         .filter(Refined::ok);
-    let Some(e) = coarse.and_then(|r| richardson(refined, &r.net)) else {
+    let Some(e) = coarse.and_then(|r| SpacingError::between(refined, &r.net, 2.0, locking_angle)) else {
         choice.reason.push_str(
             "; the pressed drape's own spacing error could not be estimated (the pressed drape at twice the spacing did not converge or has no cell to compare)",
         );
-        return;
+        return None;
     };
-    choice.indicators.mechanical_discretisation_deg = Some(e);
-    if e <= tolerance {
-        choice.reason.push_str(&format!(
-            "; the pressed drape's own spacing error is estimated at {e:.3} deg (against the same drape at twice the spacing): within the tolerance"
-        ));
+    choice.indicators.mechanical_discretisation_deg = Some(e.largest);
+    choice.indicators.mechanical_discretisation_unlocked_deg = e.unlocked;
+    choice.reason.push_str(&format!(
+        "; the pressed drape's own spacing error, against the same drape at twice the spacing, is estimated at {}",
+        e.describe()
+    ));
+    if e.largest <= tolerance {
+        choice.reason.push_str(": within the tolerance");
     } else {
-        let d = settings.spacing;
-        let needed = spacing_for(d, e, tolerance);
+        let needed = spacing_for(settings.spacing, e.largest, tolerance);
         choice.indicators.mechanical_spacing_needed_m = Some(needed);
-        choice.reason.push_str(&format!(
-            "; the pressed drape's own spacing error is estimated at {e:.2} deg (against the same drape at twice the spacing), above the {tolerance} deg tolerance: NOT ASSURED at this spacing; give spacing <= {needed:.4} m for it (mechanics at d/k costs k^2 the nodes, so auto does not refine it by itself)"
-        ));
+        choice.reason.push_str(&format!(", above the {tolerance} deg tolerance: it asks for spacing <= {needed:.4} m"));
+    }
+    Some(e)
+}
+
+/// Richardson's estimate of a drape's largest cell-shear error from its spacing, over all its
+/// complete cells and over those below the locking angle.
+#[derive(Debug, Clone, Copy)]
+struct SpacingError {
+    /// Over every complete cell, degrees.
+    largest: f64,
+    /// Over the cells below the locking angle in both drapes, degrees (`None` when none is).
+    unlocked: Option<f64>,
+}
+
+impl SpacingError {
+    /// The estimate for `fine` against `coarse`, the same drape at `ratio` times the spacing:
+    /// their largest difference at `fine`'s complete cell centres over ratio^p - 1 (p =
+    /// [`FISHNET_ORDER`]), `locking_angle` in radians.
+    fn between(fine: &DrapeNet, coarse: &DrapeNet, ratio: f64, locking_angle: f64) -> Option<Self> {
+        let (fine, coarse) = (ShearField::of(fine), ShearField::of(coarse));
+        let locking = locking_angle.to_degrees();
+        let scale = ratio.powf(FISHNET_ORDER) - 1.0;
+        let mut largest: Option<f64> = None;
+        let mut unlocked: Option<f64> = None;
+        for (u, v) in fine.complete_cell_centres() {
+            let (Some(a), Some(b)) = (fine.at(u, v), coarse.at(u, v)) else { continue };
+            let e = (a - b).abs() / scale;
+            largest = Some(largest.map_or(e, |m| m.max(e)));
+            if a.abs() < locking && b.abs() < locking {
+                unlocked = Some(unlocked.map_or(e, |m| m.max(e)));
+            }
+        }
+        Some(Self { largest: largest?, unlocked })
+    }
+
+    /// The estimate in words: the largest, and the one below the locking angle where it is less.
+    fn describe(&self) -> String {
+        match self.unlocked {
+            // Said only where it tells something: the locked cells carry the largest error.
+            Some(u) if u < 0.95 * self.largest => {
+                format!("{:.3} deg ({u:.3} deg in the cells below the locking angle)", self.largest)
+            }
+            _ => format!("{:.3} deg", self.largest),
+        }
     }
 }
 
@@ -304,7 +438,7 @@ pub fn choose(
         // Mechanics at a finer spacing costs the square of the refinement in nodes and more
         // iterations: it runs at the ply's spacing, and the estimate is reported.
         reason.push_str(&format!(
-            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics runs at the ply's spacing",
+            "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics starts at the ply's spacing",
             discretisation.unwrap_or_default()
         ));
     } else if let Some(needed) = spacing_needed {
@@ -363,16 +497,9 @@ fn discretisation_error(surfaces: &Surfaces, settings: &KinematicSettings, net: 
 }
 
 /// Richardson's estimate of the largest cell-shear error of `fine` against `coarse`, the same
-/// drape at twice the spacing, degrees: their largest difference at `fine`'s complete cell
-/// centres over 2^p - 1 (p = [`FISHNET_ORDER`]).
+/// drape at twice the spacing, degrees ([`SpacingError::between`], every cell).
 fn richardson(fine: &DrapeNet, coarse: &DrapeNet) -> Option<f64> {
-    let (fine, coarse) = (ShearField::of(fine), ShearField::of(coarse));
-    let largest = fine
-        .complete_cell_centres()
-        .into_iter()
-        .filter_map(|(u, v)| Some((fine.at(u, v)? - coarse.at(u, v)?).abs()))
-        .reduce(f64::max)?;
-    Some(largest / (2f64.powf(FISHNET_ORDER) - 1.0))
+    SpacingError::between(fine, coarse, 2.0, f64::INFINITY).map(|e| e.largest)
 }
 
 /// Most iterations the probe takes before it calls the nodes settled.

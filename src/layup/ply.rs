@@ -179,15 +179,17 @@ impl Refinement {
 
     /// Refine the kinematic `net` draped on `surface` with `draped`, as a scene's ply is: as
     /// [`Refinement::run`], but a pressed refinement on the smooth patches of a net draped on
-    /// the facets starts from the ply draped on the smooth surface ([`refine_draped`]).
+    /// the facets starts from the ply draped on the smooth surface ([`refine_draped`]; `smooth`
+    /// as in [`Refinement::run`]).
     pub fn run_draped(
         &self,
         net: &DrapeNet,
         surface: &ToolSurface,
+        smooth: Option<&SmoothSurface>,
         draped: &KinematicSettings,
     ) -> Result<(DrapeNet, Refined), RefineError> {
         let t = Instant::now();
-        let result = refine_draped(net, draped, surface, None, &self.material, &self.settings())?;
+        let result = refine_draped(net, draped, surface, smooth, &self.material, &self.settings())?;
         Ok(self.annotated(net, result, t))
     }
 

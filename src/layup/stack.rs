@@ -298,7 +298,7 @@ pub fn drape_layup(
                     }
                 };
                 let refined = match start {
-                    Start::Kinematic => r.as_ref().map(|r| r.run_draped(&net, surface, &settings)),
+                    Start::Kinematic => r.as_ref().map(|r| r.run_draped(&net, surface, None, &settings)),
                     Start::Flat { .. } => r.as_ref().map(|r| r.run(&net, surface, None)),
                 }
                 .transpose()
