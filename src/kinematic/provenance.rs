@@ -111,11 +111,20 @@ pub struct ChoiceIndicators {
     /// the spacing it asks for, within its node budget).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mechanical_spacing_needed_m: Option<f64>,
+    /// Where auto pressed the ply again finer: the order of convergence in the spacing its
+    /// three pressed drapes (2d, d, d / k) show at their largest cell-shear differences (absent
+    /// when the difference does not fall with the spacing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanical_observed_order: Option<f64>,
+    /// The same over the cells below the locking angle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanical_observed_order_unlocked: Option<f64>,
     /// Where auto pressed the ply again finer: that drape's own estimated largest cell-shear
-    /// error, degrees, against the drape at the ply's spacing (Richardson with their ratio).
+    /// error, degrees, against the drape at the ply's spacing (Richardson with their ratio, at
+    /// the observed order, at most 2; absent when no order is observed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refined_mechanical_discretisation_deg: Option<f64>,
-    /// The same over the cells below the locking angle, degrees.
+    /// The same over the cells below the locking angle, degrees (at their own observed order).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refined_mechanical_discretisation_unlocked_deg: Option<f64>,
     /// Largest cell-shear change of the steps of the mechanical model from the kinematic net

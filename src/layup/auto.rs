@@ -56,6 +56,10 @@ pub const LOCKED_NOTE_SHARE: f64 = 0.01;
 /// Order of convergence of the fishnet in the spacing (observed 1.8 on the smooth sphere, the
 /// formal order 2; see `study::speed_accuracy`).
 pub const FISHNET_ORDER: f64 = 2.0;
+/// Least order of convergence in the spacing at which Richardson's estimate from three drapes
+/// is trusted: a lower observed order means the drapes are not yet where the error falls
+/// steadily (and an estimate at that order blows the last difference up without bound).
+pub const MIN_TRUSTED_ORDER: f64 = 1.0;
 /// Most the spacing is divided by to meet the tolerance (the nodes grow by its square).
 pub const MAX_REFINEMENT: usize = 4;
 
@@ -156,7 +160,7 @@ pub fn drape_auto(
     let estimate = weigh_mechanical_spacing(&surfaces, settings, refinement, &refined.0, locking_angle, &mut a.choice);
     a.choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
     let (kinematic, refined) = match estimate {
-        Some(e) if e.largest > a.choice.tolerance_deg => {
+        Some(e) if e.largest(FISHNET_ORDER) > a.choice.tolerance_deg => {
             press_finer(&surfaces, settings, refinement, locking_angle, e, (a.net, refined), &mut a.choice)?
         }
         _ => (a.net, refined),
@@ -187,7 +191,7 @@ fn press_finer(
 ) -> Result<(DrapeNet, (DrapeNet, Refined)), AutoError> {
     let d = settings.spacing;
     let tolerance = choice.tolerance_deg;
-    let needed = spacing_for(d, estimate.largest, tolerance);
+    let needed = spacing_for(d, estimate.largest(FISHNET_ORDER), tolerance, FISHNET_ORDER);
     // The grid at d / k (an outline's grid scales the same way).
     let (nu, nv) = (at_d.0.nu, at_d.0.nv);
     let nodes = |k: usize| ((nu - 1) * k + 1) * ((nv - 1) * k + 1);
@@ -217,28 +221,73 @@ fn press_finer(
             "; pressed again at d/{k} = {:.4} m its spacing error could not be estimated (no cell to compare with the drape at d): the drape at the ply's spacing stands, NOT ASSURED",
             finer.spacing
         ));
+        choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
         return Ok(at_d);
     };
     choice.spacing_m = finer.spacing;
-    choice.indicators.refined_mechanical_discretisation_deg = Some(e.largest);
-    choice.indicators.refined_mechanical_discretisation_unlocked_deg = e.unlocked;
     choice.reason.push_str(&format!(
-        "; so the ply was draped and pressed again at d/{k} = {:.4} m ({} nodes{}), whose own spacing error, against the drape at the ply's spacing, is estimated at {}",
+        "; so the ply was draped and pressed again at d/{k} = {:.4} m ({} nodes{})",
         finer.spacing,
         nodes(k),
-        if k < wanted { format!(", the finest within auto's budget of {MECHANICAL_NODE_BUDGET}") } else { String::new() },
-        e.describe()
+        if k < wanted {
+            format!(", the finest within auto's budget of {MECHANICAL_NODE_BUDGET}")
+        } else {
+            String::new()
+        },
     ));
-    if e.largest <= tolerance {
+    // Three drapes (2d, d, d/k) show the order at which the pressed drape converges where it
+    // is worst; the estimate takes it, within [MIN_TRUSTED_ORDER, FISHNET_ORDER] (near locked
+    // cells the shear converges more slowly than the fishnet's order 2, which there understated
+    // the error 1.4-3 times).
+    let order = observed_order(&estimate, &e, false);
+    let unlocked_order = observed_order(&estimate, &e, true);
+    let trusted = |p: f64| p.clamp(MIN_TRUSTED_ORDER, FISHNET_ORDER);
+    choice.indicators.mechanical_observed_order = order;
+    choice.indicators.mechanical_observed_order_unlocked = unlocked_order;
+    choice.indicators.refined_mechanical_discretisation_deg = order.map(|p| e.largest(trusted(p)));
+    let unlocked = unlocked_order.and_then(|p| e.unlocked(trusted(p)));
+    choice.indicators.refined_mechanical_discretisation_unlocked_deg = unlocked;
+    // Said only where the worst cells are locked ones: otherwise it repeats the figures above.
+    let worst_unlocked =
+        estimate.unlocked_difference == Some(estimate.difference) && e.unlocked_difference == Some(e.difference);
+    let below_locking = match (unlocked_order, unlocked) {
+        _ if worst_unlocked => String::new(),
+        (Some(q), Some(u)) if q >= MIN_TRUSTED_ORDER => {
+            format!("; below the locking angle it converges at order {q:.2} and errs by an estimated {u:.3} deg")
+        }
+        (Some(q), Some(u)) => format!(
+            "; below the locking angle it converges only at order {q:.2}, and at order {MIN_TRUSTED_ORDER} its error there is estimated at {u:.3} deg, which may understate it"
+        ),
+        _ => "; below the locking angle its difference does not fall either".to_string(),
+    };
+    let Some(p) = order else {
+        choice.reason.push_str(&format!(
+            "; its largest cell-shear difference from the drape at the ply's spacing, {:.3} deg, is not below the one between d and 2d, {:.3} deg: the pressed drape does not converge with the spacing at its worst cells, and no error estimate holds there{below_locking}: NOT ASSURED",
+            e.difference,
+            estimate.difference,
+        ));
+        return Ok((kinematic, pressed));
+    };
+    let largest = e.largest(trusted(p));
+    choice.reason.push_str(&format!(
+        ", whose own spacing error, against the drape at the ply's spacing at the order {p:.2} the three spacings show{}, is estimated at {largest:.3} deg{below_locking}",
+        if trusted(p) != p { format!(" (taken as {})", trusted(p)) } else { String::new() },
+    ));
+    if p < MIN_TRUSTED_ORDER {
+        choice.reason.push_str(&format!(
+            ": NOT ASSURED (below order {MIN_TRUSTED_ORDER} the drapes are not yet where the error falls steadily, and the estimate may understate it)"
+        ));
+    } else if largest <= tolerance {
         choice.reason.push_str(": within the tolerance");
     } else {
         choice.reason.push_str(&format!(
             ", above the {tolerance} deg tolerance: NOT ASSURED at this spacing (it would need spacing <= {:.4} m)",
-            spacing_for(finer.spacing, e.largest, tolerance)
+            spacing_for(finer.spacing, largest, tolerance, trusted(p))
         ));
     }
     Ok((kinematic, pressed))
 }
+
 /// Mechanics ran at the ply's spacing: estimates the pressed drape's own spacing error from the
 /// same drape at twice the spacing (order 2, as the kinematic net's), records it in the choice
 /// and says whether the tolerance holds. `None` when that drape did not converge or has no cell
@@ -271,63 +320,112 @@ fn weigh_mechanical_spacing(
         );
         return None;
     };
-    choice.indicators.mechanical_discretisation_deg = Some(e.largest);
-    choice.indicators.mechanical_discretisation_unlocked_deg = e.unlocked;
+    choice.indicators.mechanical_discretisation_deg = Some(e.largest(FISHNET_ORDER));
+    choice.indicators.mechanical_discretisation_unlocked_deg = e.unlocked(FISHNET_ORDER);
     choice.reason.push_str(&format!(
         "; the pressed drape's own spacing error, against the same drape at twice the spacing, is estimated at {}",
-        e.describe()
+        e.describe(FISHNET_ORDER)
     ));
-    if e.largest <= tolerance {
+    if e.largest(FISHNET_ORDER) <= tolerance {
         choice.reason.push_str(": within the tolerance");
     } else {
-        let needed = spacing_for(settings.spacing, e.largest, tolerance);
+        let needed = spacing_for(settings.spacing, e.largest(FISHNET_ORDER), tolerance, FISHNET_ORDER);
         choice.indicators.mechanical_spacing_needed_m = Some(needed);
         choice.reason.push_str(&format!(", above the {tolerance} deg tolerance: it asks for spacing <= {needed:.4} m"));
     }
     Some(e)
 }
 
-/// Richardson's estimate of a drape's largest cell-shear error from its spacing, over all its
-/// complete cells and over those below the locking angle.
+/// How two drapes of a ply at different spacings differ: the ground of Richardson's estimate
+/// of the finer one's cell-shear error, over all their cells and over those below the locking
+/// angle.
 #[derive(Debug, Clone, Copy)]
 struct SpacingError {
-    /// Over every complete cell, degrees.
-    largest: f64,
-    /// Over the cells below the locking angle in both drapes, degrees (`None` when none is).
-    unlocked: Option<f64>,
+    /// Largest cell-shear difference at the finer drape's complete cell centres, degrees.
+    difference: f64,
+    /// The same over the cells below the locking angle in both drapes, degrees (`None` when
+    /// none is).
+    unlocked_difference: Option<f64>,
+    /// The coarser drape's spacing over the finer one's.
+    ratio: f64,
 }
 
 impl SpacingError {
-    /// The estimate for `fine` against `coarse`, the same drape at `ratio` times the spacing:
-    /// their largest difference at `fine`'s complete cell centres over ratio^p - 1 (p =
-    /// [`FISHNET_ORDER`]), `locking_angle` in radians.
+    /// `fine` against `coarse`, the same drape at `ratio` times the spacing, compared at
+    /// `fine`'s complete cell centres; `locking_angle` in radians.
     fn between(fine: &DrapeNet, coarse: &DrapeNet, ratio: f64, locking_angle: f64) -> Option<Self> {
         let (fine, coarse) = (ShearField::of(fine), ShearField::of(coarse));
         let locking = locking_angle.to_degrees();
-        let scale = ratio.powf(FISHNET_ORDER) - 1.0;
-        let mut largest: Option<f64> = None;
-        let mut unlocked: Option<f64> = None;
+        let mut difference: Option<f64> = None;
+        let mut unlocked_difference: Option<f64> = None;
         for (u, v) in fine.complete_cell_centres() {
             let (Some(a), Some(b)) = (fine.at(u, v), coarse.at(u, v)) else { continue };
-            let e = (a - b).abs() / scale;
-            largest = Some(largest.map_or(e, |m| m.max(e)));
+            let e = (a - b).abs();
+            difference = Some(difference.map_or(e, |m| m.max(e)));
             if a.abs() < locking && b.abs() < locking {
-                unlocked = Some(unlocked.map_or(e, |m| m.max(e)));
+                unlocked_difference = Some(unlocked_difference.map_or(e, |m| m.max(e)));
             }
         }
-        Some(Self { largest: largest?, unlocked })
+        Some(Self { difference: difference?, unlocked_difference, ratio })
     }
 
-    /// The estimate in words: the largest, and the one below the locking angle where it is less.
-    fn describe(&self) -> String {
-        match self.unlocked {
-            // Said only where it tells something: the locked cells carry the largest error.
-            Some(u) if u < 0.95 * self.largest => {
-                format!("{:.3} deg ({u:.3} deg in the cells below the locking angle)", self.largest)
+    /// Richardson's estimate of the finer drape's largest error at order `p`, degrees: the
+    /// difference over ratio^p - 1.
+    fn largest(&self, p: f64) -> f64 {
+        self.difference / (self.ratio.powf(p) - 1.0)
+    }
+
+    /// The same over the cells below the locking angle.
+    fn unlocked(&self, p: f64) -> Option<f64> {
+        self.unlocked_difference.map(|u| u / (self.ratio.powf(p) - 1.0))
+    }
+
+    /// The estimate at order `p` in words: the largest, and the one below the locking angle
+    /// where it is less (said only where it tells something: the locked cells carry the
+    /// largest error).
+    fn describe(&self, p: f64) -> String {
+        let largest = self.largest(p);
+        match self.unlocked(p) {
+            Some(u) if u < 0.95 * largest => {
+                format!("{largest:.3} deg ({u:.3} deg in the cells below the locking angle)")
             }
-            _ => format!("{:.3} deg", self.largest),
+            _ => format!("{largest:.3} deg"),
         }
     }
+}
+
+/// Order of convergence in the spacing observed from three drapes of a ply, at 2d, d and d / k:
+/// `coarse` compares the ones at d and 2d, `fine` those at d / k and d (their largest
+/// differences D1 and D2, over the same cells: all, or below the locking angle when
+/// `unlocked`). With an error C h^p, D1 / D2 = (2^p - 1) k^p / (k^p - 1), which grows with p
+/// from ln 2 / ln k; `None` where D1 / D2 is not above that: the difference does not fall with
+/// the spacing.
+fn observed_order(coarse: &SpacingError, fine: &SpacingError, unlocked: bool) -> Option<f64> {
+    let (d1, d2) = if unlocked {
+        (coarse.unlocked_difference?, fine.unlocked_difference?)
+    } else {
+        (coarse.difference, fine.difference)
+    };
+    let (c, k) = (coarse.ratio, fine.ratio);
+    let ratio_at = |p: f64| (c.powf(p) - 1.0) * k.powf(p) / (k.powf(p) - 1.0);
+    let wanted = d1 / d2;
+    if !wanted.is_finite() || wanted <= c.ln() / k.ln() {
+        return None;
+    }
+    // Bisection on p in (0, 16]: the ratio is monotonic; 60 halvings reach f64's resolution.
+    let (mut lo, mut hi) = (0.0, 16.0);
+    if ratio_at(hi) <= wanted {
+        return Some(hi);
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if ratio_at(mid) < wanted {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
 }
 
 /// Drape `settings` on `surfaces` and choose its model (see the module doc). `refinement` is the
@@ -429,7 +527,8 @@ pub fn choose(
         _ => (own, settings.clone(), own_discretisation),
     };
     let settings = &settings;
-    let spacing_needed = discretisation.filter(|e| *e > spacing_budget).map(|e| spacing_for(d, e, spacing_budget));
+    let spacing_needed =
+        discretisation.filter(|e| *e > spacing_budget).map(|e| spacing_for(d, e, spacing_budget, FISHNET_ORDER));
     indicators.discretisation_deg = discretisation;
     indicators.spacing_needed_m = spacing_needed;
     let mut net = net;
@@ -483,10 +582,10 @@ pub fn choose(
     Ok(AutoDrape { net, choice, start })
 }
 
-/// The spacing at which a drape whose spacing error is `error` at spacing `d` errs by `target`
-/// (the error falling as d^p, p = [`FISHNET_ORDER`]).
-fn spacing_for(d: f64, error: f64, target: f64) -> f64 {
-    d * (target / error).powf(1.0 / FISHNET_ORDER)
+/// The spacing at which a drape whose spacing error is `error` at spacing `d` errs by `target`,
+/// the error falling as d^p.
+fn spacing_for(d: f64, error: f64, target: f64, p: f64) -> f64 {
+    d * (target / error).powf(1.0 / p)
 }
 
 /// Richardson's estimate of the largest cell-shear error of `net` (drawn with `settings`) from
@@ -499,7 +598,7 @@ fn discretisation_error(surfaces: &Surfaces, settings: &KinematicSettings, net: 
 /// Richardson's estimate of the largest cell-shear error of `fine` against `coarse`, the same
 /// drape at twice the spacing, degrees ([`SpacingError::between`], every cell).
 fn richardson(fine: &DrapeNet, coarse: &DrapeNet) -> Option<f64> {
-    SpacingError::between(fine, coarse, 2.0, f64::INFINITY).map(|e| e.largest)
+    SpacingError::between(fine, coarse, 2.0, f64::INFINITY).map(|e| e.largest(FISHNET_ORDER))
 }
 
 /// Most iterations the probe takes before it calls the nodes settled.
@@ -549,4 +648,50 @@ fn equilibrium_probe(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Res
         iterations: report.iterations.len(),
         state: refined.net.positions,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The differences an error C h^p gives between drapes at 2d, d and d / k.
+    fn differences(p: f64, k: f64) -> (SpacingError, SpacingError) {
+        let (c, d) = (3.0, 0.004);
+        let error = |h: f64| c * (h / d).powf(p);
+        let coarse = SpacingError { difference: error(2.0 * d) - error(d), unlocked_difference: None, ratio: 2.0 };
+        let fine = SpacingError { difference: error(d) - error(d / k), unlocked_difference: None, ratio: k };
+        (coarse, fine)
+    }
+
+    #[test]
+    fn the_observed_order_is_the_order_of_the_error_and_the_estimate_its_exact_value() {
+        for k in [2.0, 3.0, 4.0] {
+            for p in [0.5, 1.0, 1.5, 2.0, 3.0] {
+                let (coarse, fine) = differences(p, k);
+                let observed = observed_order(&coarse, &fine, false).unwrap();
+                assert!((observed - p).abs() < 1e-9, "k = {k}: {observed} against {p}");
+                // At the true order, Richardson's estimate is the error at d / k exactly.
+                let exact = 3.0 * (1.0 / k).powf(p);
+                assert!(
+                    (fine.largest(observed) - exact).abs() < 1e-9 * exact,
+                    "{} against {exact}",
+                    fine.largest(observed)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_difference_that_does_not_fall_with_the_spacing_has_no_order() {
+        let coarse = SpacingError { difference: 4.31, unlocked_difference: Some(4.31), ratio: 2.0 };
+        let fine = SpacingError { difference: 4.76, unlocked_difference: Some(3.16), ratio: 2.0 };
+        assert_eq!(observed_order(&coarse, &fine, false), None);
+        let q = observed_order(&coarse, &fine, true).unwrap();
+        assert!((q - (4.31f64 / 3.16).log2()).abs() < 1e-12, "{q}");
+        // A coarser refinement can still show an order where the difference grows a little: at
+        // k = 3 the finer step spans a larger ratio (D1 / D2 > ln 2 / ln 3 = 0.63 converges).
+        let fine = SpacingError { ratio: 3.0, ..fine };
+        assert!(observed_order(&coarse, &fine, false).is_some());
+        assert_eq!(observed_order(&coarse, &SpacingError { difference: 7.0, ..fine }, false), None);
+    }
 }
