@@ -39,6 +39,35 @@ pub fn golden_section_min(
     }
 }
 
+/// Order of convergence p observed from three solutions at spacings h1 > h2 > h3 with an
+/// error C h^p: `d1` is the difference between the first two, `d2` between the last two,
+/// `coarse_ratio` = h1 / h2, `fine_ratio` = h2 / h3. Then d1 / d2 = (c^p - 1) k^p / (k^p - 1),
+/// which grows with p from ln c / ln k (equal ratios: d1 / d2 = k^p). `None` where d1 / d2 is
+/// not above that (the difference does not fall with the spacing) or is not a number; at most
+/// 16.
+pub fn observed_order(d1: f64, d2: f64, coarse_ratio: f64, fine_ratio: f64) -> Option<f64> {
+    let (c, k) = (coarse_ratio, fine_ratio);
+    let ratio_at = |p: f64| (c.powf(p) - 1.0) * k.powf(p) / (k.powf(p) - 1.0);
+    let wanted = d1 / d2;
+    if !wanted.is_finite() || wanted <= c.ln() / k.ln() {
+        return None;
+    }
+    // Bisection: the ratio is monotonic in p; 60 halvings reach f64's resolution.
+    let (mut lo, mut hi) = (0.0, 16.0);
+    if ratio_at(hi) <= wanted {
+        return Some(hi);
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if ratio_at(mid) < wanted {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -185,20 +185,21 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
             &format!("name = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nspacing = {spacing}\ngrid = [{nodes}, {nodes}]\nmaterial = \"card\"\n{method}"),
         );
         let out = sub.join("run");
-        drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
+        let run = drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
+        let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
         let row = read_json(&out.join("layup.json"))["plies"][0].clone();
         let net = drape::io::read_net(&out.join("p0.drape.json")).unwrap();
-        (row, net, read_json(&out.join("p0.drape.json")))
+        (row, net, read_json(&out.join("p0.drape.json")), stdout)
     };
-    let (_, coarse, _) = run("d8", 0.008, 21, "method = \"mechanical\"");
-    let (_, fine, _) = run("d2", 0.002, 81, "method = \"mechanical\"");
+    let (_, coarse, ..) = run("d8", 0.008, 21, "method = \"mechanical\"");
+    let (_, fine, ..) = run("d2", 0.002, 81, "method = \"mechanical\"");
     // Two solves of the same equilibrium from different starts (auto's from where its probe
     // stopped) agree to this, degrees of shear.
     const SAME_EQUILIBRIUM_DEG: f64 = 1e-6;
     let locking = 30.0; // the glass card's
 
     // A tolerance of 0.02 deg: mechanics at the ply's spacing is within it.
-    let (row, at_d, json) = run("tol-0.02", 0.004, 41, "method = \"auto\"\ntolerance_deg = 0.02");
+    let (row, at_d, json, stdout) = run("tol-0.02", 0.004, 41, "method = \"auto\"\ntolerance_deg = 0.02");
     assert_eq!(row["method"], "mechanical");
     assert_eq!(row["converged"], true);
     let choice = &row["method_choice"];
@@ -220,11 +221,13 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
     let below = choice["indicators"]["mechanical_discretisation_unlocked_deg"].as_f64().unwrap();
     assert!((below - unlocked / 3.0).abs() <= SAME_EQUILIBRIUM_DEG, "{below} against {unlocked} / 3");
     assert!(estimate <= 0.02 && reason.ends_with("within the tolerance"), "{reason}");
+    assert_eq!(choice["assured"], true, "{choice}");
+    assert!(stdout.contains("auto: ply 'p0' ran mechanical: "), "{stdout}");
     assert!(choice["indicators"].get("mechanical_spacing_needed_m").is_none(), "{choice}");
 
     // A tolerance of 0.005 deg: the estimate asks for d <= 4 mm x sqrt(0.005 / 0.0077), so auto
     // presses the ply again at d/2: the same drape as mechanics run at 2 mm on its own.
-    let (row, refined, json) = run("tol-0.005", 0.004, 41, "method = \"auto\"\ntolerance_deg = 0.005");
+    let (row, refined, json, stdout_refined) = run("tol-0.005", 0.004, 41, "method = \"auto\"\ntolerance_deg = 0.005");
     let choice = &row["method_choice"];
     let reason = choice["reason"].as_str().unwrap();
     assert_eq!(row["method"], "mechanical");
@@ -259,6 +262,11 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
     assert!(reason.contains("does not converge with the spacing at its worst cells"), "{reason}");
     assert!(reason.contains("which may understate it"), "{reason}");
     assert!(reason.ends_with("NOT ASSURED"), "{reason}");
+    assert_eq!(choice["assured"], false, "{choice}");
+    assert!(
+        stdout_refined.contains("auto: ply 'p0' ran mechanical (NOT ASSURED within 0.005 deg): "),
+        "{stdout_refined}"
+    );
 }
 
 /// What auto keeps is within its tolerance of what mechanics gives: the hemisphere's first ply,
@@ -281,6 +289,7 @@ fn the_kinematic_net_auto_keeps_is_within_the_tolerance_of_mechanics() {
     let choice = nets[0].meta.method_choice.clone().expect("auto records its choice");
     assert_eq!(choice.chosen, "kinematic", "{}", choice.reason);
     assert!(choice.reason.contains("past the 30 deg locking angle"), "the locked share is named: {}", choice.reason);
+    assert_eq!(choice.assured, Some(true), "{}", choice.reason);
     let difference = largest_shear_difference(&nets[0], &nets[1]);
     assert!(difference <= choice.tolerance_deg, "{difference} deg from the pressed drape");
     // The probe did not understate the change by more than its safety margin.

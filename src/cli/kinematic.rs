@@ -143,7 +143,7 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
             let chosen = drape_auto(&tool, &settings, refinement, locking_angle.to_radians(), *model)
                 .map_err(|e| input(anyhow::anyhow!("{e}")))?;
             let mut net = chosen.refined.map_or(chosen.kinematic, |(refined, _)| refined);
-            println!("auto: ran {}: {}", chosen.choice.chosen, chosen.choice.reason);
+            println!("auto: ran {}: {}", chosen.choice.headline(), chosen.choice.reason);
             net.meta.method_choice = Some(chosen.choice);
             net
         }

@@ -205,7 +205,7 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         if let Some(c) = &r.choice {
-            out += &format!("auto: ply '{}' ran {}: {}\n", ply.settings.name, c.chosen, c.reason);
+            out += &format!("auto: ply '{}' ran {}: {}\n", ply.settings.name, c.headline(), c.reason);
         }
     }
     let defaults: Vec<&str> = scene

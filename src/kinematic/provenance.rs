@@ -78,10 +78,28 @@ pub struct MethodChoice {
     pub tolerance_deg: f64,
     /// The fibre spacing that ran, m (finer than the ply's when the discretisation needed it).
     pub spacing_m: f64,
+    /// Whether the choice's estimates say the ply is within the tolerance: `false` where an
+    /// estimate is above it or could not be made, or mechanics did not converge (the reason
+    /// says which); absent in files written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub assured: Option<bool>,
     /// Why, in words.
     pub reason: String,
     /// What the choice was made from.
     pub indicators: ChoiceIndicators,
+}
+
+impl MethodChoice {
+    /// What ran, and that the tolerance is not assured where the estimates say so: the words
+    /// every place that shows the choice leads with (`mechanical`, `kinematic (NOT ASSURED
+    /// within 1 deg)`).
+    pub fn headline(&self) -> String {
+        if self.assured == Some(false) {
+            format!("{} (NOT ASSURED within {} deg)", self.chosen, self.tolerance_deg)
+        } else {
+            self.chosen.clone()
+        }
+    }
 }
 
 /// The cheap measurements on the kinematic net that `method = "auto"` decides from.

@@ -159,6 +159,8 @@ pub fn drape_auto(
     let t = Instant::now();
     let estimate = weigh_mechanical_spacing(&surfaces, settings, refinement, &refined.0, locking_angle, &mut a.choice);
     a.choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
+    a.choice.assured =
+        Some(refined.1.ok() && estimate.is_some_and(|e| e.largest(FISHNET_ORDER) <= a.choice.tolerance_deg));
     let (kinematic, refined) = match estimate {
         Some(e) if e.largest(FISHNET_ORDER) > a.choice.tolerance_deg => {
             press_finer(&surfaces, settings, refinement, locking_angle, e, (a.net, refined), &mut a.choice)?
@@ -169,9 +171,9 @@ pub fn drape_auto(
 }
 
 /// Most nodes auto presses a ply with when it refines the pressed drape's spacing by itself
-/// (the hat box at 2 mm, 43 517 nodes, presses in about 5 s; the double dome's +45 ply at
-/// 2.5 mm, 32 361 nodes, in about 3 minutes: the solver's iterations, not the nodes, set the
-/// cost). Past it, the reason gives the spacing that would do.
+/// (the hat box at 2 mm, 43 537 nodes, presses in about 5 s in 9 iterations; the double dome's
+/// +45 ply at 2.5 mm, 32 761 nodes, in about 3 minutes in 392: the solver's iterations, not
+/// the nodes, set the cost). Past it, the reason gives the spacing that would do.
 pub const MECHANICAL_NODE_BUDGET: usize = 50_000;
 
 /// The pressed drape at the ply's spacing `d` is estimated to err by `estimate`, above the
@@ -191,6 +193,8 @@ fn press_finer(
 ) -> Result<(DrapeNet, (DrapeNet, Refined)), AutoError> {
     let d = settings.spacing;
     let tolerance = choice.tolerance_deg;
+    // Assured only where the finer drape is found within the tolerance below.
+    choice.assured = Some(false);
     let needed = spacing_for(d, estimate.largest(FISHNET_ORDER), tolerance, FISHNET_ORDER);
     // The grid at d / k (an outline's grid scales the same way).
     let (nu, nv) = (at_d.0.nu, at_d.0.nv);
@@ -279,6 +283,7 @@ fn press_finer(
         ));
     } else if largest <= tolerance {
         choice.reason.push_str(": within the tolerance");
+        choice.assured = Some(pressed.1.ok());
     } else {
         choice.reason.push_str(&format!(
             ", above the {tolerance} deg tolerance: NOT ASSURED at this spacing (it would need spacing <= {:.4} m)",
@@ -396,36 +401,15 @@ impl SpacingError {
 
 /// Order of convergence in the spacing observed from three drapes of a ply, at 2d, d and d / k:
 /// `coarse` compares the ones at d and 2d, `fine` those at d / k and d (their largest
-/// differences D1 and D2, over the same cells: all, or below the locking angle when
-/// `unlocked`). With an error C h^p, D1 / D2 = (2^p - 1) k^p / (k^p - 1), which grows with p
-/// from ln 2 / ln k; `None` where D1 / D2 is not above that: the difference does not fall with
-/// the spacing.
+/// differences, over the same cells: all, or below the locking angle when `unlocked`); `None`
+/// where the difference does not fall with the spacing ([`crate::numeric::observed_order`]).
 fn observed_order(coarse: &SpacingError, fine: &SpacingError, unlocked: bool) -> Option<f64> {
     let (d1, d2) = if unlocked {
         (coarse.unlocked_difference?, fine.unlocked_difference?)
     } else {
         (coarse.difference, fine.difference)
     };
-    let (c, k) = (coarse.ratio, fine.ratio);
-    let ratio_at = |p: f64| (c.powf(p) - 1.0) * k.powf(p) / (k.powf(p) - 1.0);
-    let wanted = d1 / d2;
-    if !wanted.is_finite() || wanted <= c.ln() / k.ln() {
-        return None;
-    }
-    // Bisection on p in (0, 16]: the ratio is monotonic; 60 halvings reach f64's resolution.
-    let (mut lo, mut hi) = (0.0, 16.0);
-    if ratio_at(hi) <= wanted {
-        return Some(hi);
-    }
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if ratio_at(mid) < wanted {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(0.5 * (lo + hi))
+    crate::numeric::observed_order(d1, d2, coarse.ratio, fine.ratio)
 }
 
 /// Drape `settings` on `surfaces` and choose its model (see the module doc). `refinement` is the
@@ -533,6 +517,9 @@ pub fn choose(
     indicators.spacing_needed_m = spacing_needed;
     let mut net = net;
     let mut spacing = d;
+    // A kept kinematic net is assured when the model's step and the spacing's error were both
+    // measured within their shares; a mechanical choice is weighed after mechanics ran.
+    let mut assured = !mechanical && step.is_ok();
     if let (Some(needed), true) = (spacing_needed, mechanical) {
         // Mechanics at a finer spacing costs the square of the refinement in nodes and more
         // iterations: it runs at the ply's spacing, and the estimate is reported.
@@ -547,6 +534,7 @@ pub fn choose(
             Ok(n) => {
                 net = n;
                 spacing = finer.spacing;
+                assured &= d / k as f64 <= needed;
                 reason.push_str(&format!(
                     "; the spacing's error is estimated at {:.3} deg, more than its {spacing_budget:.2} deg, so the ply was draped at d/{k} = {:.4} m{}",
                     discretisation.unwrap_or_default(),
@@ -554,14 +542,18 @@ pub fn choose(
                     if d / k as f64 > needed { " (the finest allowed; still above the tolerance)" } else { "" }
                 ));
             }
-            Err(e) => reason.push_str(&format!(
-                "; the spacing's error is estimated at {:.3} deg and needs d <= {needed:.4} m, but the finer net could not be draped ({e}): the ply's spacing is kept",
-                discretisation.unwrap_or_default()
-            )),
+            Err(e) => {
+                assured = false;
+                reason.push_str(&format!(
+                    "; the spacing's error is estimated at {:.3} deg and needs d <= {needed:.4} m, but the finer net could not be draped ({e}): the ply's spacing is kept",
+                    discretisation.unwrap_or_default()
+                ))
+            }
         }
     } else if let Some(e) = discretisation {
         reason.push_str(&format!("; the spacing's error is estimated at {e:.3} deg (within {spacing_budget:.2} deg)"));
     } else {
+        assured = false;
         reason.push_str(
             "; the spacing's error could not be estimated (the net at twice the spacing has no cell to compare)",
         );
@@ -573,6 +565,7 @@ pub fn choose(
         surface: settings.surface.name().into(),
         tolerance_deg: tolerance,
         spacing_m: spacing,
+        assured: Some(assured),
         reason,
         indicators,
     };

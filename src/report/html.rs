@@ -296,7 +296,7 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
                 "<p class=\"choice\">Ply {}: <code>method = \"auto\"</code> (±{}°) ran <strong>{}</strong>: {}.</p>",
                 escape(&r.name),
                 c.tolerance_deg,
-                escape(&c.chosen),
+                escape(&c.headline()),
                 escape(&c.reason)
             );
         }
@@ -452,10 +452,11 @@ fn method_cell(r: &LayupRow) -> String {
     }
     let mut cell = match &r.method_choice {
         Some(c) => format!(
-            "{} <span class=\"small\" title=\"{}\">(auto, ±{}°)</span>",
+            "{} <span class=\"small\" title=\"{}\">(auto, ±{}°)</span>{}",
             escape(r.method.as_deref().unwrap_or(&c.chosen)),
             escape(&c.reason),
-            c.tolerance_deg
+            c.tolerance_deg,
+            if c.assured == Some(false) { " <strong>NOT ASSURED</strong>" } else { "" }
         ),
         None => escape(r.method.as_deref().unwrap_or("—")),
     };
@@ -477,5 +478,32 @@ mod tests {
         assert_eq!(strip_prolog("<?xml version=\"1.0\"?>\n<svg x=\"1\"/>"), "<svg x=\"1\"/>");
         assert_eq!(num(Some(f64::NAN), 2), "—");
         assert_eq!(num(Some(1.234), 1), "1.2");
+    }
+
+    #[test]
+    fn the_method_cell_marks_an_auto_choice_that_is_not_assured() {
+        let choice = |assured| crate::kinematic::MethodChoice {
+            requested: "auto".into(),
+            chosen: "mechanical".into(),
+            surface: "facets".into(),
+            tolerance_deg: 1.0,
+            spacing_m: 0.002,
+            assured,
+            reason: "why".into(),
+            indicators: Default::default(),
+        };
+        let row = |assured| LayupRow {
+            name: "p0".into(),
+            method: Some("mechanical".into()),
+            method_choice: Some(choice(assured)),
+            converged: Some(true),
+            ..Default::default()
+        };
+        assert!(method_cell(&row(Some(false))).contains("<strong>NOT ASSURED</strong>"));
+        assert!(!method_cell(&row(Some(true))).contains("NOT ASSURED"));
+        // Files written before the verdict was recorded claim nothing either way.
+        assert!(!method_cell(&row(None)).contains("NOT ASSURED"));
+        assert_eq!(choice(Some(false)).headline(), "mechanical (NOT ASSURED within 1 deg)");
+        assert_eq!(choice(None).headline(), "mechanical");
     }
 }

@@ -333,13 +333,9 @@ fn extrapolate(runs: &[(f64, &ShearField)]) -> Option<(RefField, [f64; 2], f64, 
         let vals = common(&pts, &[fc, fm, ff]);
         let (e1, e2) = (rms(vals.iter().map(|v| v[0] - v[1])), rms(vals.iter().map(|v| v[1] - v[2])));
         if e1 > ORDER_NOISE_DEG && e2 > ORDER_NOISE_DEG {
-            // Unequal ratios: solve e1/e2 = (dc^p - dm^p)/(dm^p - df^p) is not closed-form; the
-            // studies use equal ratios, and for unequal ones the mean ratio is close enough.
-            let ratio = ((dc / dm) * (dm / df)).sqrt();
-            let p = (e1 / e2).ln() / ratio.ln();
-            if p.is_finite() {
-                order = (p.clamp(ORDER_RANGE.0, ORDER_RANGE.1), true);
-            }
+            // A difference that does not fall with the spacing has no order: the least trusted.
+            let p = crate::numeric::observed_order(e1, e2, dc / dm, dm / df).unwrap_or(ORDER_RANGE.0);
+            order = (p.clamp(ORDER_RANGE.0, ORDER_RANGE.1), true);
         }
     }
     let factor = 1.0 / (r.powf(order.0) - 1.0);
