@@ -27,10 +27,13 @@
 //!   at twice the spacing. Above the tolerance the ply is draped and pressed again at d / k,
 //!   the least k the estimate says will do (at most [`MAX_REFINEMENT`]), within
 //!   [`MECHANICAL_NODE_BUDGET`] (mechanics at d / k costs k^2 the nodes and more iterations),
-//!   and that drape's own error is estimated against the one at d. Once; the reason says
-//!   `NOT ASSURED at this spacing` where the last estimate is still above the tolerance (near
-//!   locked corners the shear converges slowly: the hat box at 4 and 2 mm). Both estimates
-//!   also give the error over the cells below the locking angle.
+//!   and that drape's own error is estimated against the one at d at the order of convergence
+//!   the three drapes (2d, d, d / k) show, clamped to [[`MIN_TRUSTED_ORDER`], 2]. Once; the
+//!   reason says NOT ASSURED (and [`MethodChoice::assured`] is false) where the last estimate
+//!   is above the tolerance, the observed order is below [`MIN_TRUSTED_ORDER`], or the
+//!   difference does not fall with the spacing (near locked corners the peak shear grows as the
+//!   spacing resolves them: the hat box at 4 and 2 mm). Each estimate is also given over the
+//!   cells below the locking angle.
 //!
 //! The choice, its reason and the measurements are recorded ([`MethodChoice`]) in the net's meta
 //! and in `layup.json`, and shown in the layup table and the report.
@@ -163,7 +166,7 @@ pub fn drape_auto(
         Some(refined.1.ok() && estimate.is_some_and(|e| e.largest(FISHNET_ORDER) <= a.choice.tolerance_deg));
     let (kinematic, refined) = match estimate {
         Some(e) if e.largest(FISHNET_ORDER) > a.choice.tolerance_deg => {
-            press_finer(&surfaces, settings, refinement, locking_angle, e, (a.net, refined), &mut a.choice)?
+            press_finer(&surfaces, settings, refinement, locking_angle, e, (a.net, refined), &mut a.choice)
         }
         _ => (a.net, refined),
     };
@@ -180,8 +183,10 @@ pub const MECHANICAL_NODE_BUDGET: usize = 50_000;
 /// tolerance: drape and press the ply again at d / k, k whole (so the grid keeps its nodes),
 /// the least that the estimate (order 2) says meets the tolerance, at most [`MAX_REFINEMENT`]
 /// and within [`MECHANICAL_NODE_BUDGET`]. The finer drape's own error is then estimated from
-/// the one at `d` (Richardson with ratio k), at no further cost. Returns the kinematic and
-/// pressed nets that stand: the finer ones if that drape converged, else those at `d`.
+/// the one at `d` (Richardson with ratio k, at the order the drapes at 2d, d and d / k show),
+/// at no further cost. Returns the kinematic and pressed nets that stand: the finer ones if
+/// that drape converged, else those at `d` (also where the finer one could not be drawn: what
+/// was computed is not lost).
 fn press_finer(
     surfaces: &Surfaces,
     settings: &KinematicSettings,
@@ -190,7 +195,7 @@ fn press_finer(
     estimate: SpacingError,
     at_d: (DrapeNet, (DrapeNet, Refined)),
     choice: &mut MethodChoice,
-) -> Result<(DrapeNet, (DrapeNet, Refined)), AutoError> {
+) -> (DrapeNet, (DrapeNet, Refined)) {
     let d = settings.spacing;
     let tolerance = choice.tolerance_deg;
     // Assured only where the finer drape is found within the tolerance below.
@@ -205,19 +210,32 @@ fn press_finer(
             "; NOT ASSURED at this spacing: auto does not press it finer by itself, for at d/2 the ply has {} nodes, more than its budget of {MECHANICAL_NODE_BUDGET}",
             nodes(2)
         ));
-        return Ok(at_d);
+        return at_d;
     };
     let finer = settings.at_spacing(d / k as f64);
     let t = Instant::now();
-    let kinematic = surfaces.drape(&finer)?;
-    let pressed = refinement.run_draped(&kinematic, surfaces.tool, surfaces.for_refinement(refinement), &finer)?;
+    let drawn = surfaces.drape(&finer).map_err(AutoError::from).and_then(|kinematic| {
+        let pressed = refinement.run_draped(&kinematic, surfaces.tool, surfaces.for_refinement(refinement), &finer)?;
+        Ok((kinematic, pressed))
+    });
+    let (kinematic, pressed) = match drawn {
+        Ok(drawn) => drawn,
+        Err(why) => {
+            choice.reason.push_str(&format!(
+                "; the ply could not be draped and pressed again at d/{k} = {:.4} m ({why}): the drape at the ply's spacing stands, NOT ASSURED",
+                finer.spacing
+            ));
+            choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
+            return at_d;
+        }
+    };
     if !pressed.1.ok() {
         choice.reason.push_str(&format!(
             "; pressed again at d/{k} = {:.4} m the ply did not converge ({}): the drape at the ply's spacing stands, NOT ASSURED",
             finer.spacing, pressed.1.describe_failure()
         ));
         choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
-        return Ok(at_d);
+        return at_d;
     }
     let coarse = &at_d.1 .0;
     let Some(e) = SpacingError::between(&pressed.0, coarse, k as f64, locking_angle) else {
@@ -226,7 +244,7 @@ fn press_finer(
             finer.spacing
         ));
         choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
-        return Ok(at_d);
+        return at_d;
     };
     choice.spacing_m = finer.spacing;
     choice.reason.push_str(&format!(
@@ -270,7 +288,7 @@ fn press_finer(
             e.difference,
             estimate.difference,
         ));
-        return Ok((kinematic, pressed));
+        return (kinematic, pressed);
     };
     let largest = e.largest(trusted(p));
     choice.reason.push_str(&format!(
@@ -283,14 +301,14 @@ fn press_finer(
         ));
     } else if largest <= tolerance {
         choice.reason.push_str(": within the tolerance");
-        choice.assured = Some(pressed.1.ok());
+        choice.assured = Some(true);
     } else {
         choice.reason.push_str(&format!(
             ", above the {tolerance} deg tolerance: NOT ASSURED at this spacing (it would need spacing <= {:.4} m)",
             spacing_for(finer.spacing, largest, tolerance, trusted(p))
         ));
     }
-    Ok((kinematic, pressed))
+    (kinematic, pressed)
 }
 
 /// Mechanics ran at the ply's spacing: estimates the pressed drape's own spacing error from the
@@ -522,7 +540,8 @@ pub fn choose(
     let mut assured = !mechanical && step.is_ok();
     if let (Some(needed), true) = (spacing_needed, mechanical) {
         // Mechanics at a finer spacing costs the square of the refinement in nodes and more
-        // iterations: it runs at the ply's spacing, and the estimate is reported.
+        // iterations: it starts at the ply's spacing, and `drape_auto` presses finer only where
+        // the pressed drape's own estimate asks for it.
         reason.push_str(&format!(
             "; the kinematic net's spacing error is estimated at {:.3} deg (it would need d <= {needed:.4} m); mechanics starts at the ply's spacing",
             discretisation.unwrap_or_default()
