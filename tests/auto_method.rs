@@ -267,6 +267,11 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
         stdout_refined.contains("auto: ply 'p0' ran mechanical (NOT ASSURED within 0.005 deg): "),
         "{stdout_refined}"
     );
+    // The run table's method column says it too.
+    let row_line = stdout_refined.lines().find(|l| l.starts_with("p0 ")).unwrap_or_default();
+    assert!(row_line.contains("auto: mechanical NOT ASSURED"), "{stdout_refined}");
+    let row_line = stdout.lines().find(|l| l.starts_with("p0 ")).unwrap_or_default();
+    assert!(row_line.contains("auto: mechanical") && !row_line.contains("NOT ASSURED"), "{stdout}");
 }
 
 /// What auto keeps is within its tolerance of what mechanics gives: the hemisphere's first ply,

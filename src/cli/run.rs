@@ -162,14 +162,15 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
             format!(
-                "{}{}",
+                "{}{}{}",
                 if r.choice.is_some() { "auto: " } else { "" },
                 match &r.refined {
                     Some(refined) if !refined.ok() => "UNCONVERGED",
                     Some(refined) if refined.stability_verdict() == Some(Stability::Saddle) => "mechanical (saddle)",
                     Some(_) => "mechanical",
                     None => "kinematic",
-                }
+                },
+                if r.choice.as_ref().is_some_and(|c| c.assured == Some(false)) { " NOT ASSURED" } else { "" }
             ),
             ply.material.as_ref().map_or("-", |m| m.name.as_str()),
             format!(
