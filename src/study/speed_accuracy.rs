@@ -15,6 +15,7 @@ use super::{symmetry, StudyError};
 use crate::io::read_tool;
 use crate::kinematic::fabric_field::{FabricImage, ShearField};
 use crate::kinematic::{GeneratorKind, SurfaceKind};
+use crate::layup::auto::{FISHNET_ORDER, MIN_TRUSTED_ORDER};
 use crate::layup::Ply;
 use crate::mechanics::ContactMode;
 use crate::pipeline::Scene;
@@ -31,10 +32,11 @@ pub const MECHANICAL_SPACING_FACTORS: [f64; 2] = [2.0, 1.0];
 /// Bounds on the observed order of convergence used to extrapolate. The fishnet and the
 /// mechanical net are second order in d; an observed order above 2 comes from a coarse spacing
 /// outside the asymptotic range, and extrapolating with it would understate the error (on the
-/// Chebyshev sphere by a factor 4), so it is capped at the formal order.
-pub const ORDER_RANGE: (f64, f64) = (1.0, 2.0);
+/// Chebyshev sphere by a factor 4), so it is capped at the formal order. The same bounds as
+/// `method = "auto"` trusts (one place for them: [`MIN_TRUSTED_ORDER`], [`FISHNET_ORDER`]).
+pub const ORDER_RANGE: (f64, f64) = (MIN_TRUSTED_ORDER, FISHNET_ORDER);
 /// The order assumed when only two spacings converge or the differences vanish: the formal one.
-pub const DEFAULT_ORDER: f64 = 2.0;
+pub const DEFAULT_ORDER: f64 = FISHNET_ORDER;
 /// Differences (rms, degrees) below this are rounding, not convergence: the order is not
 /// measured from them.
 const ORDER_NOISE_DEG: f64 = 1e-9;
