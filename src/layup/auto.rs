@@ -706,4 +706,49 @@ mod tests {
         assert!(observed_order(&coarse, &fine, false).is_some());
         assert_eq!(observed_order(&coarse, &SpacingError { difference: 7.0, ..fine }, false), None);
     }
+
+    #[test]
+    fn a_finer_drape_that_does_not_converge_leaves_the_drape_at_the_plys_spacing_standing() {
+        use crate::geometry::shapes::hemisphere_with_triangles;
+        use crate::geometry::{Point, Vector};
+        use crate::material::MaterialCard;
+        let mesh = hemisphere_with_triangles(0.1, 2000);
+        let tool = ToolSurface::from_triangles(mesh.vertices, mesh.triangles).unwrap();
+        let card_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+        let refinement = Refinement::pressed(MaterialCard::load(&card_path).unwrap(), card_path);
+        let settings = KinematicSettings::grid("p0", Point::new(0.0, 0.0, 0.1), Vector::x(), 0.008, 21, 21);
+        let surfaces = Surfaces::new(&tool);
+        let kinematic = surfaces.drape(&settings).unwrap();
+        let pressed =
+            refinement.run_draped(&kinematic, &tool, surfaces.for_refinement(&refinement), &settings).unwrap();
+        assert!(pressed.1.ok(), "the drape at the ply's spacing converges");
+        // One iteration cannot bring the drape at d/2 to equilibrium.
+        let starved = Refinement { max_iterations: 1, ..refinement };
+        let mut choice = MethodChoice {
+            requested: "auto".into(),
+            chosen: "mechanical".into(),
+            surface: "facets".into(),
+            tolerance_deg: 0.001,
+            spacing_m: settings.spacing,
+            assured: Some(false),
+            reason: "start".into(),
+            indicators: ChoiceIndicators::default(),
+        };
+        let estimate = SpacingError { difference: 0.03, unlocked_difference: Some(0.03), ratio: 2.0 };
+        let at_d = (kinematic.clone(), pressed.clone());
+        let (kept, (refined, record)) =
+            press_finer(&surfaces, &settings, &starved, 30f64.to_radians(), estimate, at_d, &mut choice);
+        assert_eq!(kept.positions, kinematic.positions);
+        assert_eq!(refined.positions, pressed.0.positions);
+        assert!(record.ok());
+        assert_eq!(choice.assured, Some(false));
+        assert_eq!(choice.spacing_m, settings.spacing);
+        assert!(
+            choice.reason.contains("pressed again at d/4 = 0.0020 m the ply did not converge")
+                && choice.reason.ends_with("the drape at the ply's spacing stands, NOT ASSURED"),
+            "{}",
+            choice.reason
+        );
+        assert!(choice.indicators.time_ms > 0.0);
+    }
 }
