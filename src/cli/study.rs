@@ -279,6 +279,9 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                         a.mechanical_time_s.unwrap_or_default()
                     ))
                 );
+                if let Some(verdict) = a.verdict() {
+                    println!("  {verdict}");
+                }
                 // Auto's cost against mechanics of the same accuracy only where it has that accuracy.
                 match (a.mechanical_within_tolerance_s, a.within_tolerance) {
                     (Some(m), Some(true)) => println!(

@@ -278,7 +278,7 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                 .iter()
                 .map(|a| {
                     format!(
-                        " auto at d = {:.4} m ran {}: largest error {} (tolerance {} deg), {:.2} s{}.",
+                        " auto at d = {:.4} m ran {}: largest error {} (tolerance {} deg), {:.2} s{}{}.",
                         a.spacing,
                         a.chosen,
                         a.error_max_deg.map_or("not compared".to_string(), |e| format!("{e:.3} deg")),
@@ -288,7 +288,8 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                             " against {:.2} s for mechanics ({:.0}% of its cost)",
                             a.mechanical_time_s.unwrap_or_default(),
                             100.0 * r
-                        ))
+                        )),
+                        a.verdict().map_or(String::new(), |v| format!("; {v}"))
                     )
                 })
                 .collect();

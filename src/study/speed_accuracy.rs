@@ -204,6 +204,11 @@ pub struct AutoCost {
     pub error_max_deg: Option<f64>,
     /// Whether that error is within the tolerance.
     pub within_tolerance: Option<bool>,
+    /// Auto's own verdict ([`crate::kinematic::MethodChoice::assured`]): whether its estimates
+    /// said the result is within the tolerance. Set beside `within_tolerance`, it shows whether
+    /// auto can be trusted when it says so ([`AutoCost::verdict`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub assured: Option<bool>,
     /// Its time, s (the indicators included).
     pub time_s: f64,
     /// The pressed mechanical drape's time at the same spacing, s.
@@ -214,6 +219,21 @@ pub struct AutoCost {
     /// mechanics costs for the same accuracy.
     #[serde(default)]
     pub mechanical_within_tolerance_s: Option<f64>,
+}
+
+impl AutoCost {
+    /// Auto's verdict against the reference's, in words: whether it said rightly that its result
+    /// is within the tolerance (or not). A result auto assured and the reference finds outside
+    /// the tolerance is a FALSE ASSURANCE, the one answer an engineer cannot catch. None where
+    /// either is missing.
+    pub fn verdict(&self) -> Option<&'static str> {
+        Some(match (self.assured?, self.within_tolerance?) {
+            (true, true) => "auto assured it, rightly",
+            (false, false) => "auto said NOT ASSURED, rightly",
+            (false, true) => "auto said NOT ASSURED, yet it is within (cautious)",
+            (true, false) => "FALSE ASSURANCE: auto assured it, and it is outside",
+        })
+    }
 }
 
 /// `speed_accuracy.json`.
@@ -482,6 +502,7 @@ fn auto_costs(records: &[CaseRecord], points: &[SpeedPoint]) -> Vec<AutoCost> {
                 reason: c.reason.clone(),
                 error_max_deg: p.error_max_deg,
                 within_tolerance: p.error_max_deg.map(|e| e <= c.tolerance_deg),
+                assured: c.assured,
                 time_s: p.time_s,
                 mechanical_time_s: mech_time,
                 cost_ratio: mech_time.map(|m| p.time_s / m),
@@ -503,5 +524,35 @@ fn mark_pareto(points: &mut [SpeedPoint]) {
     for &(k, t, e) in &scored {
         let beaten = scored.iter().any(|&(j, t2, e2)| j != k && t2 <= t && e2 <= e && (t2 < t || e2 < e));
         points[k].pareto = !beaten;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_s_verdict_is_weighed_against_the_reference() {
+        let cost = |assured, within| AutoCost {
+            spacing: 0.004,
+            tolerance_deg: 1.0,
+            chosen: "mechanical".into(),
+            reason: String::new(),
+            error_max_deg: Some(if within { 0.5 } else { 2.0 }),
+            within_tolerance: Some(within),
+            assured,
+            time_s: 1.0,
+            mechanical_time_s: None,
+            cost_ratio: None,
+            mechanical_within_tolerance_s: None,
+        };
+        assert_eq!(cost(Some(true), true).verdict(), Some("auto assured it, rightly"));
+        assert_eq!(cost(Some(false), false).verdict(), Some("auto said NOT ASSURED, rightly"));
+        assert!(cost(Some(true), false).verdict().unwrap().starts_with("FALSE ASSURANCE"));
+        assert!(cost(Some(false), true).verdict().unwrap().contains("cautious"));
+        // A record from before auto gave its verdict has none to weigh.
+        assert_eq!(cost(None, true).verdict(), None);
+        let json = serde_json::to_value(cost(None, true)).unwrap();
+        assert!(json.get("assured").is_none(), "{json}");
     }
 }
