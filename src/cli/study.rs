@@ -279,7 +279,7 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                         a.mechanical_time_s.unwrap_or_default()
                     ))
                 );
-                if let Some(verdict) = a.verdict() {
+                if let Some(verdict) = a.verdict(&s.reference) {
                     println!("  {verdict}");
                 }
                 // Auto's cost against mechanics of the same accuracy only where it has that accuracy.

@@ -289,7 +289,7 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                             a.mechanical_time_s.unwrap_or_default(),
                             100.0 * r
                         )),
-                        a.verdict().map_or(String::new(), |v| format!("; {v}"))
+                        a.verdict(&s.reference).map_or(String::new(), |v| format!("; {v}"))
                     )
                 })
                 .collect();

@@ -209,6 +209,9 @@ pub struct AutoCost {
     /// auto can be trusted when it says so ([`AutoCost::verdict`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub assured: Option<bool>,
+    /// The spacing auto drew its result at, m (finer than `spacing` where it refined).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ran_spacing: Option<f64>,
     /// Its time, s (the indicators included).
     pub time_s: f64,
     /// The pressed mechanical drape's time at the same spacing, s.
@@ -222,12 +225,23 @@ pub struct AutoCost {
 }
 
 impl AutoCost {
-    /// Auto's verdict against the reference's, in words: whether it said rightly that its result
-    /// is within the tolerance (or not). A result auto assured and the reference finds outside
-    /// the tolerance is a FALSE ASSURANCE, the one answer an engineer cannot catch. None where
-    /// either is missing.
-    pub fn verdict(&self) -> Option<&'static str> {
-        Some(match (self.assured?, self.within_tolerance?) {
+    /// Auto's verdict against the `reference`'s, in words: whether it said rightly that its
+    /// result is within the tolerance (or not). A result auto assured and the reference finds
+    /// outside the tolerance is a FALSE ASSURANCE, the one answer an engineer cannot catch. A
+    /// mechanical reference no finer than auto's own drape cannot judge it (auto's drape pressed
+    /// again at the reference's spacing is the reference itself). None where either is missing.
+    pub fn verdict(&self, reference: &Reference) -> Option<&'static str> {
+        let (assured, within) = (self.assured?, self.within_tolerance?);
+        let unjudged = reference.kind == "mechanical"
+            && self.ran_spacing.is_some_and(|d| d <= reference.spacing * (1.0 + SAME_SPACING_REL));
+        if unjudged {
+            return Some(if assured {
+                "auto assured it; drawn at the reference's spacing or finer, the study has nothing finer to judge that by"
+            } else {
+                "auto said NOT ASSURED; drawn at the reference's spacing or finer, the study has nothing finer to judge that by"
+            });
+        }
+        Some(match (assured, within) {
             (true, true) => "auto assured it, rightly",
             (false, false) => "auto said NOT ASSURED, rightly",
             (false, true) => "auto said NOT ASSURED, yet it is within (cautious)",
@@ -235,6 +249,9 @@ impl AutoCost {
         })
     }
 }
+
+/// Spacings this close (relative) are the same spacing.
+const SAME_SPACING_REL: f64 = 1e-9;
 
 /// `speed_accuracy.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -503,6 +520,7 @@ fn auto_costs(records: &[CaseRecord], points: &[SpeedPoint]) -> Vec<AutoCost> {
                 error_max_deg: p.error_max_deg,
                 within_tolerance: p.error_max_deg.map(|e| e <= c.tolerance_deg),
                 assured: c.assured,
+                ran_spacing: Some(c.spacing_m),
                 time_s: p.time_s,
                 mechanical_time_s: mech_time,
                 cost_ratio: mech_time.map(|m| p.time_s / m),
@@ -533,6 +551,12 @@ mod tests {
 
     #[test]
     fn auto_s_verdict_is_weighed_against_the_reference() {
+        let reference = Reference {
+            method: "mechanical-pressed".into(),
+            spacing: 0.002,
+            kind: "mechanical".into(),
+            symmetries: Vec::new(),
+        };
         let cost = |assured, within| AutoCost {
             spacing: 0.004,
             tolerance_deg: 1.0,
@@ -541,17 +565,24 @@ mod tests {
             error_max_deg: Some(if within { 0.5 } else { 2.0 }),
             within_tolerance: Some(within),
             assured,
+            ran_spacing: Some(0.004),
             time_s: 1.0,
             mechanical_time_s: None,
             cost_ratio: None,
             mechanical_within_tolerance_s: None,
         };
-        assert_eq!(cost(Some(true), true).verdict(), Some("auto assured it, rightly"));
-        assert_eq!(cost(Some(false), false).verdict(), Some("auto said NOT ASSURED, rightly"));
-        assert!(cost(Some(true), false).verdict().unwrap().starts_with("FALSE ASSURANCE"));
-        assert!(cost(Some(false), true).verdict().unwrap().contains("cautious"));
+        assert_eq!(cost(Some(true), true).verdict(&reference), Some("auto assured it, rightly"));
+        assert_eq!(cost(Some(false), false).verdict(&reference), Some("auto said NOT ASSURED, rightly"));
+        assert!(cost(Some(true), false).verdict(&reference).unwrap().starts_with("FALSE ASSURANCE"));
+        assert!(cost(Some(false), true).verdict(&reference).unwrap().contains("cautious"));
         // A record from before auto gave its verdict has none to weigh.
-        assert_eq!(cost(None, true).verdict(), None);
+        assert_eq!(cost(None, true).verdict(&reference), None);
+        // Auto's drape pressed again at the reference's spacing is the reference: no judge.
+        let at_reference = AutoCost { ran_spacing: Some(0.002), ..cost(Some(false), true) };
+        assert!(at_reference.verdict(&reference).unwrap().contains("nothing finer to judge"));
+        // An extrapolated reference (a limit) judges every spacing.
+        let limit = Reference { kind: "extrapolated".into(), ..reference.clone() };
+        assert!(at_reference.verdict(&limit).unwrap().contains("cautious"));
         let json = serde_json::to_value(cost(None, true)).unwrap();
         assert!(json.get("assured").is_none(), "{json}");
     }
