@@ -268,6 +268,14 @@ impl Reduction {
         out
     }
 
+    /// The matrix (in this pattern) with `weight` of each node on its variables' diagonal and
+    /// nothing else: the lumped mass matrix M, for quotients such as y^T M y.
+    pub fn diagonal_of(&self, weight: &[f64]) -> Vec<f64> {
+        let mut values = vec![0.0; self.rowval.len()];
+        self.add_diagonal(&mut values, weight, 1.0);
+        values
+    }
+
     /// Adds `s * weight[k]` to the diagonal of every variable of node k (representatives: the
     /// weights of the nodes they stand for are summed).
     pub fn add_diagonal(&self, values: &mut [f64], weight: &[f64], s: f64) {
