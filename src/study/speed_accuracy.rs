@@ -227,12 +227,15 @@ pub struct AutoCost {
 impl AutoCost {
     /// Auto's verdict against the `reference`'s, in words: whether it said rightly that its
     /// result is within the tolerance (or not). A result auto assured and the reference finds
-    /// outside the tolerance is a FALSE ASSURANCE, the one answer an engineer cannot catch. A
-    /// mechanical reference no finer than auto's own drape cannot judge it (auto's drape pressed
-    /// again at the reference's spacing is the reference itself). None where either is missing.
+    /// outside the tolerance is a FALSE ASSURANCE, the one answer an engineer cannot catch. Where
+    /// auto ran mechanics, a mechanical reference no finer than auto's drape cannot judge it
+    /// (auto's drape pressed again at the reference's spacing is the reference itself, or the
+    /// same model at the same spacing from another start); a kinematic result it can. None where
+    /// either is missing.
     pub fn verdict(&self, reference: &Reference) -> Option<&'static str> {
         let (assured, within) = (self.assured?, self.within_tolerance?);
         let unjudged = reference.kind == "mechanical"
+            && self.chosen == "mechanical"
             && self.ran_spacing.is_some_and(|d| d <= reference.spacing * (1.0 + SAME_SPACING_REL));
         if unjudged {
             return Some(if assured {
@@ -583,6 +586,9 @@ mod tests {
         // An extrapolated reference (a limit) judges every spacing.
         let limit = Reference { kind: "extrapolated".into(), ..reference.clone() };
         assert!(at_reference.verdict(&limit).unwrap().contains("cautious"));
+        // A kinematic net at the reference's spacing is judged by the pressed drape there.
+        let kinematic = AutoCost { chosen: "kinematic".into(), ..at_reference.clone() };
+        assert!(kinematic.verdict(&reference).unwrap().contains("cautious"));
         let json = serde_json::to_value(cost(None, true)).unwrap();
         assert!(json.get("assured").is_none(), "{json}");
     }
