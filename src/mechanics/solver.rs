@@ -331,6 +331,12 @@ const ROUNDING_BAND: f64 = 100.0;
 /// A contact is active (the tool takes the node's push into it) when its gap is below this
 /// fraction of the spacing.
 const ACTIVE_GAP: f64 = 1e-9;
+/// With `stick`, a node held where it touches the tool is let go only when pulled off by more
+/// than this share of its own load. Let go at any pull, the nodes just inside the square
+/// table's rim, whose small pull changes sign with every step, were let go and caught again
+/// each iteration: the 4 mm table crept 856 iterations; with 0.1, 327, to an energy 0.03%
+/// lower (0.01: 806).
+const STICK_RELEASE: f64 = 0.1;
 /// Steps whose gain is lost in rounding are shortened at most this many times, each time
 /// without balancing the forces better, before the solve is called stalled.
 const ROUNDING_RETRIES: usize = 4;
@@ -1208,12 +1214,17 @@ fn bases_at(cons: &Constraints, rep: &[usize], e: &Evaluation, feet: &Feet) -> (
             match (cons.mode, foot) {
                 (ContactMode::Free, Some(foot)) if f.dofs() > 0 => {
                     let own = f.basis(None, &descent[k]);
-                    if foot.gap <= ACTIVE_GAP * cons.spacing && descent[k].dot(&foot.normal) < 0.0 {
-                        if cons.stick {
-                            (NodeBasis::FIXED, false)
-                        } else {
-                            (own.without(&foot.normal), true)
-                        }
+                    let push = descent[k].dot(&foot.normal);
+                    if cons.stick
+                        && foot.gap <= ACTIVE_GAP * cons.spacing
+                        && push < STICK_RELEASE * e.external[k].norm()
+                    {
+                        // Stuck where it touches until pulled off by more than a share of its own
+                        // weight: a node at the rim whose small pull changes sign from one
+                        // iteration to the next would otherwise be let go and caught again.
+                        (NodeBasis::FIXED, false)
+                    } else if !cons.stick && foot.gap <= ACTIVE_GAP * cons.spacing && push < 0.0 {
+                        (own.without(&foot.normal), true)
                     } else {
                         (own, false)
                     }
