@@ -46,8 +46,9 @@ pub struct RefineArgs {
     /// Gravity is applied in this many steps.
     #[arg(long, default_value_t = 1)]
     pub load_steps: usize,
-    /// Free drape: nodes the tool holds up stay where they touch instead of sliding on it
-    /// (seed 000's tables restrain the nodes on them).
+    /// Free drape: nodes the tool holds up stay where they touch instead of sliding on it, until
+    /// pulled off by more than a tenth of their weight (seed 000's tables restrain the nodes on
+    /// them).
     #[arg(long)]
     pub stick: bool,
     /// Move off an equilibrium the solver's stability check finds a saddle and iterate on to a

@@ -290,7 +290,8 @@ pub struct Constraints<'a> {
     /// Per node, the node whose freedoms it shares (stitched seams); None: each its own.
     pub stitched: Option<Vec<usize>>,
     /// Free contact only: a node the tool holds up stays where it touches (no sliding; seed
-    /// 000's tables restrain the nodes on them) until the fabric pulls it off again.
+    /// 000's tables restrain the nodes on them) until the fabric pulls it off again by more
+    /// than [`STICK_RELEASE`] of its own load.
     pub stick: bool,
 }
 
@@ -336,7 +337,7 @@ const ACTIVE_GAP: f64 = 1e-9;
 /// table's rim, whose small pull changes sign with every step, were let go and caught again
 /// each iteration: the 4 mm table crept 856 iterations; with 0.1, 327, to an energy 0.03%
 /// lower (0.01: 806).
-const STICK_RELEASE: f64 = 0.1;
+pub const STICK_RELEASE: f64 = 0.1;
 /// Steps whose gain is lost in rounding are shortened at most this many times, each time
 /// without balancing the forces better, before the solve is called stalled.
 const ROUNDING_RETRIES: usize = 4;

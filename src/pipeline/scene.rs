@@ -50,7 +50,7 @@
 //! # sheet_normal = [0, 0, 1]  # with start = "flat": the sheet plane's normal (default +z)
 //! # load_steps = 1            # gravity applied in this many steps (default 1)
 //! # max_iterations = 500      # solver iterations per load step (default 500)
-//! # stick = false             # free drape: nodes the tool holds up stay where they touch
+//! # stick = false             # free drape: nodes the tool holds up stay where they touch (until pulled off by over a tenth of their weight)
 //!                             # (seed 000's tables restrain the nodes on them; default: slide)
 //! # escape_saddles = false    # move off an equilibrium the stability check finds a saddle
 //!                             # and iterate on to a lower one (default: only report it)
