@@ -1199,10 +1199,12 @@ fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
 /// the tool: from its freedom, and in free contact without the tool's normal where a node
 /// touches the tool and is pushed into it.
 fn bases_at(cons: &Constraints, rep: &[usize], e: &Evaluation, feet: &Feet) -> (Vec<NodeBasis>, Vec<bool>) {
-    // Pushes summed over stitched nodes onto their representative.
+    // Pushes (and loads) summed over stitched nodes onto their representative.
     let mut descent: Vec<Vector> = vec![Vector::zeros(); rep.len()];
+    let mut load: Vec<Vector> = vec![Vector::zeros(); rep.len()];
     for (k, r) in rep.iter().enumerate() {
         descent[*r] += e.external[k] - e.internal[k];
+        load[*r] += e.external[k];
     }
     cons.freedom
         .par_iter()
@@ -1216,10 +1218,7 @@ fn bases_at(cons: &Constraints, rep: &[usize], e: &Evaluation, feet: &Feet) -> (
                 (ContactMode::Free, Some(foot)) if f.dofs() > 0 => {
                     let own = f.basis(None, &descent[k]);
                     let push = descent[k].dot(&foot.normal);
-                    if cons.stick
-                        && foot.gap <= ACTIVE_GAP * cons.spacing
-                        && push < STICK_RELEASE * e.external[k].norm()
-                    {
+                    if cons.stick && foot.gap <= ACTIVE_GAP * cons.spacing && push < STICK_RELEASE * load[k].norm() {
                         // Stuck where it touches until pulled off by more than a share of its own
                         // weight: a node at the rim whose small pull changes sign from one
                         // iteration to the next would otherwise be let go and caught again.
