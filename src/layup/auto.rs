@@ -214,37 +214,39 @@ fn press_finer(
     };
     let finer = settings.at_spacing(d / k as f64);
     let t = Instant::now();
-    let drawn = surfaces.drape(&finer).map_err(AutoError::from).and_then(|kinematic| {
-        let pressed = refinement.run_draped(&kinematic, surfaces.tool, surfaces.for_refinement(refinement), &finer)?;
-        Ok((kinematic, pressed))
-    });
-    let (kinematic, pressed) = match drawn {
-        Ok(drawn) => drawn,
-        Err(why) => {
-            choice.reason.push_str(&format!(
-                "; the ply could not be draped and pressed again at d/{k} = {:.4} m ({why}): the drape at the ply's spacing stands, NOT ASSURED",
-                finer.spacing
+    // The finer drape, pressed and weighed against the one at d; or why not, in which case the
+    // drape at d stands (its time then counts with the indicators': nothing of it is kept).
+    let weighed = (|| -> Result<_, String> {
+        let drawn = surfaces.drape(&finer).map_err(AutoError::from).and_then(|kinematic| {
+            let pressed =
+                refinement.run_draped(&kinematic, surfaces.tool, surfaces.for_refinement(refinement), &finer)?;
+            Ok((kinematic, pressed))
+        });
+        let (kinematic, pressed) = drawn.map_err(|why| {
+            format!("the ply could not be draped and pressed again at d/{k} = {:.4} m ({why})", finer.spacing)
+        })?;
+        if !pressed.1.ok() {
+            return Err(format!(
+                "pressed again at d/{k} = {:.4} m the ply did not converge ({})",
+                finer.spacing,
+                pressed.1.describe_failure()
             ));
+        }
+        let e = SpacingError::between(&pressed.0, &at_d.1 .0, k as f64, locking_angle).ok_or_else(|| {
+            format!(
+                "pressed again at d/{k} = {:.4} m its spacing error could not be estimated (no cell to compare with the drape at d)",
+                finer.spacing
+            )
+        })?;
+        Ok((kinematic, pressed, e))
+    })();
+    let (kinematic, pressed, e) = match weighed {
+        Ok(weighed) => weighed,
+        Err(why) => {
+            choice.reason.push_str(&format!("; {why}: the drape at the ply's spacing stands, NOT ASSURED"));
             choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
             return at_d;
         }
-    };
-    if !pressed.1.ok() {
-        choice.reason.push_str(&format!(
-            "; pressed again at d/{k} = {:.4} m the ply did not converge ({}): the drape at the ply's spacing stands, NOT ASSURED",
-            finer.spacing, pressed.1.describe_failure()
-        ));
-        choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
-        return at_d;
-    }
-    let coarse = &at_d.1 .0;
-    let Some(e) = SpacingError::between(&pressed.0, coarse, k as f64, locking_angle) else {
-        choice.reason.push_str(&format!(
-            "; pressed again at d/{k} = {:.4} m its spacing error could not be estimated (no cell to compare with the drape at d): the drape at the ply's spacing stands, NOT ASSURED",
-            finer.spacing
-        ));
-        choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
-        return at_d;
     };
     choice.spacing_m = finer.spacing;
     choice.reason.push_str(&format!(
