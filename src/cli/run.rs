@@ -170,7 +170,7 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                     Some(_) => "mechanical",
                     None => "kinematic",
                 },
-                if r.choice.as_ref().is_some_and(|c| c.assured == Some(false)) { " NOT ASSURED" } else { "" }
+                if r.choice.as_ref().is_some_and(|c| c.not_assured()) { " NOT ASSURED" } else { "" }
             ),
             ply.material.as_ref().map_or("-", |m| m.name.as_str()),
             format!(

@@ -90,11 +90,17 @@ pub struct MethodChoice {
 }
 
 impl MethodChoice {
+    /// Whether the estimates said the tolerance is not met (false for files that predate the
+    /// verdict: they claim nothing either way).
+    pub fn not_assured(&self) -> bool {
+        self.assured == Some(false)
+    }
+
     /// What ran, and that the tolerance is not assured where the estimates say so: the words
     /// every place that shows the choice leads with (`mechanical`, `kinematic (NOT ASSURED
     /// within 1 deg)`).
     pub fn headline(&self) -> String {
-        if self.assured == Some(false) {
+        if self.not_assured() {
             format!("{} (NOT ASSURED within {} deg)", self.chosen, self.tolerance_deg)
         } else {
             self.chosen.clone()

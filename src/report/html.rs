@@ -456,7 +456,7 @@ fn method_cell(r: &LayupRow) -> String {
             escape(r.method.as_deref().unwrap_or(&c.chosen)),
             escape(&c.reason),
             c.tolerance_deg,
-            if c.assured == Some(false) { " <strong>NOT ASSURED</strong>" } else { "" }
+            if c.not_assured() { " <strong>NOT ASSURED</strong>" } else { "" }
         ),
         None => escape(r.method.as_deref().unwrap_or("—")),
     };
