@@ -1218,12 +1218,13 @@ fn bases_at(cons: &Constraints, rep: &[usize], e: &Evaluation, feet: &Feet) -> (
                 (ContactMode::Free, Some(foot)) if f.dofs() > 0 => {
                     let own = f.basis(None, &descent[k]);
                     let push = descent[k].dot(&foot.normal);
-                    if cons.stick && foot.gap <= ACTIVE_GAP * cons.spacing && push < STICK_RELEASE * load[k].norm() {
+                    let touching = foot.gap <= ACTIVE_GAP * cons.spacing;
+                    if cons.stick && touching && push < STICK_RELEASE * load[k].norm() {
                         // Stuck where it touches until pulled off by more than a share of its own
                         // weight: a node at the rim whose small pull changes sign from one
                         // iteration to the next would otherwise be let go and caught again.
                         (NodeBasis::FIXED, false)
-                    } else if !cons.stick && foot.gap <= ACTIVE_GAP * cons.spacing && push < 0.0 {
+                    } else if !cons.stick && touching && push < 0.0 {
                         (own.without(&foot.normal), true)
                     } else {
                         (own, false)
