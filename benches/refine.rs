@@ -25,9 +25,11 @@ fn pressed_hemisphere(c: &mut Criterion) {
         let spacing = FRAC_PI_2 / half as f64 * 0.999;
         let settings = KinematicSettings::grid("b", Point::new(0.0, 0.0, 1.0), Vector::x(), spacing, nodes, nodes);
         let net = drape(&tool, &settings).unwrap();
-        // As a scene's ply: the refinement starts from the ply draped on the smooth surface.
+        // As a scene's ply: the refinement starts from the ply draped on the smooth surface, with
+        // the card's friction.
+        let pressed = RefineSettings { friction: card.friction.unwrap_or(0.0), ..RefineSettings::default() };
         group.bench_with_input(BenchmarkId::from_parameter(nodes), &net, |b, net| {
-            b.iter(|| refine_draped(net, &settings, &tool, None, &card, &RefineSettings::default()).unwrap())
+            b.iter(|| refine_draped(net, &settings, &tool, None, &card, &pressed).unwrap())
         });
         group.finish();
     }

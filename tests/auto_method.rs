@@ -76,7 +76,11 @@ fn auto_keeps_the_kinematic_net_on_a_developable_tool() {
     let run = drape().arg("run").arg(&path).arg("--out").arg(&out).assert().success();
     let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
     assert!(stdout.contains("auto: kinematic"), "{stdout}");
-    assert!(stdout.contains("auto: ply 'p0' ran kinematic: 2 steps towards mechanical equilibrium change"), "{stdout}");
+    // With the card's friction the net stays where it lies: the probe settles in one step.
+    assert!(
+        stdout.contains("auto: ply 'p0' ran kinematic: one step towards mechanical equilibrium changes"),
+        "{stdout}"
+    );
     let table = read_json(&out.join("layup.json"));
     let row = &table["plies"][0];
     assert_eq!(row["method"], "kinematic");
@@ -207,7 +211,11 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
     assert!(choice["indicators"]["equilibrium_step_deg"].as_f64().unwrap() > 0.02, "{choice}");
     let reason = choice["reason"].as_str().unwrap();
     let steps = choice["indicators"]["probe_iterations"].as_u64().unwrap();
-    assert!(reason.starts_with(&format!("{steps} steps towards mechanical equilibrium change the shear")), "{reason}");
+    let opening = match steps {
+        1 => "one step towards mechanical equilibrium changes the shear".to_string(),
+        n => format!("{n} steps towards mechanical equilibrium change the shear"),
+    };
+    assert!(reason.starts_with(&opening), "{reason}");
     assert_eq!(choice["spacing_m"], 0.004);
     assert_eq!(json["method"], "mechanical");
     assert_eq!(json["meta"]["solver"]["converged"], true);
@@ -473,33 +481,34 @@ fn the_study_says_why_auto_does_not_apply_to_a_free_drape() {
     assert_eq!(evaluate(&p, &[]).auto_not_run, None);
 }
 
-/// The bundled cone's scene with absolute paths and the tolerance `tolerance_deg`, written
-/// into `dir`.
-fn cone_scene(dir: &Path, tolerance_deg: f64) -> PathBuf {
+/// The bundled cone's scene with absolute paths, the tolerance `tolerance_deg` and the ply keys
+/// `extra`, written into `dir`.
+fn cone_scene(dir: &Path, tolerance_deg: f64, extra: &str) -> PathBuf {
     let scene = std::fs::read_to_string(repo("geometries/cone/scene.toml")).unwrap();
     let scene = scene
         .replace("tool = \"cone.obj\"", &format!("tool = {:?}", repo("geometries/cone/cone.obj")))
         .replace("../../materials/carbon-twill.toml", &repo("materials/carbon-twill.toml").display().to_string())
-        .replace("\nmethod = \"auto\"", &format!("\ntolerance_deg = {tolerance_deg}\nmethod = \"auto\""));
+        .replace("\nmethod = \"auto\"", &format!("\ntolerance_deg = {tolerance_deg}{extra}\nmethod = \"auto\""));
     assert!(scene.contains(&format!("tolerance_deg = {tolerance_deg}")));
     let path = dir.join("cone.toml");
     std::fs::write(&path, scene).unwrap();
     path
 }
 
-/// Where auto misses (recorded in docs/ARCHITECTURE.md): on the bundled cone the pressed drape
-/// slides the ply down the slant under gravity, symmetrically, shearing it by up to 0.5-0.8 deg,
-/// and how far it slides depends on the spacing (the pressed drape's own spacing error: 1.2 deg
-/// at 3 mm against 1.5 mm). Auto's probe sees the slide (some seven iterations, about 0.9 deg)
-/// and at a 0.1 deg tolerance runs mechanics at the ply's 3 mm, which is outside the reference at
-/// 1.5 mm; the study says so and claims no saving for it.
+/// Where auto misses: on the cone with little friction (0.05; the card's is 0.25) the pressed
+/// ply slides down the slant under gravity, symmetrically, until its stiff fibres, tightening
+/// round the cone, press it on hard enough to hold, shearing it by up to 0.5-1 deg, and how far
+/// it slides depends on the spacing. Auto's probe sees the slide (some seven iterations) and at
+/// a 0.1 deg tolerance runs mechanics at the ply's 3 mm, which is outside the reference at 1 mm
+/// (0.63 deg); auto says NOT ASSURED itself, the study weighs that verdict right, says the
+/// result is outside and claims no saving for it.
 #[test]
 fn the_study_says_so_where_auto_is_outside_its_tolerance() {
     let dir = tempfile::tempdir().unwrap();
-    let path = cone_scene(dir.path(), 0.1);
+    let path = cone_scene(dir.path(), 0.1, "\nfriction = 0.05");
     let out = dir.path().join("study");
-    let (stdout, sa) = study(&path, &out, "0.003", "0.003,0.0015");
-    assert_eq!(sa.reference.spacing, 0.0015);
+    let (stdout, sa) = study(&path, &out, "0.003", "0.003,0.001");
+    assert_eq!(sa.reference.spacing, 0.001);
     let a = sa.auto.iter().find(|a| a.spacing == 0.003).unwrap();
     assert_eq!(a.chosen, "mechanical", "{}", a.reason);
     assert!(a.reason.contains("steps towards mechanical equilibrium change the shear by up to"), "{}", a.reason);
@@ -508,29 +517,30 @@ fn the_study_says_so_where_auto_is_outside_its_tolerance() {
     assert!((0.15..1.4).contains(&e), "{e} deg from the pressed drape");
     assert_eq!(a.within_tolerance, Some(false));
     assert!(stdout.contains("(OUTSIDE)"), "{stdout}");
-    // Auto said so itself: its estimates did not assure the result (the pressed drape's
-    // spacing error falls at order 1 or less between 6, 3 and 1 mm). It pressed the ply again
-    // at 1 mm, finer than the reference's 1.5 mm, so the study cannot judge that verdict.
+    // Auto said so itself, and the study, with a reference finer than auto's drape, finds it
+    // right.
     assert_eq!(a.assured, Some(false), "{}", a.reason);
     assert!(a.reason.contains("NOT ASSURED"), "{}", a.reason);
-    assert_eq!(a.ran_spacing, Some(0.001), "{}", a.reason);
     let verdict = a.verdict(&sa.reference).unwrap();
-    assert!(verdict.starts_with("auto said NOT ASSURED; drawn at the reference's spacing or finer"), "{verdict}");
+    assert_eq!(verdict, "auto said NOT ASSURED, rightly", "{verdict}");
     assert!(stdout.contains(&format!("  {verdict}")), "{stdout}");
     assert!(stdout.contains("auto is not within it here, so it saves nothing against that"), "{stdout}");
-    // No saving claimed for the result outside the tolerance (auto at 1.5 mm is the reference
-    // itself, within, and has its cost stated).
+    // No saving claimed for the result outside the tolerance.
     let at_3mm = stdout.split("auto at d = ").find(|block| block.starts_with("0.00300 m")).unwrap();
     assert!(!at_3mm.contains("auto costs"), "no saving claimed for a result outside the tolerance: {stdout}");
 }
 
 /// The bundled cone asks for auto. Its kinematic net is symmetric and unsheared, but under
-/// gravity the pressed ply slides down the slant, which takes the full solve 15 iterations and
-/// changes the shear by 0.5-0.9 deg; one step of the model shows 0.03 deg of it. The probe goes
-/// on until the nodes settle, so it sees the slide: at the default 1 deg tolerance the change is
-/// within the model's share (the spacing needs almost none of it on a developable tool) and the
-/// kinematic net is kept; at 0.5 deg auto runs mechanics, which goes on from where the probe
-/// stopped (its start lies below the kinematic net's energy) to equilibrium.
+/// gravity the pressed ply slides down the slant (53 deg walls, friction 0.25) by most of a
+/// millimetre until its stiff fibres, tightening round the cone, press it on hard enough for
+/// friction to hold it; that changes the shear by about 1 deg, and one step of the model shows
+/// a few hundredths of it. The probe goes on until the nodes settle, so it sees the slide: at
+/// the default 1 deg tolerance the change on the smooth surface is within the model's share
+/// (the spacing needs almost none of it on a developable tool) and the kinematic net is kept;
+/// at 0.5 deg auto runs mechanics, which goes on from where the probe stopped (its start lies
+/// below the kinematic net's energy) to equilibrium. Frictionless and held by nothing, the ply
+/// may turn freely about the cone's axis: auto keeps the kinematic net (the ply as laid and
+/// held) and says NOT ASSURED.
 #[test]
 fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there() {
     let dir = tempfile::tempdir().unwrap();
@@ -539,11 +549,19 @@ fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there
     let row = &read_json(&out.join("layup.json"))["plies"][0];
     assert_eq!(row["method"], "kinematic", "{row}");
     let reason = row["method_choice"]["reason"].as_str().unwrap();
-    assert!(reason.contains("the kinematic net is kept"), "{reason}");
+    assert!(reason.contains("is kept"), "{reason}");
     let probe = row["method_choice"]["indicators"]["equilibrium_step_deg"].as_f64().unwrap();
-    assert!((0.5..1.0).contains(&probe), "{reason}");
+    assert!((0.5..1.2).contains(&probe), "{reason}");
+    let out = dir.path().join("frictionless");
+    let scene = cone_scene(dir.path(), 1.0, "\nfriction = 0.0");
+    drape().arg("run").arg(scene).arg("--out").arg(&out).assert().success();
+    let row = &read_json(&out.join("layup.json"))["plies"][0];
+    assert_eq!(row["method"], "kinematic", "{row}");
+    assert_eq!(row["method_choice"]["assured"], false, "{row}");
+    let reason = row["method_choice"]["reason"].as_str().unwrap();
+    assert!(reason.contains("NOT ASSURED: the pressed model slides"), "{reason}");
     let out = dir.path().join("run");
-    drape().arg("run").arg(cone_scene(dir.path(), 0.5)).arg("--out").arg(&out).assert().success();
+    drape().arg("run").arg(cone_scene(dir.path(), 0.5, "")).arg("--out").arg(&out).assert().success();
     let row = &read_json(&out.join("layup.json"))["plies"][0];
     assert_eq!(row["method"], "mechanical");
     assert_eq!(row["converged"], true);

@@ -263,6 +263,10 @@ fn refine_and_cantilever_from_the_command_line() {
             "pressed",
             "--max-iterations",
             "400",
+            "--friction",
+            "0",
+            "--hold",
+            "10,10",
             "--out",
             mech.to_str().unwrap(),
         ])
@@ -271,13 +275,46 @@ fn refine_and_cantilever_from_the_command_line() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(mech.join("k.drape.json")).unwrap()).unwrap();
     assert_eq!(json["method"], "mechanical");
-    // A 20 deg pre-sheared net pressed on a plate relaxes to no shear (it is held only at the
-    // origin and in the warp direction there).
+    // A 20 deg pre-sheared net pressed frictionless on a plate, held at its seed only (as the
+    // user asked), relaxes to no shear.
     let shear: Vec<f64> = json["cell_shear_deg"].as_array().unwrap().iter().filter_map(|g| g.as_f64()).collect();
     let mean = shear.iter().map(|g| g.abs()).sum::<f64>() / shear.len() as f64;
     assert!(mean < 0.01, "mean shear {mean}");
     assert_eq!(json["meta"]["solver"]["outcome"], "converged");
     assert_eq!(json["meta"]["change_from_kinematic"]["shear_deg"].as_array().unwrap().len(), 20 * 20);
+    assert_eq!(json["meta"]["contact"]["held"], serde_json::json!([[10, 10]]));
+    assert_eq!(json["meta"]["contact"]["state"][10 * 21 + 10], "held");
+    // Frictionless and held by nothing, the ply is free to slide over the plate: said, written,
+    // exit 1.
+    let free = dir.path().join("free");
+    let run = drape()
+        .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card])
+        .args(["--mode", "pressed", "--friction", "0", "--out", free.to_str().unwrap()])
+        .assert()
+        .code(1);
+    let stderr = String::from_utf8_lossy(&run.get_output().stderr).to_string();
+    assert!(stderr.contains("free to move rigidly over the tool (3 independent motions)"), "{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(free.join("k.drape.json")).unwrap()).unwrap();
+    assert_eq!(json["meta"]["solver"]["outcome"], "slides");
+    // With the card's friction (0.25) the plate grips the pre-sheared ply where it bears: it
+    // keeps part of its shear, and the contact line says how it meets the tool.
+    let run = drape()
+        .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card])
+        .args(["--mode", "pressed", "--out", free.to_str().unwrap()])
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    assert!(stdout.contains("contact: friction 0.25: "), "{stdout}");
+    // Bad holds and friction are refused with exit code 2.
+    for bad in [["--hold", "99,0"], ["--hold", "3"], ["--friction", "-0.1"]] {
+        drape()
+            .args(["refine", "--net", net.to_str().unwrap(), "--tool", tool.to_str().unwrap(), "--material", card])
+            .args(["--mode", "pressed", "--out", free.to_str().unwrap()])
+            .args(bad)
+            .assert()
+            .code(2);
+    }
     // Bad input: a missing card is refused with exit code 2.
     drape()
         .args([

@@ -24,6 +24,7 @@ mod layup;
 mod material_cli;
 mod mechanics_cantilever;
 mod mechanics_drapes;
+mod mechanics_friction;
 mod mechanics_properties;
 mod mechanics_references;
 mod mechanics_refine;

@@ -4,6 +4,7 @@ use drape::geometry::shapes;
 use drape::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use drape::kinematic::{drape, DrapeNet, KinematicSettings, NodeStatus};
 use drape::material::MaterialCard;
+use drape::mechanics::friction::STICK_SPACINGS;
 use drape::mechanics::refine::{refine, refine_draped, RefineSettings, Refined};
 use drape::mechanics::solver::MAX_STEP_SPACINGS;
 use drape::mechanics::{ContactMode, SolverSettings};
@@ -47,8 +48,11 @@ fn pressed_refinement_stays_on_the_tool_keeps_fibre_lengths_and_lowers_the_energ
     // of the energy: within 2e-4 of balance in 5 iterations, it then twists off it (the ply
     // turns about its seed by about half a spacing at the rim) to the stable equilibrium, which
     // takes a few hundred iterations.
-    let settings =
-        RefineSettings { solver: SolverSettings::default().max_iterations(600), ..RefineSettings::default() };
+    let settings = RefineSettings {
+        solver: SolverSettings::default().max_iterations(600),
+        friction: glass.friction.unwrap(),
+        ..RefineSettings::default()
+    };
     let r = refine(&net, &tool, &glass, &settings).unwrap();
     assert!(r.ok(), "{:?}", r.outcome());
     assert!(r.energy_final <= r.energy_kinematic, "{} > {}", r.energy_final, r.energy_kinematic);
@@ -97,15 +101,28 @@ fn pressed_refinement_stays_on_the_tool_keeps_fibre_lengths_and_lowers_the_energ
     }
     // Stiff fibres (8e6 N/m against a shear stiffness of 5 N/m): lengths stay within 1e-4.
     assert!(max_strain(&r.net) < 1e-4, "{}", max_strain(&r.net));
-    // The origin node is held, where the kinematic net put it, moved onto the smooth surface.
+    // Nothing holds the ply but the tool and friction: its seed, where the kinematic net put it
+    // moved onto the smooth surface, creeps less than the stick distance against friction.
     let k0 = net.index(net.origin_node.0, net.origin_node.1);
-    assert_eq!(r.net.positions[k0], smooth.project(&net.positions[k0]).point);
+    let seed_moved = (r.net.positions[k0] - smooth.project(&net.positions[k0]).point).norm();
+    assert!(seed_moved < STICK_SPACINGS * net.spacing, "the seed moved {seed_moved} m");
+    assert!(r.contact.held.is_empty() && r.slide.is_none());
     // Refining the refined net again finds it at equilibrium: the nodes stay and the energy
     // does not fall (its convergence was not measured against forces that only moving the
-    // nodes onto the smooth tool created).
+    // nodes onto the smooth tool created) by more than friction lets it: a new refinement grips
+    // every node afresh, and each may creep up to the stick distance against its friction,
+    // freeing at most mu times the normal forces times that distance.
     let again = refine(&r.net, &tool, &glass, &settings).unwrap();
     assert!(again.ok(), "{:?}", again.outcome());
-    assert!(again.energy_final > r.energy_final * (1.0 - 1e-8), "{} -> {}", r.energy_final, again.energy_final);
+    let areas = net.spacing * net.spacing;
+    let normal: f64 = r.contact.pressure_pa.iter().flatten().map(|p| p * areas).sum();
+    let creep = settings.friction * normal * STICK_SPACINGS * net.spacing;
+    assert!(
+        again.energy_final > r.energy_final - creep,
+        "{} -> {} (creep {creep})",
+        r.energy_final,
+        again.energy_final
+    );
     let moved = again.net.positions.iter().zip(&r.net.positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     // Within a thousandth of a spacing: the net's softest (shear) mode moves nodes by about the
     // residual tolerance (1e-4) over its stiffness, far more than the stiff fibres allow.
@@ -119,6 +136,7 @@ fn free_drape_never_leaves_a_node_inside_the_tool() {
     let fabric = card("sze-liu-table1.toml");
     let settings = RefineSettings {
         mode: ContactMode::Free,
+        friction: 0.3,
         load_steps: 5,
         solver: SolverSettings::default().max_iterations(300),
         ..RefineSettings::default()
@@ -159,6 +177,7 @@ fn a_large_pressed_refinement_is_the_same_on_one_thread_and_on_two() {
     let glass = card("glass-plain-weave.toml");
     let settings = RefineSettings {
         solver: SolverSettings::default().max_iterations(20).stability_check(false),
+        friction: glass.friction.unwrap(),
         ..RefineSettings::default()
     };
     let on = |threads: usize| {
@@ -183,7 +202,7 @@ fn a_pressed_ply_on_the_facets_starts_from_its_drape_on_the_smooth_surface() {
     let draped = KinematicSettings::grid("h", Point::new(0.0, 0.0, 0.1), Vector::new(1.0, 0.3, 0.0), d, 41, 41);
     let net = drape(&tool, &draped).unwrap();
     let carbon = card("carbon-twill.toml");
-    let settings = RefineSettings::default();
+    let settings = RefineSettings { friction: carbon.friction.unwrap(), ..RefineSettings::default() };
     let moved_on = refine(&net, &tool, &carbon, &settings).unwrap();
     let from_smooth = refine_draped(&net, &draped, &tool, None, &carbon, &settings).unwrap();
     assert!(moved_on.ok() && from_smooth.ok(), "{:?} {:?}", moved_on.outcome(), from_smooth.outcome());
@@ -204,11 +223,12 @@ fn a_pressed_ply_on_the_facets_starts_from_its_drape_on_the_smooth_surface() {
         iterations(&from_smooth),
         iterations(&moved_on)
     );
-    // The same equilibrium, each to the solver's tolerance: the energies agree to 1e-6 and no
-    // node is more than 5e-3 spacing from its place in the other (measured: 1.5e-8 and 2.5e-3;
-    // the shear, the softest mode, lets a state within the residual tolerance sit that far off).
+    // Nearly the same equilibrium: with friction each start ends where friction holds it, so
+    // the two agree only as far as the fibres strained in the facet net moved onto the smooth
+    // surface slid before the tool gripped them (measured: energies 3.7e-5 apart, relative; no
+    // node more than 1e-2 spacing from its place in the other).
     assert!(
-        (from_smooth.energy_final - moved_on.energy_final).abs() <= 1e-6 * moved_on.energy_final.abs(),
+        (from_smooth.energy_final - moved_on.energy_final).abs() <= 1e-4 * moved_on.energy_final.abs(),
         "{} against {}",
         from_smooth.energy_final,
         moved_on.energy_final
@@ -218,5 +238,5 @@ fn a_pressed_ply_on_the_facets_starts_from_its_drape_on_the_smooth_surface() {
         .filter(|(_, s)| **s == NodeStatus::Placed)
         .map(|((a, b), _)| (a - b).norm())
         .fold(0.0, f64::max);
-    assert!(apart < 5e-3 * d, "{apart:e} m apart");
+    assert!(apart < 1e-2 * d, "{apart:e} m apart");
 }

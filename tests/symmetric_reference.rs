@@ -222,7 +222,10 @@ fn the_study_measures_the_cone_up_to_its_mirror() {
     let (reference, coarse) = (mech(0.003), mech(0.006));
     for f in [&reference, &coarse] {
         let (e, _) = largest_difference(&f.image(WarpMirror), f);
-        assert!(e < 1e-6, "a pressed drape on the cone broke its mirror by {e} deg");
+        // To rounding, and to friction's lag loop: it stops once the normal forces agree to
+        // 1% between solves, so the two halves agree to the solves' tolerance (2.4e-6 deg
+        // measured at 3 mm), not to the last digit.
+        assert!(e < 1e-5, "a pressed drape on the cone broke its mirror by {e} deg");
     }
     let as_fell = ReferenceImages::new(&reference, &[]).compare(&coarse).error_max_deg.unwrap();
     let mirrored = ReferenceImages::new(&reference.image(WarpMirror), &[]).compare(&coarse).error_max_deg.unwrap();

@@ -34,6 +34,10 @@ pub struct BenchArgs {
     /// Iteration limit of the refinement.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
+    /// Friction between the refined ply and the tool (default: the card's `[contact] friction`,
+    /// else 0).
+    #[arg(long)]
+    pub friction: Option<f64>,
 }
 
 pub fn run(a: BenchArgs) -> Result<(), Failure> {
@@ -95,6 +99,7 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         let net = pool.install(|| drape(&tool, &settings)).map_err(input)?;
         let refine_settings = RefineSettings {
             solver: SolverSettings::default().max_iterations(a.max_iterations),
+            friction: a.friction.or(material.friction).unwrap_or(0.0),
             ..RefineSettings::default()
         };
         // As a scene's pressed ply: a net on the facets starts from the ply draped on the smooth
@@ -106,11 +111,14 @@ pub fn run(a: BenchArgs) -> Result<(), Failure> {
         let iterations: Vec<_> = refined.steps.iter().flat_map(|s| s.iterations.iter()).collect();
         let qp: u32 = iterations.iter().map(|i| i.subproblems).sum();
         println!(
-            "refinement (pressed, {}): {} placed nodes, {:?} after {} iterations ({} Clarabel subproblems) in {:.2} s, {:.0} ms per iteration; |F-P|/|P| {:.1e}",
+            "refinement (pressed, {}, friction {}): {} placed nodes, {:?} after {} iterations in {} load step(s), {} solve(s) ({} Clarabel subproblems) in {:.2} s, {:.0} ms per iteration; |F-P|/|P| {:.1e}",
             card.display(),
+            refine_settings.friction,
             placed_nodes(&net),
             refined.outcome(),
             iterations.len(),
+            refined.increments.len(),
+            refined.steps.len(),
             qp,
             total,
             total * 1e3 / iterations.len().max(1) as f64,

@@ -51,6 +51,14 @@ pub struct RefineArgs {
     /// them).
     #[arg(long)]
     pub stick: bool,
+    /// Coulomb's coefficient of friction between the ply and the tool (default: the material
+    /// card's `[contact] friction`, else 0: frictionless).
+    #[arg(long)]
+    pub friction: Option<f64>,
+    /// Hold node I,J of the grid in place (repeat for more nodes). Nothing else holds the ply
+    /// but the tool and friction.
+    #[arg(long, value_parser = parse_node)]
+    pub hold: Vec<(usize, usize)>,
     /// Move off an equilibrium the solver's stability check finds a saddle and iterate on to a
     /// lower one (default: only report it).
     #[arg(long)]
@@ -73,6 +81,10 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     }
     let net = read_net(&a.net).map_err(input)?;
     let material = MaterialCard::load(&a.material).map_err(input)?;
+    let friction = a.friction.or(material.friction).unwrap_or(0.0);
+    if !(friction.is_finite() && friction >= 0.0) {
+        return Err(input(anyhow::anyhow!("--friction must be a finite number >= 0, got {friction}")));
+    }
     let t_load = Instant::now();
     let tool = crate::io::read_tool(&a.tool, 1.0).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
@@ -90,6 +102,15 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         solver: SolverSettings::default().max_iterations(a.max_iterations).escape_saddles(a.escape_saddles),
         sheet: Default::default(),
         stick: a.stick,
+        friction,
+        holds: a
+            .hold
+            .iter()
+            .map(|&(i, j)| {
+                let (i0, j0) = net.origin_node;
+                [(i as f64 - i0 as f64) * net.spacing, (j as f64 - j0 as f64) * net.spacing]
+            })
+            .collect(),
     };
     let t = Instant::now();
     let refined = refine(&net, &tool, &material, &settings).map_err(input)?;
@@ -111,6 +132,9 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     for p in written {
         println!("  wrote {}", p.display());
     }
+    if let Some(slide) = &refined.slide {
+        return Err(compute(anyhow::anyhow!("{}; the last state was written", slide.describe())));
+    }
     if !refined.ok() {
         return Err(compute(anyhow::anyhow!(
             "the mechanical solver stopped without equilibrium ({:?}); the last accepted state was written. Try more --load-steps or --max-iterations",
@@ -120,6 +144,13 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// A grid node `I,J`.
+fn parse_node(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("expected a grid node I,J (two whole numbers), got `{s}`");
+    let (i, j) = s.split_once(',').ok_or_else(bad)?;
+    Ok((i.trim().parse().map_err(|_| bad())?, j.trim().parse().map_err(|_| bad())?))
+}
+
 pub(crate) fn print_solver(r: &Refined) {
     let iterations: usize = r.steps.iter().map(|s| s.iterations.len()).sum();
     let ms: f64 = r.steps.iter().map(|s| s.time_ms).sum();
@@ -127,13 +158,15 @@ pub(crate) fn print_solver(r: &Refined) {
     // The check of the state the net ends in (the last load step's).
     let stability = r.steps.last().and_then(|s| s.stability.as_ref()).map(|c| format!("; {}", c.describe()));
     println!(
-        "  solver: {:?} after {iterations} iterations in {} load step(s), {:.0} ms; |F-P|/|P| {:.2e}{}",
+        "  solver: {:?} after {iterations} iterations in {} load step(s) ({} solves), {:.0} ms; |F-P|/|P| {:.2e}{}",
         r.outcome(),
+        r.increments.len(),
         r.steps.len(),
         ms,
         residual,
         stability.unwrap_or_default(),
     );
+    println!("  contact: {}", r.contact.summary().describe());
     if r.energy_start == r.energy_kinematic {
         println!("  energy: kinematic {:.6e} J -> refined {:.6e} J", r.energy_kinematic, r.energy_final);
     } else {

@@ -165,6 +165,7 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 "{}{}{}",
                 if r.choice.is_some() { "auto: " } else { "" },
                 match &r.refined {
+                    Some(refined) if refined.slide.is_some() => "SLIDES",
                     Some(refined) if !refined.ok() => "UNCONVERGED",
                     Some(refined) if refined.stability_verdict() == Some(Stability::Saddle) => "mechanical (saddle)",
                     Some(_) => "mechanical",
@@ -188,9 +189,15 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         );
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if let Some(refined) = &r.refined {
+            out += &format!("contact: ply '{}': {}\n", ply.settings.name, refined.contact.summary().describe());
+        }
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
         if let Some(refined) = r.refined.as_ref().filter(|r| !r.ok()) {
+            let what = if refined.slide.is_some() { "SLIDES" } else { "UNCONVERGED" };
             out += &format!(
-                "UNCONVERGED: ply '{}' is the solver's last accepted state, not an equilibrium: {}\n",
+                "{what}: ply '{}' is the solver's last accepted state, not an equilibrium: {}\n",
                 ply.settings.name,
                 refined.describe_failure()
             );

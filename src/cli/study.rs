@@ -79,7 +79,7 @@ pub struct StabilityArgs {
     #[command(flatten)]
     pub common: Common,
     /// Parameters swept, comma-separated: spacing, angle, seed_u, seed_v, pre_shear, locking,
-    /// tool, stiffness_ratio, load_steps (default: every one that applies to the ply).
+    /// tool, stiffness_ratio, load_steps, friction (default: every one that applies to the ply).
     #[arg(long, value_delimiter = ',')]
     pub params: Vec<String>,
     /// The two parameters of the outcome map (swept over their whole product).

@@ -53,6 +53,21 @@ pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Optio
             return bad(format!("it has {len} {what} for a {} x {} grid ({n} nodes)", net.nu, net.nv));
         }
     }
+    if let Some(c) = &net.meta.contact {
+        for (what, len) in [("state", c.state.len()), ("slip_m", c.slip_m.len()), ("pressure_pa", c.pressure_pa.len())]
+        {
+            if len != n {
+                return bad(format!(
+                    "meta.contact.{what} has {len} entries for a {} x {} grid ({n} nodes)",
+                    net.nu, net.nv
+                ));
+            }
+        }
+        let odd = c.slip_m.iter().chain(&c.pressure_pa).flatten().find(|v| !v.is_finite());
+        if let Some(v) = odd {
+            return bad(format!("meta.contact holds a slip or pressure of {v}"));
+        }
+    }
     let (i0, j0) = net.origin_node;
     if i0 >= net.nu || j0 >= net.nv {
         return bad(format!("the origin node ({i0}, {j0}) lies outside the {} x {} grid", net.nu, net.nv));

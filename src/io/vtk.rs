@@ -7,8 +7,11 @@
 //! (i, j), (i+1, j), (i+1, j+1), (i, j+1) (counter-clockwise seen from the normal warp x weft).
 //!
 //! CellData: `shear_deg` (Float64), `warp`, `weft`, `normal` (Float64 x 3, unit), `cell_i`,
-//! `cell_j` (Int32). PointData: `node_i`, `node_j` (Int32). Floats are written with `{:?}`, the
-//! shortest text that parses back to the same f64.
+//! `cell_j` (Int32). PointData: `node_i`, `node_j` (Int32); for a refined net also how each node
+//! meets the tool (`meta.contact`): `contact_state` (Int32: 0 free, 1 stick, 2 slip, 3 held;
+//! [`ContactState::code`]), `slip` (Float64, m, over all load steps) and `contact_pressure`
+//! (Float64, Pa). Floats are written with `{:?}`, the shortest text that parses back to the same
+//! f64.
 //!
 //! The flow mesh with the fibres of a mapped layup as cell data (`drape export --format vtu`,
 //! `flow.vtu`): points are the mesh nodes in mesh order; cells are VTK_TRIANGLE (5) and VTK_QUAD (9) in
@@ -31,6 +34,7 @@ use super::check::{cells, check_net};
 use super::xml::xml_escape;
 use super::{write_atomic, ExportError};
 use crate::geometry::Vector;
+use crate::kinematic::provenance::ContactState;
 use crate::kinematic::{DrapeNet, NodeStatus};
 use crate::mapping::{ElementShape, FlowMesh, LayupMap};
 use std::io::{self, Write};
@@ -216,6 +220,14 @@ fn write_vtu_to<W: Write>(net: &DrapeNet, w: &mut W, encoding: VtuEncoding) -> i
     w.write_all(b"<PointData Scalars=\"node_i\">\n")?;
     arrays.array(w, "Int32", "node_i", 1, 1, placed().map(|k| k / net.nv))?;
     arrays.array(w, "Int32", "node_j", 1, 1, placed().map(|k| k % net.nv))?;
+    if let Some(c) = &net.meta.contact {
+        // Every placed node of a refined net is in its mechanical body; the net check made sure
+        // the lists fit the grid.
+        let state = |k: usize| c.state[k].map_or(ContactState::Free.code(), ContactState::code);
+        arrays.array(w, "Int32", "contact_state", 1, 1, placed().map(state))?;
+        arrays.array(w, "Float64", "slip", 1, 1, placed().map(|k| c.slip_m[k].unwrap_or(0.0)))?;
+        arrays.array(w, "Float64", "contact_pressure", 1, 1, placed().map(|k| c.pressure_pa[k].unwrap_or(0.0)))?;
+    }
     w.write_all(b"</PointData>\n")?;
 
     w.write_all(b"<CellData Scalars=\"shear_deg\" Vectors=\"warp\">\n")?;

@@ -54,6 +54,9 @@ pub struct Provenance {
     /// For a refined net: what the solver did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub solver: Option<SolverRecord>,
+    /// For a refined net: how each node meets the tool (friction, stick and slip, pressure).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactRecord>,
     /// For a ply draped with `method = "auto"`: what was chosen and why.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method_choice: Option<MethodChoice>,
@@ -215,9 +218,126 @@ pub struct SolverRecord {
     /// The figures are in the last load step's `stability`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stability: Option<Stability>,
-    /// The solver's log, one entry per load step.
+    /// The solver's log, one entry per solve (a load step's friction may take several).
     #[serde(default)]
     pub load_steps: Value,
+    /// Per load step: its share of the load, its solves and how far its friction's normal
+    /// forces changed over the last one.
+    #[serde(default, skip_serializing_if = "Value::is_null")]
+    pub increments: Value,
+}
+
+/// How a node of a refined net meets the tool at the end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactState {
+    /// Bears on the tool and friction holds it: it crept less than the stick distance in the
+    /// last increment.
+    Stick,
+    /// Bears on the tool and slid over it in the last increment.
+    Slip,
+    /// Does not bear on the tool (hangs free, or a pressed node the tool pulls).
+    Free,
+    /// Held in place at the user's request (`hold`).
+    Held,
+}
+
+impl ContactState {
+    /// The state's number in VTU point data: 0 free, 1 stick, 2 slip, 3 held.
+    pub fn code(self) -> i32 {
+        match self {
+            ContactState::Free => 0,
+            ContactState::Stick => 1,
+            ContactState::Slip => 2,
+            ContactState::Held => 3,
+        }
+    }
+
+    /// The state's name in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactState::Stick => "stick",
+            ContactState::Slip => "slip",
+            ContactState::Free => "free",
+            ContactState::Held => "held",
+        }
+    }
+}
+
+/// How each node of a refined net meets the tool (`"contact"` in the net's meta); per-node
+/// lists are indexed `i * nv + j`, null where a node is not in the mechanical body.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactRecord {
+    /// Coulomb's coefficient between the ply and the tool.
+    pub friction: f64,
+    /// Per node: `stick`, `slip`, `free` or `held`.
+    pub state: Vec<Option<ContactState>>,
+    /// Per node: how far it slid over the tool over all load steps, m.
+    pub slip_m: Vec<Option<f64>>,
+    /// Per node: the tool's normal force on it over the node's share of the fabric, Pa.
+    pub pressure_pa: Vec<Option<f64>>,
+    /// The nodes the user held in place, [i, j].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<[usize; 2]>,
+    /// Where the ply slides: the least friction coefficient that would hold it, as far as the
+    /// forces at the end tell (0: it rests in neutral balance, any friction holds it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_needed: Option<f64>,
+}
+
+/// How a refined ply meets the tool, in a few numbers (the layup table's and the report's).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactSummary {
+    /// Coulomb's coefficient between the ply and the tool.
+    pub friction: f64,
+    /// Nodes that bear on the tool and stick.
+    pub stick: usize,
+    /// Nodes that bear on the tool and slipped in the last load step.
+    pub slip: usize,
+    /// Nodes that do not bear on the tool.
+    pub free: usize,
+    /// Nodes held at the user's request.
+    pub held: usize,
+    /// The farthest any node slid over the tool, m.
+    pub max_slip_m: f64,
+    /// The largest contact pressure, Pa.
+    pub max_pressure_pa: f64,
+    /// Where the ply slides: the least friction coefficient that would hold it, where the
+    /// forces tell.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_needed: Option<f64>,
+}
+
+impl ContactRecord {
+    /// The record in a few numbers.
+    pub fn summary(&self) -> ContactSummary {
+        let count = |s: ContactState| self.state.iter().flatten().filter(|&&x| x == s).count();
+        let largest = |v: &[Option<f64>]| v.iter().flatten().copied().fold(0.0, f64::max);
+        ContactSummary {
+            friction: self.friction,
+            stick: count(ContactState::Stick),
+            slip: count(ContactState::Slip),
+            free: count(ContactState::Free),
+            held: count(ContactState::Held),
+            max_slip_m: largest(&self.slip_m),
+            max_pressure_pa: largest(&self.pressure_pa),
+            friction_needed: self.friction_needed,
+        }
+    }
+}
+
+impl ContactSummary {
+    /// One line for people: friction, how many nodes stick and slip, the largest slip.
+    pub fn describe(&self) -> String {
+        let mut s =
+            format!("friction {}: {} nodes stick, {} slip, {} free", self.friction, self.stick, self.slip, self.free);
+        if self.held > 0 {
+            s += &format!(", {} held", self.held);
+        }
+        s +=
+            &format!("; largest slip {:.2} mm, largest pressure {:.3} Pa", self.max_slip_m * 1e3, self.max_pressure_pa);
+        s
+    }
 }
 
 /// What the second-order check found of a converged mechanical state (`mechanics::stability`).

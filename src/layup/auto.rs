@@ -3,8 +3,11 @@
 //! The kinematic net is drawn first, as always. Three cheap measurements on it decide whether it
 //! is the answer or mechanics must run, and at what spacing:
 //! - **the model**: steps of the mechanical model (the ply's card, pressed) from the kinematic
-//!   net until the nodes settle ([`PROBE_SETTLED_SHARE`]; two on a net near equilibrium, seven
-//!   on the cone, where gravity slides the ply down the slant). Their largest cell-shear change
+//!   net until the nodes settle ([`PROBE_SETTLED_SHARE`]; two on a net near equilibrium, more
+//!   where the way there is long: frictionless, gravity slid the cone's ply down the slant over
+//!   seven). With the ply's friction, where nothing would hold the ply (it slides, or turns
+//!   freely on a tool that lets it), the kinematic net is the ply held where it is laid, and
+//!   the choice says NOT ASSURED. Their largest cell-shear change
 //!   says in degrees how far equilibrium lies. Above the model's share of the tolerance (the
 //!   tolerance less the spacing's estimated error below, which takes at most
 //!   [`SPACING_SHARE`] of it), mechanics runs, going on from where the probe stopped;
@@ -540,6 +543,14 @@ pub fn choose(
     // A kept kinematic net is assured when the model's step and the spacing's error were both
     // measured within their shares; a mechanical choice is weighed after mechanics ran.
     let mut assured = !mechanical && step.is_ok();
+    if let Ok(Probe { slides: Some(why), .. }) = &step {
+        // The kinematic net is the ply as laid and held there; the pressed model says nothing
+        // holds it (frictionless on a tool it can slide or turn on, or friction too weak).
+        assured = false;
+        reason.push_str(&format!(
+            "; NOT ASSURED: the pressed model {why}; the kinematic net is the ply held where it is laid"
+        ));
+    }
     if let (Some(needed), true) = (spacing_needed, mechanical) {
         // Mechanics at a finer spacing costs the square of the refinement in nodes and more
         // iterations: it starts at the ply's spacing, and `drape_auto` presses finer only where
@@ -632,15 +643,17 @@ struct Probe {
     iterations: usize,
     /// The positions where it stopped, one per node of the net it started from.
     state: Vec<Point>,
+    /// Where the pressed model finds that nothing holds the ply on the tool: why, in words.
+    slides: Option<String>,
 }
 
 /// Steps of the mechanical model from `net` until the nodes settle (an iteration moves them by
 /// at most [`PROBE_SETTLED_SHARE`] of the largest move so far), it converges, or
 /// [`PROBE_MAX_ITERATIONS`] pass. One step is not enough where the way to equilibrium is long:
-/// on the cone, gravity slides the ply down the slant over some ten iterations, and the first
-/// moves the shear by 0.03 of the 0.78 deg it changes in all. Where the kinematic net lies near
-/// equilibrium (the hemisphere) the second iteration moves the nodes by 1/50 of the first and
-/// the probe ends there.
+/// frictionless, gravity slid the cone's ply (held at its seed) down the slant over some ten
+/// iterations, and the first moved the shear by 0.03 of the 0.78 deg it changed in all. Where
+/// the kinematic net lies near equilibrium (the hemisphere) the second iteration moves the
+/// nodes by 1/50 of the first and the probe ends there.
 fn equilibrium_probe(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Result<Probe, String> {
     let mut settings = r.settings();
     settings.load_steps = 1;
@@ -660,6 +673,7 @@ fn equilibrium_probe(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Res
         change_deg,
         residual: report.residual,
         iterations: report.iterations.len(),
+        slides: refined.slide.as_ref().map(|s| s.describe()),
         state: refined.net.positions,
     })
 }

@@ -132,15 +132,22 @@ pub struct Refinement {
     pub sheet: SheetFeatures,
     /// Free drape: nodes the tool holds up stay where they touch.
     pub stick: bool,
+    /// Coulomb's coefficient between the ply and the tool.
+    pub friction: f64,
+    /// Fabric points held in place at the user's request (u, v from the origin node, m; see
+    /// [`RefineSettings::holds`]).
+    pub holds: Vec<[f64; 2]>,
     /// Move off saddles the solver's stability check finds ([`SolverSettings::escape_saddles`]).
     pub escape_saddles: bool,
 }
 
 impl Refinement {
     /// The default pressed refinement with a material card: from the kinematic net, one load
-    /// step, [`DEFAULT_SOLVER_ITERATIONS`], no sheet features.
+    /// step, [`DEFAULT_SOLVER_ITERATIONS`], no sheet features, the card's friction (else none).
     pub fn pressed(material: MaterialCard, material_path: PathBuf) -> Refinement {
         Refinement {
+            friction: material.friction.unwrap_or(0.0),
+            holds: Vec::new(),
             material,
             material_path,
             mode: ContactMode::Pressed,
@@ -161,6 +168,8 @@ impl Refinement {
             solver: SolverSettings::default().max_iterations(self.max_iterations).escape_saddles(self.escape_saddles),
             sheet: self.sheet.clone(),
             stick: self.stick,
+            friction: self.friction,
+            holds: self.holds.clone(),
             ..RefineSettings::default()
         }
     }

@@ -6,7 +6,7 @@ use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
 use crate::kinematic::coverage::SurfaceCoverage;
-use crate::kinematic::provenance::Stability;
+use crate::kinematic::provenance::{ContactSummary, Stability};
 use crate::kinematic::MethodChoice;
 use serde::{Deserialize, Serialize};
 
@@ -107,6 +107,13 @@ pub struct LayupRow {
     /// balance.
     #[serde(default)]
     pub solver_failure: Option<String>,
+    /// For a mechanical ply: how it ended (`converged`, `slides`, `iteration_limit`, ...; the
+    /// solver's outcomes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outcome: Option<String>,
+    /// For a mechanical ply: how it meets the tool (friction, stick and slip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSummary>,
     /// For a mechanical ply that converged: the second-order check of its state, `minimum` or
     /// `saddle` (an equilibrium the energy falls away from: an unstable one), or `unresolved`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -241,6 +248,8 @@ impl LayupRow {
             method_choice: result.choice.clone(),
             converged: result.refined.as_ref().map(|r| r.ok()),
             solver_failure: result.refined.as_ref().filter(|r| !r.ok()).map(|r| r.describe_failure()),
+            outcome: result.refined.as_ref().map(|r| r.outcome().name().to_string()),
+            contact: result.refined.as_ref().map(|r| r.contact.summary()),
             stability: result.refined.as_ref().and_then(|r| r.stability_verdict()),
             thickness_m: ply.thickness,
             locking_angle_deg: Some(ply.locking_angle.to_degrees()),

@@ -32,6 +32,9 @@ pub struct MaterialCard {
     pub bending: Bending,
     /// What resin-flow exports need (optional `[flow]` section).
     pub flow: Option<FlowProperties>,
+    /// Coulomb's coefficient of friction of the fabric on a tool (optional `[contact]`
+    /// section, `friction = MU`): the default of mechanical plies made of it.
+    pub friction: Option<f64>,
 }
 
 /// The optional `[flow]` section: what resin-flow exports need of the fabric.
@@ -73,6 +76,11 @@ impl MaterialCard {
                 ));
             }
             positive("flow.fibre_radius", f.fibre_radius, "m")?;
+        }
+        if let Some(mu) = self.friction {
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(("contact.friction".into(), format!("must be a finite number >= 0, got {mu}")));
+            }
         }
         let cf = self.tension.compression_factor;
         if !(cf.is_finite() && (0.0..=1.0).contains(&cf)) {

@@ -23,6 +23,9 @@
 //! [bending]                 # flexural rigidity per unit width, N m
 //! warp = 1.0e-7
 //! weft = 1.0e-7
+//!
+//! [contact]                 # optional
+//! friction = 0.25           # Coulomb's coefficient on a tool: the default of mechanical plies
 //! ```
 //!
 //! The knit (strain-stiffening) tension law of seed 004, Supplementary Eq. 14, one table per
@@ -89,6 +92,9 @@ impl MaterialCard {
         lines.note("bending.weft", raw.bending.get_ref().weft.span());
         if let Some(f) = &raw.flow {
             lines.note("flow", f.span());
+        }
+        if let Some(c) = &raw.contact {
+            lines.note("contact", c.span());
         }
         let at = |lines: &Lines, field: &str, m: String| {
             let section = field.split('.').next().unwrap_or(field);
@@ -232,6 +238,7 @@ impl MaterialCard {
                 let f = f.into_inner();
                 FlowProperties { fibre_volume_fraction: f.fibre_volume_fraction, fibre_radius: f.fibre_radius }
             }),
+            friction: raw.contact.map(|c| c.into_inner().friction),
         };
         card.check().map_err(|(f, m)| at(&lines, &f, m))?;
         Ok(card)
@@ -296,6 +303,10 @@ impl MaterialCard {
             let _ = writeln!(s, "fibre_volume_fraction = {}", f(flow.fibre_volume_fraction));
             let _ = writeln!(s, "fibre_radius = {} # m", f(flow.fibre_radius));
         }
+        if let Some(mu) = self.friction {
+            s.push_str("\n[contact]\n");
+            let _ = writeln!(s, "friction = {} # Coulomb's coefficient on a tool", f(mu));
+        }
         s
     }
 }
@@ -326,6 +337,13 @@ struct RawCard {
     shear: Spanned<RawShear>,
     bending: Spanned<RawBending>,
     flow: Option<Spanned<RawFlow>>,
+    contact: Option<Spanned<RawContact>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawContact {
+    friction: f64,
 }
 
 #[derive(Deserialize)]

@@ -65,6 +65,11 @@ pub trait Objective: Sync {
     fn term_forces(&self, _x: &[Point]) -> Vec<(&'static str, Vec<Vector>)> {
         Vec::new()
     }
+    /// Whether the state `x` has run away from any equilibrium (a ply sliding off over the
+    /// tool, [`super::friction::Frictional`]): the solve then stops with [`Outcome::Slides`].
+    fn runaway(&self, _x: &[Point]) -> bool {
+        false
+    }
 }
 
 /// One evaluation of the objective.
@@ -210,9 +215,29 @@ pub enum Outcome {
     SubproblemFailed,
     /// Stopped as asked once the nodes settled ([`SolverSettings::settle_share`]): a probe.
     Settled,
+    /// The ply slid away over the tool ([`Objective::runaway`]): nothing holds it there, or
+    /// friction is too weak to (no equilibrium).
+    Slides,
+    /// Every solve of an increment balanced its forces, but the friction's normal forces kept
+    /// changing from one solve to the next ([`super::friction::MAX_LAGS`]).
+    FrictionUnsettled,
 }
 
 impl Outcome {
+    /// Its name in files (`converged`, `slides`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Converged => "converged",
+            Outcome::Stalled => "stalled",
+            Outcome::IterationLimit => "iteration_limit",
+            Outcome::LineSearchFailed => "line_search_failed",
+            Outcome::SubproblemFailed => "subproblem_failed",
+            Outcome::Settled => "settled",
+            Outcome::Slides => "slides",
+            Outcome::FrictionUnsettled => "friction_unsettled",
+        }
+    }
+
     /// What the outcome means, for people.
     pub fn describe(self) -> &'static str {
         match self {
@@ -222,6 +247,8 @@ impl Outcome {
             Outcome::LineSearchFailed => "no step lowered the energy, however short",
             Outcome::SubproblemFailed => "a quadratic subproblem could not be solved",
             Outcome::Settled => "stopped once the nodes settled (a probe, not an equilibrium)",
+            Outcome::Slides => "slides: nothing holds the ply where it is on the tool (no equilibrium)",
+            Outcome::FrictionUnsettled => "the friction's normal forces did not settle",
         }
     }
 }
@@ -796,6 +823,10 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         if residual <= settings.tolerance {
             // Converged: checked at the top of the loop.
             continue;
+        }
+        if accepted_flag && objective.runaway(x) {
+            outcome = Outcome::Slides;
+            break;
         }
         if let (Some(share), true) = (settings.settle_share, accepted_flag) {
             largest_step = largest_step.max(step);

@@ -14,6 +14,8 @@
 //! nesting_gap = 0.01          # optional: gap between nested pieces (default 10 mm)
 //! cutting_margin = 0.0        # optional: allowance around each flat pattern
 //! rotate_patterns = false     # optional: pieces may turn 90 deg on the roll (warp across)
+//! friction = 0.25             # optional: Coulomb's coefficient between mechanical plies and the
+//!                             # tool, for every ply without its own (default: each card's)
 //! [materials]                 # optional: names for material cards, relative to this file
 //! glass = "../../materials/glass-plain-weave.toml"
 //! [export]                    # optional: map every ply onto a resin-flow mesh
@@ -50,8 +52,13 @@
 //! # sheet_normal = [0, 0, 1]  # with start = "flat": the sheet plane's normal (default +z)
 //! # load_steps = 1            # gravity applied in this many steps (default 1)
 //! # max_iterations = 500      # solver iterations per load step (default 500)
+//! # friction = 0.25          # Coulomb's coefficient between the ply and the tool (default: the
+//!                             # scene's `friction`, else the card's [contact] friction, else 0)
+//! # hold = [[30, 30]]         # grid nodes [i, j] held in place (nothing else holds a ply but
+//!                             # the tool and friction; a ply that slides says so)
 //! # stick = false             # free drape: nodes the tool holds up stay where they touch (until pulled off by over a tenth of their weight)
-//!                             # (seed 000's tables restrain the nodes on them; default: slide)
+//!                             # (seed 000's tables restrain the nodes on them: friction without
+//!                             # limit; default: friction as given)
 //! # escape_saddles = false    # move off an equilibrium the stability check finds a saddle
 //!                             # and iterate on to a lower one (default: only report it)
 //! # [[ply.reinforcement]]     # regions with multiplied properties (seed 000's bands):
@@ -126,6 +133,7 @@ struct SceneFile {
     cutting_margin: Option<f64>,
     #[serde(default)]
     rotate_patterns: bool,
+    friction: Option<f64>,
     #[serde(default)]
     materials: BTreeMap<String, String>,
     export: Option<toml::Spanned<ExportFile>>,
@@ -191,6 +199,8 @@ struct PlyFile {
     load_steps: Option<usize>,
     max_iterations: Option<usize>,
     stick: Option<bool>,
+    friction: Option<f64>,
+    hold: Option<Vec<[usize; 2]>>,
     escape_saddles: Option<bool>,
     #[serde(default)]
     reinforcement: Vec<ReinforcementFile>,
@@ -274,6 +284,7 @@ fn refinement(
     material: Option<&PlyMaterial>,
     extent: &Extent,
     scale: f64,
+    scene_friction: Option<f64>,
 ) -> Result<Refinement, (&'static str, String)> {
     let m = material.ok_or((
         "material",
@@ -379,6 +390,7 @@ fn refinement(
         let origin = origin_node.unwrap_or_else(|| default_origin_node(*nu, *nv, sheet.seam));
         sheet.layout(*nu, *nv, p.spacing * scale, origin).map_err(|e| ("seam", e.0))?;
     }
+    let seam = sheet.seam;
     Ok(Refinement {
         material: m.card.clone(),
         material_path: m.path.clone(),
@@ -392,6 +404,35 @@ fn refinement(
                 return Err(("stick", "only a free drape sticks to the tool: give mode = \"free\"".into()))
             }
             (s, _) => s.unwrap_or(false),
+        },
+        friction: match p.friction.or(scene_friction).or(m.card.friction) {
+            Some(mu) if !(mu.is_finite() && mu >= 0.0) => {
+                return Err(("friction", format!("must be a finite number >= 0 (Coulomb's coefficient), got {mu}")))
+            }
+            mu => mu.unwrap_or(0.0),
+        },
+        holds: match (extent, &p.hold) {
+            (_, None) => Vec::new(),
+            (Extent::Grid { nu, nv, origin_node }, Some(hold)) => {
+                let (i0, j0) = origin_node.unwrap_or_else(|| default_origin_node(*nu, *nv, seam));
+                let d = p.spacing * scale;
+                let mut holds = Vec::new();
+                for &[i, j] in hold {
+                    if i >= *nu || j >= *nv {
+                        return Err((
+                            "hold",
+                            format!(
+                                "node [{i}, {j}] is outside the {nu} x {nv} grid: give [i, j] with i < {nu}, j < {nv}"
+                            ),
+                        ));
+                    }
+                    holds.push([(i as f64 - i0 as f64) * d, (j as f64 - j0 as f64) * d]);
+                }
+                holds
+            }
+            (Extent::Outline(_), Some(_)) => {
+                return Err(("hold", "held nodes are grid nodes [i, j]: the ply needs a grid (not an outline)".into()))
+            }
         },
         escape_saddles: p.escape_saddles.unwrap_or(false),
     })
@@ -599,6 +640,8 @@ impl Scene {
                         ("load_steps", p.load_steps.is_some()),
                         ("max_iterations", p.max_iterations.is_some()),
                         ("stick", p.stick.is_some()),
+                        ("friction", p.friction.is_some()),
+                        ("hold", p.hold.is_some()),
                         ("escape_saddles", p.escape_saddles.is_some()),
                         ("reinforcement", !p.reinforcement.is_empty()),
                         ("seam", p.seam.is_some()),
@@ -610,7 +653,9 @@ impl Scene {
                     }
                     None
                 }
-                "mechanical" => Some(refinement(p, material.as_ref(), &extent, scale).map_err(|(f, m)| at(f, m))?),
+                "mechanical" => {
+                    Some(refinement(p, material.as_ref(), &extent, scale, file.friction).map_err(|(f, m)| at(f, m))?)
+                }
                 "auto" => {
                     if material.is_none() {
                         return Err(at(
@@ -618,7 +663,8 @@ impl Scene {
                             "method = \"auto\" weighs the kinematic net under the ply's material card: give material = \"card.toml\" or a name from [materials]".into(),
                         ));
                     }
-                    let r = refinement(p, material.as_ref(), &extent, scale).map_err(|(f, m)| at(f, m))?;
+                    let r =
+                        refinement(p, material.as_ref(), &extent, scale, file.friction).map_err(|(f, m)| at(f, m))?;
                     if r.mode != ContactMode::Pressed {
                         return Err(at(
                             "mode",

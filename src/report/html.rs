@@ -409,6 +409,7 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
             rows.push(["change", "change-histogram"].iter().filter_map(|s| png(s)).map(|p| (p, "")).collect());
         }
     }
+    rows.push(png("contact").into_iter().map(|p| (p, "stick and slip · ")).collect());
     for row in rows.iter().filter(|r| !r.is_empty()) {
         let _ = writeln!(h, "<div class=\"pair\">");
         for (p, c) in row {
@@ -447,6 +448,14 @@ fn compare_text(ply: &PlyReport, change: Option<&str>) -> String {
 /// The layup table's method cell: what ran, marked when it did not converge or ended on a
 /// saddle, with auto's choice in a tooltip.
 fn method_cell(r: &LayupRow) -> String {
+    if r.outcome.as_deref() == Some("slides") {
+        let title = r.solver_failure.as_deref().unwrap_or("nothing holds the ply where it is on the tool");
+        return format!(
+            "<strong>SLIDES</strong> <span class=\"small\" title=\"{}\">{}</span>",
+            escape(title),
+            escape(r.method.as_deref().unwrap_or(""))
+        );
+    }
     if r.converged == Some(false) {
         return format!("<strong>NOT CONVERGED</strong> {}", escape(r.method.as_deref().unwrap_or("")));
     }
@@ -503,6 +512,20 @@ mod tests {
         assert!(!method_cell(&row(Some(true))).contains("NOT ASSURED"));
         // Files written before the verdict was recorded claim nothing either way.
         assert!(!method_cell(&row(None)).contains("NOT ASSURED"));
+        // A saddle and a ply that slides are marked too.
+        let saddle = LayupRow { stability: Some(Stability::Saddle), ..row(Some(true)) };
+        assert!(method_cell(&saddle).contains("(unstable: a saddle)"));
+        let slides = LayupRow {
+            converged: Some(false),
+            outcome: Some("slides".into()),
+            solver_failure: Some("slides: frictionless and held by nothing".into()),
+            ..row(Some(true))
+        };
+        let cell = method_cell(&slides);
+        assert!(
+            cell.starts_with("<strong>SLIDES</strong>") && cell.contains("frictionless and held by nothing"),
+            "{cell}"
+        );
         assert_eq!(choice(Some(false)).headline(), "mechanical (NOT ASSURED within 1 deg)");
         assert_eq!(choice(None).headline(), "mechanical");
     }

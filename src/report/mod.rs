@@ -13,7 +13,9 @@
 //!   the same views) and `<ply>-change-histogram.png/.svg`, with the largest and mean change;
 //!   and when the run kept the kinematic net it started from (`<ply>.kinematic.json`),
 //!   `<ply>-kinematic.png`: that net from the same views and window on the same colour scale,
-//!   shown beside `<ply>-shear.png`;
+//!   shown beside `<ply>-shear.png`; and, when the net records how it meets the tool
+//!   (`meta.contact`), `<ply>-contact.png`: the stick/slip map (cells that stick, that slid and
+//!   how far, that hang off the tool, that the user held) with the friction and the largest slip;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
 //!   nets), laminate totals, the flow-mesh export as `layup.json` records it, what each node status means, the interactive 3D view (the
 //!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
@@ -38,6 +40,7 @@ use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::read_tool_mesh;
 use crate::io::{kinematic_net_path, read_net, write_atomic, ExportError};
 use crate::kinematic::coverage::surface_coverage;
+use crate::kinematic::provenance::{ContactRecord, ContactState};
 use crate::kinematic::{DrapeNet, Method};
 use crate::layup::table::{CoverageOf, LayupRow, LayupTable};
 use crate::layup::{locking_angle_deg, LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
@@ -630,6 +633,8 @@ fn row_of_net(input: &PlyInput, tool: Option<&RawTool>) -> LayupRow {
         offset_m: net.meta.stack_offset_max_m,
         converged: net.meta.solver.as_ref().map(|s| s.converged),
         solver_failure: net.meta.solver.as_ref().and_then(|s| s.reason.clone()),
+        outcome: net.meta.solver.as_ref().map(|s| s.outcome.clone()),
+        contact: net.meta.contact.as_ref().map(|c| c.summary()),
         method_choice: net.meta.method_choice.clone(),
         ..LayupRow::default()
     }
@@ -889,6 +894,7 @@ fn draw_ply(
                             "largest change {max:.2}°; within ±{floor:.2}° (the solver's noise) drawn as none; {tool_text}"
                         ),
                         limit: climit,
+                        from_zero: false,
                         bar_label: "shear change (deg)".into(),
                         marks: vec![
                             Mark { value: floor, label: format!("+{floor:.2}° noise") },
@@ -930,6 +936,13 @@ fn draw_ply(
         }
         bar.inc(1);
     }
+    if let Some(contact) = &net.meta.contact {
+        let p = name("contact.png");
+        let (scene, pic) = contact_picture(net, contact, tool_mesh(), &input.stem, &tool_text);
+        let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&p))?;
+        write_atomic(&p, |w| w.write_all(&bytes))?;
+        files.push(p);
+    }
     Ok(PlyReport {
         name: input.stem.clone(),
         method: net.method,
@@ -951,6 +964,66 @@ fn draw_ply(
         files,
         notes,
     })
+}
+
+/// Colours of the stick/slip map: cells whose nodes bear on the tool and stick, cells that do
+/// not bear on it, cells with a node held by the user (cells that slipped take the colour of
+/// how far they slid).
+const STICK_COLOUR: [u8; 3] = [69, 117, 180];
+const FREE_COLOUR: [u8; 3] = [205, 205, 215];
+const HELD_COLOUR: [u8; 3] = [40, 40, 40];
+
+/// The stick/slip map of a refined ply: each cell by its corners (held if one is held, free if
+/// none bears on the tool, else by the largest slip of a corner that slipped, or stick).
+fn contact_picture<'a>(
+    net: &'a DrapeNet,
+    contact: &ContactRecord,
+    tool: Option<ToolMesh<'a>>,
+    stem: &str,
+    tool_text: &str,
+) -> (PlyScene<'a>, ShadedPicture) {
+    let summary = contact.summary();
+    let limit_mm = view::nice_ceil((summary.max_slip_m * 1e3).max(1e-3));
+    let cv = net.nv - 1;
+    let paint: Vec<Option<CellPaint>> = (0..net.num_cells())
+        .map(|c| {
+            let (i, j) = (c / cv, c % cv);
+            net.cell_corners(i, j)?;
+            let corners = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)].map(|(a, b)| net.index(a, b));
+            let state = |k: usize| contact.state.get(k).copied().flatten();
+            let colour = if corners.iter().any(|&k| state(k) == Some(ContactState::Held)) {
+                HELD_COLOUR
+            } else if corners.iter().all(|&k| matches!(state(k), Some(ContactState::Free) | None)) {
+                FREE_COLOUR
+            } else if corners.iter().any(|&k| state(k) == Some(ContactState::Slip)) {
+                let slip = corners.iter().filter_map(|&k| contact.slip_m.get(k).copied().flatten()).fold(0.0, f64::max);
+                shear_colour(slip * 1e3, limit_mm)
+            } else {
+                STICK_COLOUR
+            };
+            Some(CellPaint { colour, hatch: false })
+        })
+        .collect();
+    let scene = PlyScene::new(net, tool, paint, false);
+    let mut subtitle = format!("{}; {tool_text}", summary.describe());
+    if let Some(mu) = summary.friction_needed {
+        subtitle = format!("SLIDES (friction {mu:.3} would hold it); {subtitle}");
+    }
+    let pic = ShadedPicture {
+        title: format!("Ply {stem}: stick and slip on the tool"),
+        subtitle,
+        limit: limit_mm,
+        from_zero: true,
+        bar_label: "slip over the tool (mm)".into(),
+        marks: Vec::new(),
+        legend: vec![
+            LegendItem { swatch: Swatch::Fill(STICK_COLOUR), text: "sticks".into() },
+            LegendItem { swatch: Swatch::Fill(FREE_COLOUR), text: "off the tool".into() },
+            LegendItem { swatch: Swatch::Fill(HELD_COLOUR), text: "held (hold)".into() },
+            LegendItem { swatch: Swatch::Fill(shade::TOOL_BASE), text: "tool".into() },
+        ],
+    };
+    (scene, pic)
 }
 
 /// The placed nodes of a net.
@@ -1029,6 +1102,7 @@ fn shear_picture(shot: &ShearShot) -> Result<ShearPng, String> {
         title: shot.title.clone(),
         subtitle: shot.subtitle.clone(),
         limit,
+        from_zero: false,
         bar_label: "shear angle (deg)".into(),
         marks: vec![
             Mark { value: lock, label: format!("+{lock:.0}° locking") },

@@ -67,22 +67,23 @@ fn bold(size: f64) -> FontDesc<'static> {
     (FONT, size, FontStyle::Bold).into_font()
 }
 
-/// The colour bar in the right column: the diverging map from -limit to +limit with ticks, a
-/// label and marked lines (the locking angle).
+/// The colour bar in the right column: the diverging map from -limit (or 0, `from_zero`) to
+/// +limit with ticks, a label and marked lines (the locking angle).
 fn draw_colour_bar<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    limit: f64,
+    (limit, from_zero): (f64, bool),
     label: &str,
     marks: &[Mark],
     bottom: u32,
 ) -> DrawResult {
+    let low = if from_zero { 0.0 } else { -limit };
     let (_, column) = root.split_horizontally(WIDTH - BAR_COLUMN_PX);
     let mut chart = ChartBuilder::on(&column)
         .margin_top(TITLE_PX + 10)
         .margin_bottom(bottom)
         .margin_right(85)
         .y_label_area_size(58)
-        .build_cartesian_2d(0f64..1f64, -limit..limit)
+        .build_cartesian_2d(0f64..1f64, low..limit)
         .map_err(de)?;
     let step_label = |v: &f64| if limit >= 5.0 { format!("{v:.0}") } else { format!("{v:.2}") };
     chart
@@ -98,10 +99,10 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .draw()
         .map_err(de)?;
     const STEPS: usize = 128;
-    let h = 2.0 * limit / STEPS as f64;
+    let h = (limit - low) / STEPS as f64;
     chart
         .draw_series((0..STEPS).map(|k| {
-            let a = -limit + k as f64 * h;
+            let a = low + k as f64 * h;
             Rectangle::new([(0.0, a), (1.0, a + h)], rgb(shear_colour(a + 0.5 * h, limit)).filled())
         }))
         .map_err(de)?;
@@ -279,6 +280,8 @@ pub struct ShadedPicture {
     pub subtitle: String,
     /// Colour bar limit (symmetric) and label, marks on it.
     pub limit: f64,
+    /// The bar runs from 0 to the limit only (a quantity that is never negative).
+    pub from_zero: bool,
     /// Colour bar label.
     pub bar_label: String,
     /// Marked values on the bar.
@@ -354,7 +357,13 @@ pub fn shaded_png(
             let at = (((WIDTH - BAR_COLUMN_PX) / 2) as i32, (HEIGHT / 2) as i32);
             root.draw(&Text::new("no complete cells to draw", at, style)).map_err(de)?;
         }
-        draw_colour_bar(&root, pic.limit, &pic.bar_label, &pic.marks, HEIGHT - LEGEND_TOP as u32 + 20)?;
+        draw_colour_bar(
+            &root,
+            (pic.limit, pic.from_zero),
+            &pic.bar_label,
+            &pic.marks,
+            HEIGHT - LEGEND_TOP as u32 + 20,
+        )?;
         draw_legend(&root, &pic.legend)?;
         root.present().map_err(de)?;
     }

@@ -148,6 +148,9 @@ pub fn case_ply(base: &Ply, layup: &Layup, v: &Variant, tool: &ToolSurface) -> R
         if let Some(n) = v.load_steps {
             r.load_steps = n;
         }
+        if let Some(mu) = v.friction {
+            r.friction = mu;
+        }
     }
     Ok(ply)
 }
@@ -215,7 +218,10 @@ pub fn run_case(base: &Ply, layup: &Layup, case: &Case, tool: &ToolSurface) -> C
         // A mechanical case is judged by its solver: the nodes it lacks are its kinematic
         // start's, which the kinematic cases report.
         out.outcome = "ok".into();
-        if !rec.converged {
+        if rec.outcome == "slides" {
+            // Nothing holds the ply on the tool: a named outcome of its own on the map.
+            out.outcome = "slides".into();
+        } else if !rec.converged {
             out.outcome = format!("not_converged: {}", rec.outcome);
             if let Some(u) = rec.unbalanced.first() {
                 out.where_.insert("unbalanced".into(), u.position);

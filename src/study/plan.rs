@@ -103,6 +103,9 @@ pub struct Variant {
     /// Load steps of the mechanical stage, when the case sets them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load_steps: Option<usize>,
+    /// Friction between the ply and the tool in the mechanical stage, when the case sets it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
 }
 
 impl Variant {
@@ -119,6 +122,7 @@ impl Variant {
             max_shear_deg: None,
             tension_factor: 1.0,
             load_steps: None,
+            friction: None,
         }
     }
 }

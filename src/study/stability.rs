@@ -42,11 +42,13 @@ pub enum Parameter {
     StiffnessRatio,
     /// Load steps of the mechanical stage.
     LoadSteps,
+    /// Coulomb's coefficient of friction between the ply and the tool (mechanical stage).
+    Friction,
 }
 
 impl Parameter {
     /// Every parameter.
-    pub const ALL: [Parameter; 9] = [
+    pub const ALL: [Parameter; 10] = [
         Parameter::Spacing,
         Parameter::Angle,
         Parameter::SeedU,
@@ -56,6 +58,7 @@ impl Parameter {
         Parameter::Tool,
         Parameter::StiffnessRatio,
         Parameter::LoadSteps,
+        Parameter::Friction,
     ];
     /// Its name in the JSON and in `--axes`.
     pub fn name(self) -> &'static str {
@@ -69,6 +72,7 @@ impl Parameter {
             Parameter::Tool => "tool",
             Parameter::StiffnessRatio => "stiffness_ratio",
             Parameter::LoadSteps => "load_steps",
+            Parameter::Friction => "friction",
         }
     }
     /// The parameter called `name`.
@@ -80,7 +84,7 @@ impl Parameter {
     }
     /// Whether it only acts on the mechanical stage.
     pub fn is_mechanical(self) -> bool {
-        matches!(self, Parameter::StiffnessRatio | Parameter::LoadSteps)
+        matches!(self, Parameter::StiffnessRatio | Parameter::LoadSteps | Parameter::Friction)
     }
     /// Its default values.
     pub fn values(self, tools: usize) -> Vec<f64> {
@@ -93,6 +97,7 @@ impl Parameter {
             Parameter::Tool => (0..tools).map(|k| k as f64).collect(),
             Parameter::StiffnessRatio => vec![0.01, 0.1, 1.0, 10.0, 100.0],
             Parameter::LoadSteps => vec![1.0, 2.0, 5.0, 10.0],
+            Parameter::Friction => vec![0.0, 0.1, 0.2, 0.3, 0.5],
         }
     }
     /// Set the parameter to `value` in `v`.
@@ -107,6 +112,7 @@ impl Parameter {
             Parameter::Tool => v.tool = tools[value as usize].clone(),
             Parameter::StiffnessRatio => v.tension_factor = value,
             Parameter::LoadSteps => v.load_steps = Some(value as usize),
+            Parameter::Friction => v.friction = Some(value),
         }
     }
 }
@@ -173,7 +179,7 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
     let mechanical = ply.material.is_some() || ply.refinement.is_some();
     let applies = |p: Parameter| match p {
         Parameter::Tool => tools.len() > 1,
-        Parameter::StiffnessRatio | Parameter::LoadSteps => mechanical,
+        Parameter::StiffnessRatio | Parameter::LoadSteps | Parameter::Friction => mechanical,
         Parameter::Spacing | Parameter::Angle => true,
         // A free drape starts from a flat sheet: no seed, generators or shear limit to turn.
         _ => !free,
