@@ -31,6 +31,13 @@ use std::path::Path;
 pub const MID: u64 = 1;
 
 pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
+    check(map)?;
+    let angles = Angles::new(map);
+    write_atomic(out, |w| write_to(mesh, map, &angles, w))
+}
+
+/// What [`write_flow`] checks before it writes.
+pub(crate) fn check(map: &LayupMap) -> Result<(), ExportError> {
     for ply in &map.plies {
         if let Some(f) = ply.elements.iter().flatten().find(|f| !(f.nominal_thickness > 0.0)) {
             return Err(ExportError::FlowInvalid {
@@ -42,8 +49,7 @@ pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<
             });
         }
     }
-    let angles = Angles::new(map);
-    write_atomic(out, |w| write_to(mesh, map, &angles, w))
+    Ok(())
 }
 
 /// The split of each fibre angle between element, PLY and DRAPE (radians).

@@ -16,7 +16,7 @@
 //! ply does not cover keep their PID and get no THETA (the field is left blank, and a comment
 //! lists them).
 use super::{large, real};
-use crate::io::flow::{deg, file_tag, sibling};
+use crate::io::flow::{deg, ply_files};
 use crate::io::{write_atomic, ExportError};
 use crate::mapping::{ElementShape, FlowElement, FlowMesh, LayupMap, PlyMap};
 use std::io::{self, Write};
@@ -35,21 +35,17 @@ pub(crate) fn pid(el: &FlowElement) -> u64 {
 }
 
 pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Vec<PathBuf>, ExportError> {
-    let ext = out.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
-    let targets: Vec<(PathBuf, &PlyMap)> = if map.layup {
-        let mut v = Vec::new();
-        for ply in &map.plies {
-            let tag = file_tag("nastran", &ply.ply)?;
-            v.push((sibling(out, &format!("_{tag}{ext}")), ply));
-        }
-        v
-    } else {
-        vec![(out.to_path_buf(), &map.plies[0])]
-    };
+    let targets = check(map, out)?;
     for (path, ply) in &targets {
         write_atomic(path, |w| write_deck(mesh, ply, w))?;
     }
     Ok(targets.into_iter().map(|(p, _)| p).collect())
+}
+
+/// What [`write_flow`] checks before it writes: the deck of each ply (ply names become file
+/// names), or why none can be written.
+pub(crate) fn check<'a>(map: &'a LayupMap, out: &Path) -> Result<Vec<(PathBuf, &'a PlyMap)>, ExportError> {
+    ply_files("nastran", map, out)
 }
 
 fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<()> {
