@@ -134,7 +134,8 @@ pub fn write_flow_with(
 
 /// Everything [`write_flow_with`] checks before it opens a file, for `format` written to `out`:
 /// the map against the mesh (sizes, finite values) and what the format itself needs (ply names
-/// that become file names, the CalculiX material name, RTMsim's permeability and field widths).
+/// that become file names, the CalculiX material name, RTMsim's permeability and field widths,
+/// the property and material of every PID of a Nastran or OptiStruct deck).
 /// Returns notes on what the files will carry that the flow mesh or the plies did not give. A
 /// run checks every format of its export with this before it writes any file, so a map that a
 /// format cannot write stops it with nothing written.
@@ -146,14 +147,13 @@ pub fn check_flow(
     options: &FlowOptions,
 ) -> Result<Vec<String>, ExportError> {
     check(mesh, map, format.name())?;
-    match format {
-        FlowFormat::Vtu | FlowFormat::Abaqus | FlowFormat::Csv => {}
-        FlowFormat::Nastran => drop(nastran::write::check(map, out)?),
-        FlowFormat::Calculix => drop(calculix::check(map, out, &options.material_name)?),
-        FlowFormat::OptiStruct => optistruct::check(map)?,
-        FlowFormat::Rtmsim => rtmsim::check(mesh, map, out)?,
-    }
-    Ok(Vec::new())
+    Ok(match format {
+        FlowFormat::Vtu | FlowFormat::Abaqus | FlowFormat::Csv => Vec::new(),
+        FlowFormat::Nastran => nastran::write::check(mesh, map, out)?,
+        FlowFormat::Calculix => calculix::check(map, out, &options.material_name).map(|_| Vec::new())?,
+        FlowFormat::OptiStruct => optistruct::check(mesh, map)?,
+        FlowFormat::Rtmsim => rtmsim::check(mesh, map, out).map(|()| Vec::new())?,
+    })
 }
 
 /// What [`write_rtmsim`] wrote and how it grouped the elements.

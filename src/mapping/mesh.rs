@@ -38,7 +38,7 @@ pub struct FlowElement {
 }
 
 /// A shell mesh of the part, in metres.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct FlowMesh {
     /// The file it was read from.
     pub path: PathBuf,
@@ -48,6 +48,63 @@ pub struct FlowMesh {
     pub node_ids: Vec<u64>,
     /// The elements, in file order.
     pub elements: Vec<FlowElement>,
+    /// Metres per length unit of the file (1 for metres, 0.001 for millimetres): writers that
+    /// carry the file's own cards through write lengths back in its unit.
+    pub scale: f64,
+    /// The property and material cards of the file, for the writers of its family to carry
+    /// through (Nastran: PSHELL, PCOMP, PCOMPG, MAT1, MAT2, MAT8); empty for other formats.
+    pub cards: MeshCards,
+}
+
+impl Default for FlowMesh {
+    fn default() -> Self {
+        FlowMesh {
+            path: PathBuf::new(),
+            nodes: Vec::new(),
+            node_ids: Vec::new(),
+            elements: Vec::new(),
+            scale: 1.0,
+            cards: MeshCards::default(),
+        }
+    }
+}
+
+/// One property or material card of a flow mesh's file, kept as read (in the file's units).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MeshCard {
+    /// The card's name, upper case (`PSHELL`, `MAT8`, ...).
+    pub name: String,
+    /// Its id (the PID of a property, the MID of a material): its first data field.
+    pub id: u64,
+    /// Its data fields as text, the id first, in small-field numbering (eight a line, blanks
+    /// kept as empty strings), each at most 15 characters.
+    pub fields: Vec<String>,
+    /// Where it was read: `file line n`.
+    pub origin: String,
+}
+
+/// The property and material cards a flow mesh's file gives (see [`FlowMesh::cards`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MeshCards {
+    /// Property cards, in file order.
+    pub properties: Vec<MeshCard>,
+    /// Material cards, in file order.
+    pub materials: Vec<MeshCard>,
+    /// Cards of the same families that are not carried (temperature-dependent or nonlinear
+    /// materials, say), named with where they are, for the writers to say so.
+    pub not_carried: Vec<String>,
+}
+
+impl MeshCards {
+    /// The property card with PID `id`.
+    pub fn property(&self, id: u64) -> Option<&MeshCard> {
+        self.properties.iter().find(|c| c.id == id)
+    }
+
+    /// The material card with MID `id`.
+    pub fn material(&self, id: u64) -> Option<&MeshCard> {
+        self.materials.iter().find(|c| c.id == id)
+    }
 }
 
 impl FlowMesh {

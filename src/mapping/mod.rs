@@ -7,7 +7,7 @@ use crate::geometry::{Point, Vector};
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
 pub use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP, VF_MAX_HEX};
-pub use mesh::{Degeneracy, ElementShape, FlowElement, FlowMesh, DEGENERATE_RATIO};
+pub use mesh::{Degeneracy, ElementShape, FlowElement, FlowMesh, MeshCard, MeshCards, DEGENERATE_RATIO};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
@@ -49,6 +49,72 @@ pub struct PlyMap {
     pub ply: String,
     /// One entry per flow element.
     pub elements: Vec<Option<ElementFibres>>,
+    /// The ply's fabric as its material card gives it, `None` for a ply without a card.
+    pub fabric: Option<PlyFabric>,
+}
+
+/// What a ply's material card says of the fabric in its plane, for the writers that give a
+/// solver a material (the MAT8 of the Nastran and OptiStruct decks): the fibre families' tensile
+/// rigidities at zero strain, the shear stiffness at zero shear and the areal mass, with the
+/// ply's thickness as laid. The card models a pin-jointed net: the families do not couple (no
+/// Poisson effect). These are the dry fabric's constants, not a cured laminate's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlyFabric {
+    /// The card's name.
+    pub card: String,
+    /// Warp tensile rigidity per unit width at zero strain, N/m.
+    pub tension_warp: f64,
+    /// Weft tensile rigidity per unit width at zero strain, N/m.
+    pub tension_weft: f64,
+    /// Shear stiffness dM/dg at zero shear, N/m per rad.
+    pub shear: f64,
+    /// Areal mass, kg/m^2.
+    pub areal_mass: f64,
+    /// The ply's thickness as laid flat (t0), m.
+    pub thickness: f64,
+}
+
+/// The orthotropic constants of a ply of [`PlyFabric`], per unit volume (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FabricModuli {
+    /// E1 = warp rigidity / t0, Pa.
+    pub e1: f64,
+    /// E2 = weft rigidity / t0, Pa.
+    pub e2: f64,
+    /// G12 = shear stiffness / t0, Pa.
+    pub g12: f64,
+    /// NU12: 0 (the families do not couple).
+    pub nu12: f64,
+    /// Density = areal mass / t0, kg/m^3.
+    pub density: f64,
+}
+
+impl PlyFabric {
+    /// The fabric of `card` in a ply `thickness` (m) thick.
+    pub fn new(card: &crate::material::MaterialCard, thickness: f64) -> PlyFabric {
+        use crate::material::laws::Fibre;
+        PlyFabric {
+            card: card.name.clone(),
+            tension_warp: card.tension(Fibre::Warp, 0.0).2,
+            tension_weft: card.tension(Fibre::Weft, 0.0).2,
+            shear: card.shear(0.0).2,
+            areal_mass: card.areal_mass,
+            thickness,
+        }
+    }
+
+    /// Its constants per unit volume: the rigidities per unit width and the areal mass over the
+    /// thickness, so that a shell of that thickness has the card's rigidities and mass.
+    pub fn moduli(&self) -> FabricModuli {
+        let t = self.thickness;
+        FabricModuli {
+            e1: self.tension_warp / t,
+            e2: self.tension_weft / t,
+            g12: self.shear / t,
+            nu12: 0.0,
+            density: self.areal_mass / t,
+        }
+    }
 }
 
 /// Every ply of a layup mapped onto one flow mesh, with laminate-level fields.
@@ -206,9 +272,7 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
             let (Some(normal), Some(reference)) = (mesh.normal(e), mesh.first_edge(e)) else {
                 return None;
             };
-            let Some(hit) = sampler.cover(&mesh.centroid(e), settings.max_distance) else {
-                return None;
-            };
+            let hit = sampler.cover(&mesh.centroid(e), settings.max_distance)?;
             let (w3, f3) = (hit.warp, hit.weft);
             // Angles are measured about the element's own normal (right-handed over G1, G2, G3),
             // as the solvers that read THETA measure them, whichever side the ply lies on.
@@ -235,7 +299,7 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
             })
         })
         .collect();
-    Ok(PlyMap { ply: net.name.clone(), elements })
+    Ok(PlyMap { ply: net.name.clone(), elements, fabric: None })
 }
 
 /// One ply to map onto a flow mesh: its net and what it is made of.
@@ -269,7 +333,8 @@ pub fn map_plies(
     for p in plies {
         let (settings, notes) = PlyMapSettings::for_net(p.net, p.card, p.thickness, cavity, p.permeability);
         notes.iter().for_each(|n| note(n));
-        let map = map_net(p.net, mesh, &settings)?;
+        let mut map = map_net(p.net, mesh, &settings)?;
+        map.fabric = p.card.map(|c| PlyFabric::new(c, settings.thickness));
         if !mesh.elements.is_empty() && map.elements.iter().all(Option::is_none) {
             return Err(MapError::NotCovered {
                 ply: p.net.name.clone(),
@@ -540,8 +605,8 @@ mod tests {
             vf,
             permeability: None,
         };
-        let a = PlyMap { ply: "a".into(), elements: vec![Some(f(1e-3, 0.5)), None] };
-        let b = PlyMap { ply: "b".into(), elements: vec![Some(f(3e-3, 0.6)), None] };
+        let a = PlyMap { ply: "a".into(), elements: vec![Some(f(1e-3, 0.5)), None], fabric: None };
+        let b = PlyMap { ply: "b".into(), elements: vec![Some(f(3e-3, 0.6)), None], fabric: None };
         let m = LayupMap::new(vec![a, b], true, 2);
         assert!((m.thickness[0] - 4e-3).abs() < 1e-18 && m.thickness[1] == 0.0);
         assert!((m.mean_vf[0].unwrap() - 0.575).abs() < 1e-12 && m.mean_vf[1].is_none());
