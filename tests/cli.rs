@@ -431,11 +431,12 @@ fn a_run_owns_its_folder_and_the_report_shows_its_plies() {
     assert!(!out.join("other.drape.json").exists() && out.join("a.drape.json").is_file());
 }
 
-/// A scene whose flow export no ply covers, or whose export a format cannot write, stops with
-/// exit 2 before any file is written (issue 34: every ply was written first); a flow mesh with a
+/// A scene whose flow export no ply covers, whose export a format cannot write, or whose plies
+/// do not fit the roll, stops with exit 2 before any file is written (issue 34: every ply was
+/// written first); a flow mesh with a
 /// degenerate element (G1 = G2) is mapped but for that element, which a note names.
 #[test]
-fn an_export_that_cannot_be_written_stops_the_run_before_any_file() {
+fn a_run_that_cannot_finish_stops_before_any_file() {
     let dir = tempfile::tempdir().unwrap();
     plate_obj(dir.path());
     let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
@@ -489,6 +490,14 @@ fn an_export_that_cannot_be_written_stops_the_run_before_any_file() {
     let a = run("plate.obj", "\"vtu\", \"rtmsim\"", &out).code(2);
     let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
     assert!(err.contains("permeability") && err.contains("Nothing was written"), "{err}");
+    assert!(!out.exists());
+    // A ply wider than the roll (found by the pipeline fuzz: roll_width = 1e-320): nested
+    // before any net is written.
+    let out = dir.path().join("roll");
+    std::fs::write(&scene, format!("tool = \"plate.obj\"\nroll_width = 0.1\n{ply}")).unwrap();
+    let a = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("the roll is only 0.100000 m wide"), "{err}");
     assert!(!out.exists());
     let out = dir.path().join("degenerate");
     let a = run("bad.bdf", "\"vtu\"", &out).success();

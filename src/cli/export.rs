@@ -39,8 +39,8 @@ pub struct ExportArgs {
     /// Units of the flow mesh: m or mm.
     #[arg(long, default_value = "m")]
     pub mesh_units: String,
-    /// Material card for the ply's thickness, Vf and fibre radius (default: the card the net
-    /// records, if any).
+    /// Material card for the ply's thickness, Vf and fibre radius, and the MAT8 of the Nastran
+    /// and OptiStruct decks (default: the card the net records, if any).
     #[arg(long)]
     pub material: Option<PathBuf>,
     /// Ply thickness as laid flat, m (overrides the card's).

@@ -5,10 +5,11 @@
 //! Order, so that bad input costs nothing computed: the plies' settings are checked, the flow
 //! export's mesh is read and the plies' cards checked for what it asks, the tool is read, the
 //! output folder is checked ([`super::folder`]), every ply is draped (a bad ply stops
-//! the run before any file is written), the plies are mapped onto the scene's flow mesh and the
-//! map checked against every format the export asks for (a ply that covers no element, or a map
-//! a format cannot write, stops the run before any file is written), then each net is written,
-//! the flat patterns are nested and drawn, the flow files are written, `layup.json` is written
+//! the run before any file is written), the flat patterns are made and nested (a ply too wide
+//! for the roll stops the run before any file is written), the plies are mapped onto the scene's
+//! flow mesh and the map checked against every format the export asks for (a ply that covers no
+//! element, or a map a format cannot write, stops the run before any file is written), then each
+//! net is written, the flat patterns are drawn, the flow files are written, `layup.json` is written
 //! listing every file, and last the files of an earlier run into the folder that this one did
 //! not write are removed.
 use super::folder::{prepare, FolderError};
@@ -260,7 +261,9 @@ pub fn run(
     let mut results = drape_layup(&scene.layup, &tool, |index, name| on(Event::Draping { index, count, name }))
         .map_err(|error| RunError::Layup { scene: scene.path.clone(), error })?;
     on(Event::Draped);
-    // The flow export is mapped and checked before the first file is written.
+    // The flat patterns are nested and the flow export is mapped and checked before the first
+    // file is written.
+    let cutting = plan_cutting(scene, &results)?;
     let mapped = match (&scene.export, &flow) {
         (Some(export), Some(flow)) => Some(map_flow(scene, export, flow, &results, out)?),
         _ => None,
@@ -301,7 +304,7 @@ pub fn run(
         written.extend(files);
     }
     on(Event::Layup { scene, results: &results });
-    let (nesting, patterns) = cutting_plan(scene, &results, out, &mut written, on)?;
+    let (nesting, patterns) = write_cutting(cutting, out, &mut written, on)?;
     // The flow export before the table, so that the table lists its files.
     let export_row = match (&scene.export, &flow, &mapped) {
         (Some(export), Some(flow), Some(mapped)) => Some(export_flow(export, flow, mapped, out, &mut written, on)?),
@@ -343,17 +346,23 @@ pub fn run(
     Ok(())
 }
 
-/// Flat patterns of every ply, nested on the roll: `patterns.dxf`, `patterns.svg` and one SVG a
-/// ply. Plies without a complete cell have no pattern and are named; a pattern not cut along the
-/// line its ply asks for says why. Returns the nesting (when there is a pattern) and the patterns.
-fn cutting_plan(
-    scene: &Scene,
-    results: &[PlyResult],
-    out: &Path,
-    written: &mut Vec<PathBuf>,
-    on: &mut dyn FnMut(Event),
-) -> Result<(Option<Nesting>, Vec<FlatPattern>), RunError> {
-    let mut patterns = Vec::new();
+/// Flat patterns of every ply, nested on the roll, before anything is written (a ply too wide
+/// for the roll stops the run with nothing written).
+struct Cutting {
+    patterns: Vec<FlatPattern>,
+    /// Per ply in stacking order: its pattern's index, or its name when it has no complete cell
+    /// (so no pattern).
+    plies: Vec<Result<usize, String>>,
+    /// The roll width assumed when the scene gives none.
+    assumed_width: Option<f64>,
+    nesting: Option<Nesting>,
+}
+
+/// Flat patterns of every ply, nested on the roll. Plies without a complete cell have no pattern
+/// and are named; a pattern not cut along the line its ply asks for says why ([`write_cutting`]
+/// reports both).
+fn plan_cutting(scene: &Scene, results: &[PlyResult]) -> Result<Cutting, RunError> {
+    let mut cutting = Cutting { patterns: Vec::new(), plies: Vec::new(), assumed_width: None, nesting: None };
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         // A ply draped with an outline is cut along it (without a margin).
         let outline = match &ply.settings.extent {
@@ -362,33 +371,54 @@ fn cutting_plan(
         };
         match ply_pattern(&r.net, outline, scene.cutting_margin) {
             Ok(p) => {
-                for warning in &p.warnings {
-                    on(Event::PatternWarning { ply: &p.ply, warning });
-                }
-                patterns.push(p)
+                cutting.plies.push(Ok(cutting.patterns.len()));
+                cutting.patterns.push(p);
             }
-            Err(FlatError::NoCells { ply }) => on(Event::NoPattern { ply: &ply }),
+            Err(FlatError::NoCells { ply }) => cutting.plies.push(Err(ply)),
             Err(e) => return Err(RunError::Flat(e)),
         }
     }
-    if patterns.is_empty() {
-        return Ok((None, patterns));
+    if cutting.patterns.is_empty() {
+        return Ok(cutting);
     }
     let rotation = if scene.rotate_patterns { Rotation::AllowQuarterTurn } else { Rotation::WarpAlongRoll };
-    let roll_width = match scene.roll_width {
-        Some(w) => w,
-        None => {
-            // Without a roll width the pieces go on a roll as wide as the widest of them.
-            let width = patterns.iter().map(|p| p.size()[1]).fold(0.0, f64::max);
-            on(Event::RollWidthAssumed { width });
-            width
+    let roll_width = scene.roll_width.unwrap_or_else(|| {
+        // Without a roll width the pieces go on a roll as wide as the widest of them.
+        let width = cutting.patterns.iter().map(|p| p.size()[1]).fold(0.0, f64::max);
+        cutting.assumed_width = Some(width);
+        width
+    });
+    cutting.nesting = Some(nest(&cutting.patterns, roll_width, scene.nesting_gap, rotation).map_err(RunError::Flat)?);
+    Ok(cutting)
+}
+
+/// Report the cutting plan and draw it: `patterns.dxf`, `patterns.svg` and one SVG a ply.
+/// Returns the nesting (when there is a pattern) and the patterns.
+fn write_cutting(
+    cutting: Cutting,
+    out: &Path,
+    written: &mut Vec<PathBuf>,
+    on: &mut dyn FnMut(Event),
+) -> Result<(Option<Nesting>, Vec<FlatPattern>), RunError> {
+    for ply in &cutting.plies {
+        match ply {
+            Ok(k) => {
+                let p = &cutting.patterns[*k];
+                for warning in &p.warnings {
+                    on(Event::PatternWarning { ply: &p.ply, warning });
+                }
+            }
+            Err(ply) => on(Event::NoPattern { ply }),
         }
-    };
-    let nesting = nest(&patterns, roll_width, scene.nesting_gap, rotation).map_err(RunError::Flat)?;
-    let files = write_cutting_plan(&patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
-    on(Event::CuttingPlan { pieces: patterns.len(), nesting: &nesting, files: &files });
+    }
+    let Some(nesting) = cutting.nesting else { return Ok((None, cutting.patterns)) };
+    if let Some(width) = cutting.assumed_width {
+        on(Event::RollWidthAssumed { width });
+    }
+    let files = write_cutting_plan(&cutting.patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
+    on(Event::CuttingPlan { pieces: cutting.patterns.len(), nesting: &nesting, files: &files });
     written.extend(files);
-    Ok((Some(nesting), patterns))
+    Ok((Some(nesting), cutting.patterns))
 }
 
 /// Every ply on the flow mesh, checked against the export's formats, before anything is written.
