@@ -27,6 +27,7 @@ fn flow_mesh(m: &TriangleMesh) -> FlowMesh {
                 property: 0,
             })
             .collect(),
+        ..FlowMesh::default()
     }
 }
 

@@ -468,6 +468,81 @@ fn a_run_owns_its_folder_and_the_report_shows_its_plies() {
     assert!(!out.join("other.drape.json").exists() && out.join("a.drape.json").is_file());
 }
 
+/// A scene whose flow export no ply covers, whose export a format cannot write, or whose plies
+/// do not fit the roll, stops with exit 2 before any file is written (issue 34: every ply was
+/// written first); a flow mesh with a
+/// degenerate element (G1 = G2) is mapped but for that element, which a note names.
+#[test]
+fn a_run_that_cannot_finish_stops_before_any_file() {
+    let dir = tempfile::tempdir().unwrap();
+    plate_obj(dir.path());
+    let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+    let ply = format!(
+        "[[ply]]\nname = \"a\"\norigin = [0, 0, 0]\nwarp = [1, 0, 0]\nspacing = 0.05\ngrid = [19, 19]\nmaterial = {card:?}\n"
+    );
+    // The plate moved 10 m away: no ply covers it.
+    let far: String = std::fs::read_to_string(dir.path().join("plate.obj"))
+        .unwrap()
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(v) => {
+                let x: Vec<f64> = v.split_whitespace().map(|t| t.parse().unwrap()).collect();
+                format!("v {} {} {}\n", x[0] + 10.0, x[1], x[2])
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(dir.path().join("far.obj"), far).unwrap();
+    // The plate as a Nastran mesh with one CQUAD4 whose G1 and G2 are the same grid.
+    let mut bdf = String::from("BEGIN BULK\n");
+    for i in 0..=4 {
+        for j in 0..=4 {
+            bdf += &format!("GRID,{},,{},{},0.\n", 10 * i + j + 1, 0.2 * i as f64 - 0.4, 0.2 * j as f64 - 0.4);
+        }
+    }
+    for i in 0..4 {
+        for j in 0..4 {
+            let a = 10 * i + j + 1;
+            let g2 = if (i, j) == (1, 1) { a } else { a + 10 };
+            bdf += &format!("CQUAD4,{},1,{a},{g2},{},{}\n", 100 + 4 * i + j, a + 11, a + 1);
+        }
+    }
+    std::fs::write(dir.path().join("bad.bdf"), bdf + "ENDDATA\n").unwrap();
+    let scene = dir.path().join("scene.toml");
+    let run = |mesh: &str, formats: &str, out: &Path| {
+        std::fs::write(
+            &scene,
+            format!("tool = \"plate.obj\"\n[export]\nmesh = \"{mesh}\"\nformats = [{formats}]\n{ply}"),
+        )
+        .unwrap();
+        drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert()
+    };
+    let out = dir.path().join("far");
+    let a = run("far.obj", "\"vtu\"", &out).code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("covers none of the 200 elements"), "{err}");
+    assert!(!out.exists(), "wrote {:?}", std::fs::read_dir(&out).map(|d| d.count()));
+    // RTMsim needs permeability, which the export does not ask for.
+    let out = dir.path().join("rtmsim");
+    let a = run("plate.obj", "\"vtu\", \"rtmsim\"", &out).code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("permeability") && err.contains("Nothing was written"), "{err}");
+    assert!(!out.exists());
+    // A ply wider than the roll (found by the pipeline fuzz: roll_width = 1e-320): nested
+    // before any net is written.
+    let out = dir.path().join("roll");
+    std::fs::write(&scene, format!("tool = \"plate.obj\"\nroll_width = 0.1\n{ply}")).unwrap();
+    let a = drape().args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+    assert!(err.contains("the roll is only 0.100000 m wide"), "{err}");
+    assert!(!out.exists());
+    let out = dir.path().join("degenerate");
+    let a = run("bad.bdf", "\"vtu\"", &out).success();
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    assert!(stdout.contains("1 degenerate element(s) (105)") && stdout.contains("same node 12"), "{stdout}");
+    assert!(stdout.contains("covers 15 of 16 elements"), "{stdout}");
+}
+
 /// Everything a run can check is checked before it computes: bad input exits 2 with one message
 /// saying what to do, and writes nothing.
 #[test]

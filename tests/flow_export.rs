@@ -220,7 +220,18 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
     }
 
     // Nastran (pyNastran): THETA from G1->G2 about the element normal gives the net's warp.
-    let bdf = readback("nastran", &[&export(&case, "nastran", "flow.bdf", &[])]);
+    let bdf_path = export(&case, "nastran", "flow.bdf", &[]);
+    let bdf = readback("nastran", &[&bdf_path]);
+    // The deck reads alone with cross-referencing: the OBJ mesh has no PIDs, so every element is
+    // on PID 1, a PSHELL drape writes of the card's fabric (MAT8).
+    let xref = readback("nastran-xref", &[&bdf_path]);
+    assert_eq!(xref["rejected"], serde_json::json!([]));
+    for el in xref["elements"].as_object().unwrap().values() {
+        assert_eq!(
+            (el["pid"].as_u64(), el["property"].as_str(), el["material"].as_str()),
+            (Some(1), Some("PSHELL"), Some("MAT8"))
+        );
+    }
     let deck = &bdf["decks"][0];
     let grids = &deck["grids"];
     let mut thetas = 0;
@@ -270,7 +281,17 @@ fn every_format_reads_back_unit_in_plane_directions_at_the_plys_shear() {
 
     // OptiStruct (documented DRAPE/PLY layout), free cavity: thinning T = 1 / cos(shear) and
     // element THETA + PLY THETA + DRAPE THETA gives the warp.
-    let fem = readback("optistruct", &[&export(&case, "optistruct", "flow.fem", &["--cavity", "free"])]);
+    let fem_path = export(&case, "optistruct", "flow.fem", &["--cavity", "free"]);
+    let fem = readback("optistruct", &[&fem_path]);
+    // Cross-referenced (pyNastran taught PCOMPP, our parser for PLY, STACK, SET, DRAPE): nothing
+    // dangles; covered elements on the PCOMPP, the others on a PSHELL of their own.
+    let xref = readback("optistruct-xref", &[&fem_path]);
+    assert_eq!(xref["dangling"], serde_json::json!([]));
+    for (id, el) in xref["elements"].as_object().unwrap() {
+        let covered = elements[&id.parse::<u64>().unwrap()].1.is_some();
+        let want = if covered { (Some(1), Some("PCOMPP")) } else { (Some(2), Some("PSHELL")) };
+        assert_eq!((el["pid"].as_u64(), el["property"].as_str()), want, "OptiStruct element {id}");
+    }
     let ply = fem["plies"].as_object().unwrap().values().next().unwrap();
     let drape = &fem["drapes"][ply["did"].as_u64().unwrap().to_string()];
     let mut checked = 0;

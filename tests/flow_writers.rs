@@ -12,7 +12,7 @@ use drape::io::csv::FLOW_CSV_HEADER;
 use drape::io::flow::{write_flow, write_rtmsim, FlowFormat};
 use drape::io::rtmsim::MAX_RTMSIM_SETS;
 use drape::io::ExportError;
-use drape::mapping::{ElementFibres, LayupMap, PlyMap};
+use drape::mapping::{ElementFibres, LayupMap, MeshCard, MeshCards, PlyFabric, PlyMap};
 use drape::mapping::{ElementShape, FlowElement, FlowMesh};
 use nalgebra::Matrix3;
 use serde_json::Value;
@@ -79,7 +79,41 @@ fn mesh() -> FlowMesh {
         el(15, &[22, 32, 33, 23]),
         el(16, &[31, 40, 32]),
     ];
-    FlowMesh { path: PathBuf::from("test-mesh.bdf"), nodes, node_ids, elements }
+    FlowMesh { path: PathBuf::from("test-mesh.bdf"), nodes, node_ids, elements, scale: 1.0, cards: user_cards() }
+}
+
+/// The user's cards of [`mesh`]: PSHELL 5 on MAT8 100, PCOMP 6 of MAT1 101 and MAT8 100; none
+/// for the elements without a PID (1 in the decks); a MATT8 drape does not carry.
+fn user_cards() -> MeshCards {
+    let card = |name: &str, fields: &[&str]| MeshCard {
+        name: name.into(),
+        id: fields[0].parse().unwrap(),
+        fields: fields.iter().map(|f| f.to_string()).collect(),
+        origin: format!("test-mesh.bdf line {}", fields[0]),
+    };
+    MeshCards {
+        properties: vec![
+            card("PSHELL", &["5", "100", ".002", "100"]),
+            card("PCOMP", &["6", "", "", "", "", "", "", "", "101", ".0005", "0.", "", "100", ".0005", "90."]),
+        ],
+        materials: vec![
+            card("MAT8", &["100", "140.+9", "10.+9", ".3", "5.+9", "", "", "1600."]),
+            card("MAT1", &["101", "70.+9", "", ".33", "2700."]),
+        ],
+        not_carried: vec!["MATT8 100 (test-mesh.bdf line 9)".into()],
+    }
+}
+
+/// The fabric of the plies of [`layup_map`].
+fn fabric() -> PlyFabric {
+    PlyFabric {
+        card: "test-fabric".into(),
+        tension_warp: 8.0e6,
+        tension_weft: 6.0e6,
+        shear: 5.0,
+        areal_mass: 0.6,
+        thickness: NOMINAL_T,
+    }
 }
 
 /// The user's property of each element of [`mesh`]: 0 (none) for elements 15 and 16.
@@ -148,6 +182,7 @@ fn layup_map(mesh: &FlowMesh, layup: bool) -> LayupMap {
         .map(|(k, (name, angle, missing))| PlyMap {
             ply: name.to_string(),
             elements: (0..n).map(|e| (!missing.contains(&e)).then(|| fibres(mesh, e, k, *angle))).collect(),
+            fabric: Some(fabric()),
         })
         .collect();
     let mut thickness = vec![0.0; n];
@@ -457,6 +492,60 @@ fn optistruct_ply_drape() {
     for el in &mesh.elements {
         assert_eq!(els[&el.id.to_string()]["pid"], kept_pid(el.id));
     }
+    // pyNastran, taught PCOMPP, cross-references the deck alone; PLY, STACK, SET and DRAPE
+    // resolve. Every element here lies under some ply: all on PCOMPPs of their PIDs, each ply on
+    // a MAT8 of its fabric, the plies in one STACK in stacking order.
+    let x = readback("optistruct-xref", &files);
+    assert_eq!(x["dangling"], serde_json::json!([]));
+    for el in &mesh.elements {
+        let r = &x["elements"][&el.id.to_string()];
+        assert_eq!((r["pid"].as_u64(), r["property"].as_str()), (Some(kept_pid(el.id)), Some("PCOMPP")));
+    }
+    assert_eq!(x["stacks"]["1"]["plies"], serde_json::json!([1, 2, 3]));
+    let f = fabric();
+    for k in 1..=3 {
+        let m = &x["plies"][&k.to_string()]["material"];
+        assert_eq!(m["type"], "MAT8");
+        assert!((m["e1"].as_f64().unwrap() - f.tension_warp / NOMINAL_T).abs() < 1e-6 * f.tension_warp / NOMINAL_T);
+    }
+    assert!(comments(&text).contains("it replaces the flow mesh's PSHELL 5"), "{text}");
+
+    // Elements no ply covers: off the PCOMPPs. Element 3 (PID 5, beside covered element 7) takes
+    // a fresh PID 7 with the user's PSHELL 5 renumbered; element 16 (no PID, beside covered 15)
+    // a fresh PID 8 with a PSHELL of the bottom ply's fabric, named in a note.
+    let mut part = map.clone();
+    for ply in &mut part.plies {
+        ply.elements[1] = None;
+        ply.elements[5] = None;
+    }
+    let notes = drape::io::flow::check_flow(
+        &mesh,
+        &part,
+        FlowFormat::OptiStruct,
+        &dir.path().join("part.fem"),
+        &Default::default(),
+    )
+    .unwrap();
+    assert!(
+        notes.len() == 1 && notes[0].contains("PID 8 (PID 1 in the flow mesh): 1 element(s) no ply covers"),
+        "{notes:?}"
+    );
+    let files = write(&mesh, &part, FlowFormat::OptiStruct, &dir.path().join("part.fem"));
+    let x = readback("optistruct-xref", &files);
+    assert_eq!(x["dangling"], serde_json::json!([]));
+    let pid_of = |id: u64| {
+        (
+            x["elements"][&id.to_string()]["pid"].as_u64().unwrap(),
+            x["elements"][&id.to_string()]["property"].as_str().unwrap().to_string(),
+        )
+    };
+    assert_eq!(pid_of(3), (7, "PSHELL".into()));
+    assert_eq!(pid_of(16), (8, "PSHELL".into()));
+    assert_eq!(pid_of(7), (5, "PCOMPP".into()));
+    assert_eq!(pid_of(15), (1, "PCOMPP".into()));
+    assert_eq!(x["properties"]["7"]["t"].as_f64(), Some(0.002));
+    assert_eq!(x["properties"]["8"]["t"].as_f64(), Some(NOMINAL_T));
+    assert_eq!(x["properties"]["8"]["materials"], serde_json::json!(["MAT8"]));
 }
 
 #[test]
@@ -701,32 +790,37 @@ fn rtmsim_merges_excess_groups() {
     assert_eq!(s["patchtypes"], serde_json::json!([2, 2, 2, 2]));
 }
 
-/// pyNastran reads a solver's deck that INCLUDEs drape's bulk data with cross-referencing on:
-/// every element finds the user's property and material, and keeps its THETA.
+/// pyNastran reads drape's Nastran deck alone, and a solver's deck that INCLUDEs it, with
+/// cross-referencing on: every element keeps its PID and finds its property and material, the
+/// user's cards carried as they were, a PSHELL and MAT8 from the ply's fabric for the PID the
+/// mesh gives none (E = rigidity / t0, G12 = shear stiffness / t0, RHO = areal mass / t0).
 #[test]
-fn nastran_deck_cross_references_the_users_properties() {
+fn nastran_deck_reads_alone_and_included_with_cross_references() {
     if !python_ready() {
         return;
     }
     let mesh = mesh();
     let map = layup_map(&mesh, false);
     let dir = tempfile::tempdir().unwrap();
-    write(&mesh, &map, FlowFormat::Nastran, &dir.path().join("flow.bdf"));
+    let deck = write(&mesh, &map, FlowFormat::Nastran, &dir.path().join("flow.bdf")).remove(0);
     let master = dir.path().join("job.bdf");
-    let mut text = String::from("SOL 101\nCEND\nSUBCASE 1\n  DISP = ALL\nBEGIN BULK\n");
-    for pid in [1, 5, 6] {
-        text += &format!("PSHELL,{pid},100,0.001\n");
-    }
-    text += "MAT8,100,140.+9,10.+9,0.3,5.+9,5.+9,5.+9,1600.\nINCLUDE 'flow.bdf'\nENDDATA\n";
-    std::fs::write(&master, text).unwrap();
-    let s = readback("nastran-xref", &[master]);
-    let els = s["elements"].as_object().unwrap();
+    std::fs::write(&master, "SOL 101\nCEND\nSUBCASE 1\n  DISP = ALL\nBEGIN BULK\nINCLUDE 'flow.bdf'\nENDDATA\n")
+        .unwrap();
+    let alone = readback("nastran-xref", &[deck]);
+    let included = readback("nastran-xref", &[master]);
+    assert_eq!(alone["elements"], included["elements"]);
+    assert_eq!(alone["rejected"], serde_json::json!([]), "pyNastran rejected cards of the deck");
+    let els = alone["elements"].as_object().unwrap();
     assert_eq!(els.len(), mesh.elements.len());
     for (e, el) in mesh.elements.iter().enumerate() {
         let r = &els[&el.id.to_string()];
         assert_eq!(r["pid"], kept_pid(el.id));
-        assert_eq!(r["property"], "PSHELL");
-        assert_eq!(r["material"], "MAT8");
+        let (property, material) = match kept_pid(el.id) {
+            5 => ("PSHELL", "MAT8"),
+            6 => ("PCOMP", "MAT1"),
+            _ => ("PSHELL", "MAT8"),
+        };
+        assert_eq!((r["property"].as_str().unwrap(), r["material"].as_str().unwrap()), (property, material));
         match &map.plies[0].elements[e] {
             Some(fib) => {
                 assert!((r["theta"].as_f64().unwrap() - fib.theta.to_degrees()).abs() < LARGE_FIELD_DEG_TOL)
@@ -734,6 +828,39 @@ fn nastran_deck_cross_references_the_users_properties() {
             None => assert!(r["theta"].is_null() || r["theta"].as_f64() == Some(0.0), "{r}"),
         }
     }
+    // The user's cards as they were.
+    let props = &alone["properties"];
+    assert_eq!(props["5"]["t"].as_f64(), Some(0.002));
+    assert_eq!(props["5"]["mids"], serde_json::json!([100, 100]));
+    assert_eq!(props["6"]["mids"], serde_json::json!([101, 100]));
+    assert_eq!(props["6"]["materials"], serde_json::json!(["MAT1", "MAT8"]));
+    let mats = &alone["materials"];
+    assert_eq!(mats["100"]["e1"].as_f64(), Some(140.0e9));
+    assert_eq!(mats["101"]["e"].as_f64(), Some(70.0e9));
+    // PID 1: drape's PSHELL (membrane, t0) and MAT8 of the fabric, above the user's MIDs.
+    assert_eq!(props["1"]["t"].as_f64(), Some(NOMINAL_T));
+    assert_eq!(props["1"]["mids"], serde_json::json!([102]));
+    let m = &mats["102"];
+    let f = fabric();
+    let close = |v: &Value, want: f64| (v.as_f64().unwrap() - want).abs() <= 1e-9 * want.abs();
+    assert!(close(&m["e1"], f.tension_warp / NOMINAL_T) && close(&m["e2"], f.tension_weft / NOMINAL_T), "{m}");
+    assert!(close(&m["g12"], f.shear / NOMINAL_T) && close(&m["rho"], f.areal_mass / NOMINAL_T), "{m}");
+    assert_eq!(m["nu12"].as_f64(), Some(0.0));
+    let text = std::fs::read_to_string(dir.path().join("flow.bdf")).unwrap();
+    assert!(comments(&text).contains("not carried from the flow mesh: MATT8 100"), "{text}");
+    // Without a fabric for the PID the mesh gives no card, the deck is refused, saying what to give.
+    let mut bare = map.clone();
+    bare.plies[0].fabric = None;
+    let e = write_flow(&mesh, &bare, FlowFormat::Nastran, &dir.path().join("bare.bdf")).unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    let e = e.to_string();
+    assert!(e.contains("PID 1") && e.contains("elements 15, 16") && e.contains("--material"), "{e}");
+    // A user's card that refers to a material the mesh does not give is refused, naming both.
+    let mut lost = mesh.clone();
+    lost.cards.materials.retain(|c| c.id != 101);
+    let e = write_flow(&lost, &map, FlowFormat::Nastran, &dir.path().join("lost.bdf")).unwrap_err().to_string();
+    assert!(e.contains("PCOMP 6 (test-mesh.bdf line 6) refers to material 101") && e.contains("MATT8 100"), "{e}");
+    assert!(!dir.path().join("bare.bdf").exists() && !dir.path().join("lost.bdf").exists());
 }
 
 /// The flow VTU as compressed binary: VTK's own reader gets the same arrays as from the ASCII
@@ -793,4 +920,279 @@ fn flow_vtu_binary_reads_in_vtk_as_the_ascii_does() {
         }
     }
     assert!(uncovered > 0, "the layup leaves elements uncovered");
+}
+
+/// A Nastran card in one of the layouts a flow mesh may use.
+#[derive(Clone, Copy, Debug)]
+enum Layout {
+    Small,
+    Large,
+    Free,
+}
+
+fn nastran_card(layout: Layout, name: &str, fields: &[String]) -> String {
+    let mut out = String::new();
+    match layout {
+        Layout::Free => {
+            // Eight fields a line, continuation lines starting with a comma.
+            for (k, chunk) in fields.chunks(8).enumerate() {
+                out += &format!("{},{}\n", if k == 0 { name } else { "" }, chunk.join(","));
+            }
+        }
+        Layout::Small => {
+            for (k, chunk) in fields.chunks(8).enumerate() {
+                out += &format!("{:<8}", if k == 0 { name } else { "" });
+                for f in chunk {
+                    assert!(f.len() <= 8, "{f}");
+                    out += &format!("{f:>8}");
+                }
+                out += "\n";
+            }
+        }
+        Layout::Large => {
+            for (k, chunk) in fields.chunks(4).enumerate() {
+                out += &if k == 0 { format!("{:<8}", format!("{name}*")) } else { format!("{:<8}", "*") };
+                for f in chunk {
+                    out += &format!("{f:<16}");
+                }
+                out += "\n";
+            }
+        }
+    }
+    out
+}
+
+/// Decks that read alone, on Nastran flow meshes generated here with several PIDs (stripes
+/// across the part), each with its own property layout: PSHELL on a MAT1, PCOMP (a blank MID
+/// taking the ply above's) on a MAT8, PCOMPG on a MAT8 and the first stripe's MAT1, the last
+/// stripe without a card; small, large or free fields; metres or millimetres. Two plies draped
+/// on the plate, one short of the part's end, one over half of it. pyNastran cross-references
+/// every Nastran deck alone and the OptiStruct deck (taught PCOMPP): every element keeps its PID
+/// (OptiStruct: a PCOMPP where a ply covers it, else its card, a fresh PID beside a PCOMPP), the
+/// user's cards read as written, drape's PSHELL and MAT8 carry the card's fabric in the mesh's
+/// units.
+#[test]
+fn decks_read_alone_on_generated_nastran_meshes_with_several_pids() {
+    use drape::geometry::shapes;
+    use drape::kinematic::{drape, KinematicSettings};
+    use drape::mapping::{map_plies, Cavity, PlyToMap};
+    use drape::material::MaterialCard;
+    if !python_ready() {
+        return;
+    }
+    let card =
+        MaterialCard::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml")).unwrap();
+    let tool = shapes::plate(0.4, 0.3, 8, 6).into_surface().unwrap();
+    let ply = |name: &str, x0: f64, nu: usize| {
+        let s = KinematicSettings::grid(name, Point::new(x0, 0.0, 0.0), Vector::new(1.0, 0.2, 0.0), 0.01, nu, 31);
+        drape(&tool, &s).unwrap()
+    };
+    // Seeds at the grid's middle node: a covers x < 0.12 m, b x < 0.0 m.
+    let nets = [ply("a", -0.04, 33), ply("b", -0.1, 21)];
+    for (stripes, layout, scale, nx, ny) in
+        [(3, Layout::Small, 1.0, 12, 5), (5, Layout::Large, 1e-3, 15, 4), (4, Layout::Free, 1e-3, 16, 6)]
+    {
+        let what = format!("{stripes} PIDs, {layout:?} fields, {scale} m a unit");
+        let unit = |metres: f64| metres / scale;
+        // Three significant digits, as short as a small field needs ("2.00E5").
+        let real = |x: f64| format!("{x:.2e}").replace('e', "E");
+        let short = |x: f64| drape_short(x);
+        let mut text = String::from("$ generated flow mesh\nBEGIN BULK\n");
+        let node = |i: usize, j: usize| (1000 + 100 * i + j) as u64;
+        for i in 0..=nx {
+            for j in 0..=ny {
+                let (x, y) = (-0.2 + 0.4 * i as f64 / nx as f64, -0.15 + 0.3 * j as f64 / ny as f64);
+                let f = vec![node(i, j).to_string(), String::new(), short(unit(x)), short(unit(y)), short(0.0)];
+                text += &nastran_card(layout, "GRID", &f);
+            }
+        }
+        let pid_of = |i: usize| 10 * (1 + i * stripes / nx) as u64;
+        let mut expected_pid = std::collections::BTreeMap::new();
+        let mut eid = 500;
+        for i in 0..nx {
+            for j in 0..ny {
+                let p = pid_of(i).to_string();
+                let (a, b, c, d) = (node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1));
+                if (i + j) % 3 == 0 {
+                    for tri in [[a, b, c], [a, c, d]] {
+                        eid += 1;
+                        let mut f = vec![eid.to_string(), p.clone()];
+                        f.extend(tri.iter().map(u64::to_string));
+                        text += &nastran_card(layout, "CTRIA3", &f);
+                        expected_pid.insert(eid, pid_of(i));
+                    }
+                } else {
+                    eid += 1;
+                    let mut f = vec![eid.to_string(), p.clone()];
+                    f.extend([a, b, c, d].iter().map(u64::to_string));
+                    text += &nastran_card(layout, "CQUAD4", &f);
+                    expected_pid.insert(eid, pid_of(i));
+                }
+            }
+        }
+        // Cards: stripe k's MID is 7 + k (so drape's first MID is 7 + stripes - 1).
+        let t_user = |k: usize| unit(0.001 * (1.0 + k as f64));
+        let (e_steel, rho) = (2.0e11 * scale * scale, 7800.0 * scale.powi(4));
+        let mut user = std::collections::BTreeMap::new(); // PID -> (type, t, mids)
+        for k in 0..stripes - 1 {
+            let (pid, mid) = (10 * (k + 1) as u64, 7 + k as u64);
+            let mut f: Vec<String> = vec![pid.to_string()];
+            let b = String::new;
+            match k % 3 {
+                0 => {
+                    f.extend([mid.to_string(), short(t_user(k)), mid.to_string()]);
+                    text += &nastran_card(layout, "PSHELL", &f);
+                    text +=
+                        &nastran_card(layout, "MAT1", &[mid.to_string(), real(e_steel), b(), ".3".into(), real(rho)]);
+                    user.insert(pid, ("PSHELL", vec![t_user(k)], vec![mid, mid]));
+                }
+                1 => {
+                    f.extend((0..7).map(|_| b()));
+                    f.extend([
+                        mid.to_string(),
+                        short(t_user(k) / 2.0),
+                        "0.".into(),
+                        b(),
+                        b(),
+                        short(t_user(k) / 2.0),
+                        "90.".into(),
+                    ]);
+                    text += &nastran_card(layout, "PCOMP", &f);
+                    user.insert(pid, ("PCOMP", vec![t_user(k) / 2.0; 2], vec![mid, mid]));
+                }
+                _ => {
+                    f.extend((0..7).map(|_| b()));
+                    f.extend(["1".into(), mid.to_string(), short(t_user(k) / 2.0), "45.".into(), b(), b(), b(), b()]);
+                    f.extend(["2".into(), "7".into(), short(t_user(k) / 2.0), "-45.".into()]);
+                    text += &nastran_card(layout, "PCOMPG", &f);
+                    user.insert(pid, ("PCOMPG", vec![t_user(k) / 2.0; 2], vec![mid, 7]));
+                }
+            }
+            if k % 3 != 0 {
+                let f = [
+                    mid.to_string(),
+                    real(1.4e11 * scale * scale),
+                    real(1.0e10 * scale * scale),
+                    ".3".into(),
+                    real(5e9 * scale * scale),
+                ];
+                text += &nastran_card(layout, "MAT8", &f);
+            }
+        }
+        if stripes > 3 {
+            // Stripe 1's PCOMP is on MAT8 8; its temperature dependence is not carried.
+            text += "MATT8,8,1\n";
+        }
+        text += "ENDDATA\n";
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("part.bdf");
+        std::fs::write(&path, &text).unwrap();
+        let mesh = drape::io::read_flow_mesh(&path, scale).unwrap_or_else(|e| panic!("{what}: {e}\n{text}"));
+        assert_eq!(mesh.cards.properties.len(), stripes - 1, "{what}");
+        let plies: Vec<PlyToMap> =
+            nets.iter().map(|net| PlyToMap { net, card: Some(&card), thickness: None, permeability: None }).collect();
+        let map = map_plies(&mesh, &plies, Cavity::Fixed, true, &mut |_| {}).unwrap();
+        let covered = |e: usize| map.plies.iter().any(|p| p.elements[e].is_some());
+        assert!((0..mesh.elements.len()).any(|e| !covered(e)), "{what}: some element no ply covers");
+        let t0 = card.thickness;
+        let moduli = PlyFabric::new(&card, t0).moduli();
+        let close = |v: &Value, want: f64| (v.as_f64().unwrap() - want).abs() <= 1e-9 * want.abs();
+        let drape_mid = 7 + stripes as u64 - 1;
+        let last = 10 * stripes as u64;
+
+        let decks = write(&mesh, &map, FlowFormat::Nastran, &dir.path().join("flow.bdf"));
+        assert_eq!(decks.len(), 2);
+        for (k, deck) in decks.iter().enumerate() {
+            let x = readback("nastran-xref", std::slice::from_ref(deck));
+            assert_eq!(x["rejected"], serde_json::json!([]), "{what}");
+            for (e, el) in mesh.elements.iter().enumerate() {
+                let r = &x["elements"][&el.id.to_string()];
+                assert_eq!(r["pid"].as_u64(), Some(expected_pid[&el.id]), "{what}: element {}", el.id);
+                match &map.plies[k].elements[e] {
+                    Some(f) => {
+                        assert!((r["theta"].as_f64().unwrap() - f.theta.to_degrees()).abs() < LARGE_FIELD_DEG_TOL)
+                    }
+                    None => assert!(r["theta"].is_null() || r["theta"].as_f64() == Some(0.0), "{what}: {r}"),
+                }
+            }
+            for (pid, (kind, ts, mids)) in &user {
+                let p = &x["properties"][&pid.to_string()];
+                assert_eq!(p["type"].as_str(), Some(*kind), "{what}: PID {pid}");
+                let t: Vec<f64> =
+                    if *kind == "PSHELL" { vec![p["t"].as_f64().unwrap()] } else { f64s(&p["thicknesses"]) };
+                assert!(t.iter().zip(ts).all(|(a, b)| (a - b).abs() <= 1e-6 * b), "{what}: PID {pid} thickness {t:?}");
+                assert_eq!(p["mids"], serde_json::json!(mids), "{what}: PID {pid}");
+            }
+            assert!(close(&x["materials"]["7"]["e"], e_steel), "{what}");
+            let p = &x["properties"][&last.to_string()];
+            assert_eq!(
+                (p["type"].as_str(), p["mids"].clone()),
+                (Some("PSHELL"), serde_json::json!([drape_mid])),
+                "{what}"
+            );
+            assert!(close(&p["t"], t0 / scale), "{what}: {p}");
+            let m = &x["materials"][&drape_mid.to_string()];
+            assert!(
+                close(&m["e1"], moduli.e1 * scale * scale) && close(&m["e2"], moduli.e2 * scale * scale),
+                "{what}: {m}"
+            );
+            assert!(
+                close(&m["g12"], moduli.g12 * scale * scale) && close(&m["rho"], moduli.density * scale.powi(4)),
+                "{what}: {m}"
+            );
+        }
+
+        let files = write(&mesh, &map, FlowFormat::OptiStruct, &dir.path().join("flow.fem"));
+        let x = readback("optistruct-xref", &files);
+        assert_eq!(x["dangling"], serde_json::json!([]), "{what}");
+        let mut fresh = std::collections::BTreeMap::new();
+        for (e, el) in mesh.elements.iter().enumerate() {
+            let r = &x["elements"][&el.id.to_string()];
+            let (pid, property) = (r["pid"].as_u64().unwrap(), r["property"].as_str().unwrap());
+            let own = expected_pid[&el.id];
+            if covered(e) {
+                assert_eq!((pid, property), (own, "PCOMPP"), "{what}: element {}", el.id);
+                continue;
+            }
+            let beside = (0..mesh.elements.len()).any(|f| covered(f) && expected_pid[&mesh.elements[f].id] == own);
+            if beside {
+                assert!(pid > last, "{what}: element {} keeps PID {pid} beside a PCOMPP", el.id);
+                assert_eq!(*fresh.entry(own).or_insert(pid), pid, "{what}: one fresh PID a PID");
+            } else {
+                assert_eq!(pid, own, "{what}: element {}", el.id);
+            }
+            let want = user.get(&own).map_or("PSHELL", |u| u.0);
+            assert_eq!(property, want, "{what}: element {}", el.id);
+        }
+        assert!(!fresh.is_empty(), "{what}: a PID with elements on both sides of the plies' edge");
+        assert_eq!(x["stacks"]["1"]["plies"], serde_json::json!([1, 2]), "{what}");
+        for k in ["1", "2"] {
+            let p = &x["plies"][k];
+            assert!(close(&p["t"], t0 / scale), "{what}: PLY {k} {p}");
+            assert!(close(&p["material"]["e1"], moduli.e1 * scale * scale), "{what}: PLY {k} {p}");
+        }
+        let text = std::fs::read_to_string(&files[0]).unwrap();
+        assert_eq!(comments(&text).contains("not carried from the flow mesh: MATT8 8"), stripes > 3, "{what}");
+    }
+}
+
+/// `x` in at most 8 characters (a Nastran small field), as a pre-processor writes it.
+fn drape_short(x: f64) -> String {
+    if x == 0.0 {
+        return "0.".into();
+    }
+    for p in (0..=6).rev() {
+        let s = format!("{x:.p$}");
+        let s = if s.contains('.') { s } else { format!("{s}.") };
+        if s.len() <= 8 {
+            return s;
+        }
+    }
+    panic!("{x} does not fit 8 characters")
+}
+
+/// The comment lines of a deck as one text (lines broken at blanks joined again).
+fn comments(deck: &str) -> String {
+    let words: Vec<&str> = deck.lines().filter_map(|l| l.strip_prefix('$')).flat_map(str::split_whitespace).collect();
+    words.join(" ")
 }

@@ -472,3 +472,49 @@ fn large_nastran_deck_reads_whole() {
     );
     assert!((m.nodes[m.nodes.len() - 1].x - n as f64 * 0.01).abs() < 1e-12);
 }
+
+/// The shells' property and material cards are kept as read, in every layout, for the Nastran
+/// and OptiStruct writers to carry through: a free-field real too long for a large field is
+/// rewritten in 15 characters (11 significant digits or more), other MAT cards and cards with a
+/// non-numeric id are named as not carried, and an id defined twice is refused (as Nastran
+/// refuses it). The fixtures' PSHELL and MAT1 are there, in each layout.
+#[test]
+fn nastran_property_and_material_cards_are_kept_as_read() {
+    let m = read("plate_small.bdf");
+    let p = m.cards.property(1).unwrap();
+    assert_eq!((p.name.as_str(), p.fields.as_slice()), ("PSHELL", ["1", "1", "2.-3"].map(String::from).as_slice()));
+    let mat = m.cards.material(1).unwrap();
+    assert_eq!(
+        (mat.name.as_str(), mat.fields.as_slice()),
+        ("MAT1", ["1", "70.+9", "", ".33"].map(String::from).as_slice())
+    );
+    assert!(mat.origin.ends_with("plate_small.bdf line 8"), "{}", mat.origin);
+    // Large fixed fields, continued by a blank first field (the ply's line in small fields).
+    let m = read("plate_quirks.bdf");
+    let p = m.cards.property(2).unwrap();
+    let mut want = vec!["2".to_string()];
+    want.extend(std::iter::repeat_n(String::new(), 7));
+    want.extend(["1", "1.-4", "45.", "YES"].map(String::from));
+    assert_eq!((p.name.as_str(), &p.fields), ("PCOMP", &want));
+    assert!(m.cards.materials.is_empty());
+    let tri = "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,0.,1.,0.\nCTRIA3,1,7,1,2,3\n";
+    let (_d, m) = read_text(
+        "cards.bdf",
+        &format!(
+            "{tri}PSHELL,7,70,0.0012345678901234567,70\nMAT8,70,1.4e11,1.0e10,.3,5.+9\nMATT8,70,3\nPSHELL,STEEL,1,.1\n"
+        ),
+    );
+    let m = m.unwrap();
+    let p = m.cards.property(7).unwrap();
+    assert!(p.fields[2].len() <= 15, "{:?}", p.fields);
+    let t = drape::io::nastran::parse_real(&p.fields[2]).unwrap();
+    // 15 characters keep 11 significant digits or more.
+    assert!((t - 0.0012345678901234567).abs() < 1e-11 * t, "{t}");
+    assert_eq!(m.cards.material(70).unwrap().fields, ["70", "1.4e11", "1.0e10", ".3", "5.+9"]);
+    assert_eq!(m.cards.not_carried.len(), 2, "{:?}", m.cards.not_carried);
+    assert!(m.cards.not_carried[0].starts_with("MATT8 70 (") && m.cards.not_carried[1].contains("id is not a number"));
+    let e = err_text("twice.bdf", &format!("{tri}MAT1,5,7.+10,,.3\nPSHELL,7,5,.1\nMAT1,5,2.+11,,.3\n"));
+    assert!(e.contains("line 7") && e.contains("material id 5 is defined twice") && e.contains("line 5"), "{e}");
+    // Other formats have no such cards.
+    assert!(read("plate.inp").cards == Default::default() && read("plate.obj").cards == Default::default());
+}

@@ -9,12 +9,22 @@
 //! `DRAPE_FUZZ_CASES=n` for a longer run (`DRAPE_FUZZ_SEED` changes the seed). A mutant that
 //! panicked is kept under the test target's tmp folder (`fuzz-failures/`) to reproduce it.
 //!
-//! The pipeline is checked too: a few mutated scenes run by `drape run` end with exit code 0, 1
-//! or 2 and never a panic (101).
+//! Flow meshes that read are mapped onto a net and exported in every flow format (the path of
+//! `drape export`), so a mutant that reads but breaks the mapping or a writer is caught too;
+//! an export may refuse a mutant with an error, never with a panic or an error that calls itself
+//! a bug. The `fuzz_element_nodes_*` runs mutate node ids inside elements (a number of a line
+//! copied over another of the same line: repeated nodes, swapped corners) of the Nastran,
+//! Abaqus, Gmsh and OBJ meshes.
+//!
+//! The pipeline is checked too: a few mutated scenes with a flow export run by `drape run` end
+//! with exit code 0, 1 or 2 and never a panic (101), and a run that ends with 2 ("bad input,
+//! nothing written") wrote nothing.
 use assert_cmd::Command;
 use drape::geometry::Point;
+use drape::io::flow::{write_flow, FlowFormat};
 use drape::io::{read_flow_mesh, read_net, read_tool, write_json};
 use drape::kinematic::{DrapeNet, NodeStatus};
+use drape::mapping::{map_plies, Cavity, PermeabilityModel, PlyToMap};
 use drape::material::MaterialCard;
 use drape::pipeline::Scene;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -165,8 +175,49 @@ fn mutate(rng: &mut Rng, input: &[u8]) -> (Vec<u8>, String) {
     (b, what.join(", "))
 }
 
-/// A reader under test: reads the file at the path, Ok or a message.
-type Read = fn(&Path) -> Result<(), String>;
+/// Byte ranges of the integers (digits only, not part of a real) in `b`.
+fn integers(b: &[u8]) -> Vec<(usize, usize)> {
+    numbers(b).into_iter().filter(|&(s, e)| b[s..e].iter().all(u8::is_ascii_digit)).collect()
+}
+
+/// One or two node ids inside elements changed: on a line with three or more integers (an
+/// element's id and corners in every format here), one integer copied over another, padded with
+/// blanks on the left to its width so fixed columns stay in place. Gives repeated nodes, swapped
+/// or unknown corners.
+fn mutate_ids(rng: &mut Rng, input: &[u8]) -> (Vec<u8>, String) {
+    let mut b = input.to_vec();
+    let mut what = Vec::new();
+    for _ in 0..1 + rng.below(2) {
+        let candidates: Vec<(usize, usize)> =
+            lines(&b).into_iter().filter(|&(s, e)| integers(&b[s..e]).len() >= 3).collect();
+        if candidates.is_empty() {
+            break;
+        }
+        let (s, e) = candidates[rng.below(candidates.len())];
+        let ints: Vec<(usize, usize)> = integers(&b[s..e]).into_iter().map(|(a, z)| (s + a, s + z)).collect();
+        let (from, to) = (ints[rng.below(ints.len())], ints[rng.below(ints.len())]);
+        let mut text = b[from.0..from.1].to_vec();
+        while text.len() < to.1 - to.0 {
+            text.insert(0, b' ');
+        }
+        what.push(format!(
+            "integer at byte {} ({}) copied over the one at byte {} ({})",
+            from.0,
+            String::from_utf8_lossy(&b[from.0..from.1]),
+            to.0,
+            String::from_utf8_lossy(&b[to.0..to.1])
+        ));
+        b.splice(to.0..to.1, text);
+    }
+    (b, what.join(", "))
+}
+
+/// A reader under test: reads the file at the path (a mutant of input number `usize`), Ok or a
+/// message.
+type Read<'a> = &'a dyn Fn(&Path, usize) -> Result<(), String>;
+
+/// How a case's input is mutated.
+type Mutate = fn(&mut Rng, &[u8]) -> (Vec<u8>, String);
 
 /// The generator of `reader`'s mutants.
 fn reader_rng(reader: &str, seed: u64) -> Rng {
@@ -190,7 +241,15 @@ struct Running {
 
 /// Read `cases` mutants of each input with `read`, writing each to `file` first. Returns the
 /// number of cases tried; panics (after all cases) if any reader panicked.
-fn fuzz(reader: &str, inputs: &[(String, Vec<u8>)], file: &Path, read: Read, cases: usize, seed: u64) -> usize {
+fn fuzz(
+    reader: &str,
+    inputs: &[(String, Vec<u8>)],
+    file: &Path,
+    read: Read,
+    mutator: Mutate,
+    cases: usize,
+    seed: u64,
+) -> usize {
     let running = Arc::new(Running { case: AtomicU64::new(u64::MAX), what: Mutex::new(String::new()) });
     let done = Arc::new(AtomicU64::new(0));
     let watchdog = {
@@ -213,12 +272,12 @@ fn fuzz(reader: &str, inputs: &[(String, Vec<u8>)], file: &Path, read: Read, cas
     let mut failures = Vec::new();
     for case in 0..cases {
         let (name, input) = &inputs[case % inputs.len()];
-        let (bytes, what) = mutate(&mut rng, input);
+        let (bytes, what) = mutator(&mut rng, input);
         let what = format!("{reader} case {case}, {name}: {what}");
         std::fs::write(file, &bytes).unwrap();
         *running.what.lock().unwrap() = what.clone();
         running.case.store(case as u64, Ordering::Relaxed);
-        if let Err(p) = catch_unwind(AssertUnwindSafe(|| read(file))) {
+        if let Err(p) = catch_unwind(AssertUnwindSafe(|| read(file, case % inputs.len()))) {
             let msg = p
                 .downcast_ref::<String>()
                 .cloned()
@@ -257,20 +316,168 @@ fn shell_mesh(path: &Path) -> Result<(), String> {
     flow.and(tool)
 }
 
+/// The export path of the mesh mutants: per input, a flat net over the input's own mesh (as
+/// read before mutation), a material card and a folder to write into.
+struct Export {
+    nets: Vec<DrapeNet>,
+    card: MaterialCard,
+    dir: tempfile::TempDir,
+    /// Mutants read as flow meshes, mapped (some element covered), and written in every format.
+    counts: [AtomicU64; 3],
+}
+
+/// Nodes of the export nets along each side.
+const EXPORT_NET_NODES: usize = 24;
+
+impl Export {
+    fn new(inputs: &[(String, Vec<u8>)], ext: &str) -> Export {
+        let dir = tempfile::tempdir().unwrap();
+        let nets: Vec<Option<DrapeNet>> = inputs
+            .iter()
+            .map(|(name, bytes)| {
+                // The bundled file where there is one (its INCLUDEs beside it), else the bytes.
+                let mut p = root().join(name);
+                if !p.is_file() {
+                    p = dir.path().join(format!("input.{ext}"));
+                    std::fs::write(&p, bytes).unwrap();
+                }
+                // A file that is not a mesh alone (grids to INCLUDE) takes another input's net.
+                let mesh = read_flow_mesh(&p, 1.0).ok()?;
+                let (lo, hi) =
+                    mesh.nodes.iter().fold((mesh.nodes[0], mesh.nodes[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+                // A plane at the median height of the nodes, a little wider than the mesh's box.
+                let mut z: Vec<f64> = mesh.nodes.iter().map(|p| p.z).collect();
+                z.sort_by(f64::total_cmp);
+                let size = (hi.x - lo.x).max(hi.y - lo.y);
+                let spacing = 1.2 * size / (EXPORT_NET_NODES - 1) as f64;
+                let n = EXPORT_NET_NODES;
+                let mut net = DrapeNet::new("fuzz", spacing, n, n, (n / 2, n / 2));
+                let (cx, cy, cz) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), z[z.len() / 2]);
+                for i in 0..n {
+                    for j in 0..n {
+                        let k = net.index(i, j);
+                        let (u, v) = ((i as f64 - (n / 2) as f64) * spacing, (j as f64 - (n / 2) as f64) * spacing);
+                        net.positions[k] = Point::new(cx + u, cy + v, cz);
+                        net.status[k] = NodeStatus::Placed;
+                        net.triangles[k] = 0;
+                    }
+                }
+                net.meta.warp_direction = Some([1.0, 0.0, 0.0]);
+                Some(net)
+            })
+            .collect();
+        let any = nets.iter().flatten().next().expect("an input reads as a flow mesh").clone();
+        let nets = nets.into_iter().map(|n| n.unwrap_or_else(|| any.clone())).collect();
+        let card = MaterialCard::load(&root().join("materials/glass-plain-weave.toml")).unwrap();
+        Export { nets, card, dir, counts: Default::default() }
+    }
+
+    /// Read `path` as a shell mesh; if it reads as a flow mesh, map input `input`'s net onto it
+    /// and write every flow format. Errors are fine; an error that calls itself a bug is not.
+    fn check(&self, path: &Path, input: usize) -> Result<(), String> {
+        let read = shell_mesh(path);
+        let Ok(mesh) = read_flow_mesh(path, 1.0) else { return read };
+        self.counts[0].fetch_add(1, Ordering::Relaxed);
+        let net = &self.nets[input];
+        let ply = PlyToMap {
+            net,
+            card: Some(&self.card),
+            thickness: Some(net.spacing / 20.0),
+            permeability: Some(PermeabilityModel { fibre_radius: 8e-6 }),
+        };
+        let map = match map_plies(&mesh, &[ply], Cavity::Fixed, false, &mut |_| {}) {
+            Ok(map) => map,
+            Err(e) => return Err(e.to_string()),
+        };
+        self.counts[1].fetch_add(1, Ordering::Relaxed);
+        let mut all = true;
+        for format in FlowFormat::ALL {
+            let out = self.dir.path().join(format!("flow-{}.out", format.name()));
+            if let Err(e) = write_flow(&mesh, &map, format, &out) {
+                let e = e.to_string();
+                assert!(!e.contains("bug"), "{} export: {e}", format.name());
+                all = false;
+            }
+        }
+        if all {
+            self.counts[2].fetch_add(1, Ordering::Relaxed);
+        }
+        read
+    }
+}
+
 fn fuzz_files(reader: &str, ext: &str, inputs: &[(String, Vec<u8>)], read: Read) {
+    fuzz_files_with(reader, ext, inputs, read, mutate);
+}
+
+fn fuzz_files_with(reader: &str, ext: &str, inputs: &[(String, Vec<u8>)], read: Read, mutator: Mutate) {
     let dir = tempfile::tempdir().unwrap();
-    let n = fuzz(reader, inputs, &dir.path().join(format!("case.{ext}")), read, cases(), seed());
+    let n = fuzz(reader, inputs, &dir.path().join(format!("case.{ext}")), read, mutator, cases(), seed());
     eprintln!("fuzz {reader}: {n} mutants, no panic");
+}
+
+/// The mutants of a shell-mesh format, read, mapped and exported.
+fn fuzz_meshes(reader: &str, ext: &str, inputs: &[(String, Vec<u8>)], mutator: Mutate) {
+    let export = Export::new(inputs, ext);
+    fuzz_files_with(reader, ext, inputs, &|p, k| export.check(p, k), mutator);
+    let [read, mapped, written] = export.counts.map(|c| c.into_inner());
+    eprintln!("fuzz {reader}: {read} read as flow meshes, {mapped} mapped, {written} written in every format");
+}
+
+fn nastran_inputs() -> Vec<(String, Vec<u8>)> {
+    load(&[
+        "tests/data/flowmesh/plate_free.bdf",
+        "tests/data/flowmesh/plate_large.bdf",
+        "tests/data/flowmesh/plate_quirks.bdf",
+        "tests/data/flowmesh/plate_quirks_grids.bdf",
+        "tests/data/flowmesh/plate_small.bdf",
+    ])
+}
+
+fn abaqus_inputs() -> Vec<(String, Vec<u8>)> {
+    load(&[
+        "tests/data/flowmesh/plate.inp",
+        "tests/data/flowmesh/plate_parts.inp",
+        "tests/data/flowmesh/plate_parts_nodes.inp",
+    ])
+}
+
+fn gmsh_inputs() -> Vec<(String, Vec<u8>)> {
+    load(&["tests/data/flowmesh/plate.msh", "tests/data/flowmesh/plate_bin.msh"])
+}
+
+fn obj_inputs() -> Vec<(String, Vec<u8>)> {
+    load(&[
+        "tests/data/flowmesh/plate.obj",
+        "tests/data/flowmesh/pentagon.obj",
+        "geometries/square-table/square-table.obj",
+    ])
+}
+
+#[test]
+fn fuzz_element_nodes_nastran() {
+    fuzz_meshes("nastran-nodes", "bdf", &nastran_inputs(), mutate_ids);
+}
+
+#[test]
+fn fuzz_element_nodes_abaqus() {
+    fuzz_meshes("abaqus-nodes", "inp", &abaqus_inputs(), mutate_ids);
+}
+
+#[test]
+fn fuzz_element_nodes_gmsh() {
+    // The ASCII file only: ids inside the binary one are not text.
+    fuzz_meshes("gmsh-nodes", "msh", &gmsh_inputs()[..1], mutate_ids);
+}
+
+#[test]
+fn fuzz_element_nodes_obj() {
+    fuzz_meshes("obj-nodes", "obj", &obj_inputs(), mutate_ids);
 }
 
 #[test]
 fn fuzz_obj() {
-    let inputs = load(&[
-        "tests/data/flowmesh/plate.obj",
-        "tests/data/flowmesh/pentagon.obj",
-        "geometries/square-table/square-table.obj",
-    ]);
-    fuzz_files("obj", "obj", &inputs, shell_mesh);
+    fuzz_meshes("obj", "obj", &obj_inputs(), mutate);
 }
 
 fn stl_inputs() -> Vec<(String, Vec<u8>)> {
@@ -285,42 +492,29 @@ fn stl_inputs() -> Vec<(String, Vec<u8>)> {
 
 #[test]
 fn fuzz_stl() {
-    fuzz_files("stl", "stl", &stl_inputs(), shell_mesh);
+    fuzz_meshes("stl", "stl", &stl_inputs(), mutate);
 }
 
 #[test]
 fn fuzz_nastran() {
-    let inputs = load(&[
-        "tests/data/flowmesh/plate_free.bdf",
-        "tests/data/flowmesh/plate_large.bdf",
-        "tests/data/flowmesh/plate_quirks.bdf",
-        "tests/data/flowmesh/plate_quirks_grids.bdf",
-        "tests/data/flowmesh/plate_small.bdf",
-    ]);
-    fuzz_files("nastran", "bdf", &inputs, shell_mesh);
+    fuzz_meshes("nastran", "bdf", &nastran_inputs(), mutate);
 }
 
 #[test]
 fn fuzz_abaqus() {
-    let inputs = load(&[
-        "tests/data/flowmesh/plate.inp",
-        "tests/data/flowmesh/plate_parts.inp",
-        "tests/data/flowmesh/plate_parts_nodes.inp",
-    ]);
-    fuzz_files("abaqus", "inp", &inputs, shell_mesh);
+    fuzz_meshes("abaqus", "inp", &abaqus_inputs(), mutate);
 }
 
 #[test]
 fn fuzz_gmsh() {
-    let inputs = load(&["tests/data/flowmesh/plate.msh", "tests/data/flowmesh/plate_bin.msh"]);
-    fuzz_files("gmsh", "msh", &inputs, shell_mesh);
+    fuzz_meshes("gmsh", "msh", &gmsh_inputs(), mutate);
 }
 
 #[test]
 fn fuzz_material_card() {
     let inputs =
         load(&["materials/glass-plain-weave.toml", "materials/carbon-twill.toml", "materials/sze-liu-table1.toml"]);
-    fuzz_files("card", "toml", &inputs, |p| MaterialCard::load(p).map(drop).map_err(|e| e.to_string()));
+    fuzz_files("card", "toml", &inputs, &|p, _| MaterialCard::load(p).map(drop).map_err(|e| e.to_string()));
 }
 
 /// A 7 x 6 net on a tilted plane, two nodes not placed.
@@ -347,7 +541,7 @@ fn small_net_json(dir: &Path) -> Vec<u8> {
 fn fuzz_net_json() {
     let dir = tempfile::tempdir().unwrap();
     let inputs = vec![("a 7 x 6 net".to_string(), small_net_json(dir.path()))];
-    fuzz_files("net", "json", &inputs, |p| read_net(p).map(drop).map_err(|e| e.to_string()));
+    fuzz_files("net", "json", &inputs, &|p, _| read_net(p).map(drop).map_err(|e| e.to_string()));
 }
 
 /// The bundled scenes, read from a copy of `geometries/<dir>/` beside a copy of `materials/`, so
@@ -379,15 +573,17 @@ fn fuzz_scene() {
         "scene",
         &inputs,
         &scene_dir.join("scene.toml"),
-        |p| Scene::load(p).map(drop).map_err(|e| e.to_string()),
+        &|p, _| Scene::load(p).map(drop).map_err(|e| e.to_string()),
+        mutate,
         cases(),
         seed(),
     );
     eprintln!("fuzz scene: {n} mutants, no panic");
 }
 
-/// A one-ply scene on a 10 x 10 plate, mutated, run end to end by `drape run`: exit 0, 1 or 2,
-/// never a panic; a run that fails leaves no ply file half written.
+/// A two-ply scene on a 10 x 10 plate with a flow export onto the plate in every format,
+/// mutated, run end to end by `drape run`: exit 0, 1 or 2, never a panic; a run that fails leaves
+/// no file half written, and one that ends with 2 (bad input) wrote nothing at all.
 #[test]
 fn fuzz_scene_through_the_pipeline() {
     let dir = tempfile::tempdir().unwrap();
@@ -407,6 +603,7 @@ fn fuzz_scene_through_the_pipeline() {
     let card = root().join("materials/glass-plain-weave.toml");
     let scene = format!(
         "units = \"m\"\ntool = \"plate.obj\"\nreference = [1.0, 0.0, 0.0]\nroll_width = 1.0\n\n[materials]\nglass = {card:?}\n\n\
+         [export]\nmesh = \"plate.obj\"\nformats = [\"vtu\", \"nastran\", \"abaqus\", \"calculix\", \"optistruct\", \"rtmsim\", \"csv\"]\npermeability = true\n\n\
          [[ply]]\nname = \"p0\"\norigin = [0.0, 0.0, 0.0]\nangle_deg = 30.0\nmaterial = \"glass\"\nspacing = 0.05\ngrid = [11, 11]\n\n\
          [[ply]]\nname = \"p1\"\norigin = [0.1, 0.0, 0.0]\nangle_deg = -45.0\nmaterial = \"glass\"\nspacing = 0.04\ngrid = [9, 9]\n"
     );
@@ -437,6 +634,14 @@ fn fuzz_scene_through_the_pipeline() {
             what.join(", ")
         );
         codes[code.unwrap() as usize] += 1;
+        if code == Some(2) && out.exists() {
+            let files: Vec<_> = std::fs::read_dir(&out).unwrap().map(|f| f.unwrap().file_name()).collect();
+            assert!(
+                files.is_empty(),
+                "case {case} ({}): exit 2 (nothing written) but wrote {files:?}\n{err}",
+                what.join(", ")
+            );
+        }
         if code != Some(0) && out.exists() {
             // Nothing half written: every file there is whole (the atomic writer leaves no temporaries).
             for f in std::fs::read_dir(&out).unwrap() {

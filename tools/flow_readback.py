@@ -9,9 +9,17 @@ Usage: python3 tools/flow_readback.py FORMAT FILE [FILE...]
                       grids, elements with PID and THETA;
                       meshio on the same deck: its GRID points (meshio skips elements that carry
                       a THETA field, so only the points are compared)
-  nastran-xref FILE   pyNastran read_bdf(FILE, xref=True), as a solver reads a whole deck (the
-                      user's, which INCLUDEs drape's bulk data): elements with PID, the type of
-                      the property and material they cross-reference, THETA
+  nastran-xref FILE   pyNastran read_bdf(FILE, xref=True), as a solver reads a deck: drape's
+                      bulk data alone (punch=True) or a whole deck that INCLUDEs it: elements with
+                      PID, the type of the property and material they cross-reference, THETA;
+                      every property (type, thickness, material ids) and material (type and
+                      constants) pyNastran cross-referenced
+  optistruct-xref FILE  pyNastran read_bdf(FILE, xref=True) taught OptiStruct's PCOMPP (a property
+                      that refers to no card, per the OptiStruct Reference Guide) for the parts
+                      pyNastran knows (elements, PCOMPP/PSHELL/PCOMP, MAT8...); our parser for
+                      PLY, STACK, SET and DRAPE and their references (to pyNastran's materials,
+                      the sets, the drapes, the plies); "dangling" lists every reference that
+                      does not resolve
   abaqus FILE         meshio for nodes and elements; our parser of *ELSET, *DISTRIBUTION TABLE,
                       *DISTRIBUTION and *ORIENTATION as the Abaqus Keywords Reference lays them out
   optistruct FILE     our parser of large-field fixed format (GRID*, CTRIA3*, CQUAD4*, SET*,
@@ -163,23 +171,149 @@ def read_nastran(paths):
     return {"decks": decks}
 
 
-def read_nastran_xref(path):
-    from pyNastran.bdf.bdf import BDF
+def material_json(m):
+    """The constants of a material pyNastran read."""
+    out = {"type": m.type}
+    if m.type == "MAT8":
+        out.update(e1=m.e11, e2=m.e22, nu12=m.nu12, g12=m.g12, rho=m.rho)
+    elif m.type == "MAT1":
+        out.update(e=m.e, g=m.g, nu=m.nu, rho=m.rho)
+    return out
 
-    model = BDF(debug=None, log=None, mode="msc")
-    model.read_bdf(path, xref=True)
+
+def property_json(p):
+    """A property pyNastran read and cross-referenced: its type, thickness and materials."""
+    out = {"type": p.type}
+    if p.type == "PSHELL":
+        out.update(t=p.t, mids=[m for m in (p.mid1, p.mid2, p.mid3, p.mid4) if m is not None and m > 0],
+                   materials=[m.type for m in (p.mid1_ref, p.mid2_ref, p.mid3_ref, p.mid4_ref)
+                              if m is not None and not isinstance(m, int)])
+    elif p.type in ("PCOMP", "PCOMPG"):
+        out.update(thicknesses=[float(t) for t in p.thicknesses], mids=[int(m) for m in p.mids],
+                   materials=[m.type for m in p.mids_ref])
+    return out
+
+
+def elements_json(model):
     elements = {}
     for eid, e in model.elements.items():
         theta = e.theta_mcid
         prop = e.pid_ref
-        mats = prop.mid_ref if hasattr(prop, "mid_ref") else prop.mids_ref[0]
+        if prop.type == "PCOMPP":
+            material = None
+        else:
+            material = (prop.mid_ref if hasattr(prop, "mid_ref") else prop.mids_ref[0]).type
         elements[int(eid)] = {
             "pid": int(e.pid),
             "property": prop.type,
-            "material": mats.type,
+            "material": material,
             "theta": float(theta) if isinstance(theta, float) else None,
         }
-    return {"elements": elements, "rejected": len(model.reject_cards)}
+    return elements
+
+
+def read_nastran_xref(path):
+    from pyNastran.bdf.bdf import BDF
+
+    with open(path) as f:
+        whole = any(l.strip().upper() == "BEGIN BULK" for l in f)
+    model = BDF(debug=None, log=None, mode="msc")
+    # drape's deck is bulk data alone (punch=True); a user's deck INCLUDEs it after BEGIN BULK.
+    model.read_bdf(path, xref=True, punch=not whole)
+    return {
+        "elements": elements_json(model),
+        "properties": {int(k): property_json(p) for k, p in model.properties.items()},
+        "materials": {int(k): material_json(m) for k, m in model.materials.items()},
+        "rejected": sorted(model.reject_count),
+    }
+
+
+def optistruct_model():
+    """A pyNastran BDF that reads OptiStruct's PCOMPP (PID Z0 NSM SB FT TREF GE; OptiStruct
+    Reference Guide): a property that refers to no other card."""
+    from pyNastran.bdf.bdf import BDF
+    from pyNastran.bdf.bdf_interface.assign_type import double_or_blank, integer, string_or_blank
+    from pyNastran.bdf.cards.base_card import Property
+
+    class PCOMPP(Property):
+        type = "PCOMPP"
+
+        def __init__(self, pid, comment=""):
+            Property.__init__(self)
+            self.pid = pid
+            self.comment = comment
+
+        @classmethod
+        def add_card(cls, card, comment=""):
+            pid = integer(card, 1, "pid")
+            for k, name in ((2, "z0"), (3, "nsm"), (4, "sb"), (6, "tref"), (7, "ge")):
+                double_or_blank(card, k, name)
+            string_or_blank(card, 5, "ft")
+            return PCOMPP(pid, comment)
+
+        def cross_reference(self, model):
+            pass
+
+        def safe_cross_reference(self, model, xref_errors):
+            pass
+
+        def uncross_reference(self):
+            pass
+
+        def raw_fields(self):
+            return ["PCOMPP", self.pid]
+
+    model = BDF(debug=None, log=None, mode="optistruct")
+    model._card_parser["PCOMPP"] = (PCOMPP, model._add_methods._add_property_object)
+    model.cards_to_read.add("PCOMPP")
+    return model
+
+
+def read_optistruct_xref(path):
+    model = optistruct_model()
+    model.read_bdf(path, xref=True)
+    ours = read_optistruct(path)
+    dangling = []
+    plies = {}
+    for pid_s, ply in ours["plies"].items():
+        m = model.materials.get(ply["mid"])
+        if m is None:
+            dangling.append("PLY %s: MID %d is not a material" % (pid_s, ply["mid"]))
+        if str(ply["did"]) not in ours["drapes"]:
+            dangling.append("PLY %s: DRAPE %d is not defined" % (pid_s, ply["did"]))
+        for esid in ply["esids"]:
+            if str(esid) not in ours["sets"]:
+                dangling.append("PLY %s: SET %d is not defined" % (pid_s, esid))
+        plies[pid_s] = dict(ply, material=material_json(m) if m is not None else None)
+    in_plies = {}
+    for pid_s, ply in ours["plies"].items():
+        for esid in ply["esids"]:
+            for eid in ours["sets"].get(str(esid), []):
+                in_plies.setdefault(eid, []).append(int(pid_s))
+                if eid not in model.elements:
+                    dangling.append("SET %d: element %d is not defined" % (esid, eid))
+    stacked = [p for s in ours["stacks"].values() for p in s["plies"]]
+    for p in stacked:
+        if str(p) not in ours["plies"]:
+            dangling.append("STACK: ply %d is not defined" % p)
+    for pid_s in ours["plies"]:
+        if stacked.count(int(pid_s)) != 1:
+            dangling.append("PLY %s is in %d STACKs (one expected)" % (pid_s, stacked.count(int(pid_s))))
+    for eid, e in model.elements.items():
+        is_pcompp = e.pid_ref.type == "PCOMPP"
+        if is_pcompp and eid not in in_plies:
+            dangling.append("element %d: PCOMPP %d but in no PLY" % (eid, e.pid))
+        if not is_pcompp and eid in in_plies:
+            dangling.append("element %d: in PLY %s but its property is a %s" % (eid, in_plies[eid], e.pid_ref.type))
+    return {
+        "elements": elements_json(model),
+        "properties": {int(k): property_json(p) for k, p in model.properties.items()},
+        "materials": {int(k): material_json(m) for k, m in model.materials.items()},
+        "plies": plies,
+        "stacks": ours["stacks"],
+        "in_plies": {str(k): v for k, v in in_plies.items()},
+        "dangling": dangling,
+    }
 
 
 def read_abaqus(path):
@@ -263,7 +397,7 @@ def read_abaqus(path):
 
 
 def read_optistruct(path):
-    grids, elements, sets, drapes, plies = {}, {}, {}, {}, {}
+    grids, elements, sets, drapes, plies, stacks = {}, {}, {}, {}, {}, {}
     for name, fields in large_entries(path):
         if name == "GRID":
             grids[int(fields[0])] = [nastran_real(x) for x in fields[2:5]]
@@ -298,12 +432,15 @@ def read_optistruct(path):
                 "did": int(fields[6]),
                 "esids": [int(x) for x in fields[8:] if x],
             }
+        elif name == "STACK":
+            stacks[int(fields[0])] = {"lam": fields[1], "plies": [int(x) for x in fields[2:] if x]}
     return {
         "grids": {str(k): v for k, v in grids.items()},
         "elements": {str(k): v for k, v in elements.items()},
         "sets": {str(k): v for k, v in sets.items()},
         "drapes": {str(k): v for k, v in drapes.items()},
         "plies": {str(k): v for k, v in plies.items()},
+        "stacks": {str(k): v for k, v in stacks.items()},
     }
 
 
@@ -394,6 +531,8 @@ def main(argv):
         out = read_abaqus(files[0])
     elif fmt == "optistruct" and len(files) == 1:
         out = read_optistruct(files[0])
+    elif fmt == "optistruct-xref" and len(files) == 1:
+        out = read_optistruct_xref(files[0])
     elif fmt == "rtmsim" and len(files) == 2:
         out = read_rtmsim(files[0], files[1])
     elif fmt == "csv" and len(files) == 1:

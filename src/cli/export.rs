@@ -1,7 +1,7 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
 use super::{input, Failure};
-use crate::io::flow::{write_flow_with, FlowFormat, FlowOptions};
+use crate::io::flow::{check_flow, write_flow_with, FlowFormat, FlowOptions};
 use crate::io::vtk::VtuEncoding;
 use crate::io::{read_flow_mesh, read_net};
 use crate::mapping::{map_plies, PlyMap, PlyToMap};
@@ -39,8 +39,8 @@ pub struct ExportArgs {
     /// Units of the flow mesh: m or mm.
     #[arg(long, default_value = "m")]
     pub mesh_units: String,
-    /// Material card for the ply's thickness, Vf and fibre radius (default: the card the net
-    /// records, if any).
+    /// Material card for the ply's thickness, Vf and fibre radius, and the MAT8 of the Nastran
+    /// and OptiStruct decks (default: the card the net records, if any).
     #[arg(long)]
     pub material: Option<PathBuf>,
     /// Ply thickness as laid flat, m (overrides the card's).
@@ -120,9 +120,11 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     );
     println!("{}", coverage_line(&map.plies[0]));
     println!("  mapped in {map_ms:.1} ms");
-    let written =
-        write_flow_with(&mesh, &map, format, &a.out, &FlowOptions { material_name: a.material_name.clone(), vtu })
-            .map_err(super::write_failure)?;
+    let options = FlowOptions { material_name: a.material_name.clone(), vtu };
+    for n in check_flow(&mesh, &map, format, &a.out, &options).map_err(super::write_failure)? {
+        eprintln!("note: {n}");
+    }
+    let written = write_flow_with(&mesh, &map, format, &a.out, &options).map_err(super::write_failure)?;
     for p in written {
         println!("  wrote {}", p.display());
     }

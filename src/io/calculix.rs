@@ -26,7 +26,7 @@
 //! (`--material-name`, default [`DEFAULT_MATERIAL`]) in the deck that includes this one, and give
 //! the uncovered elements a section of your own. Every number fits CalculiX's 20-character
 //! fields ([`short`]).
-use super::flow::{file_tag, sibling};
+use super::flow::ply_files;
 use super::{write_atomic, ExportError};
 use crate::mapping::{ElementShape, FlowMesh, LayupMap, PlyMap};
 use std::collections::BTreeMap;
@@ -67,22 +67,22 @@ pub(crate) fn write_flow(
     out: &Path,
     material: &str,
 ) -> Result<Vec<PathBuf>, ExportError> {
-    check_material_name(material).map_err(|reason| ExportError::FlowInvalid { format: "calculix", reason })?;
-    let ext = out.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
-    let targets: Vec<(PathBuf, &PlyMap)> = if map.layup {
-        let mut v = Vec::new();
-        for ply in &map.plies {
-            let tag = file_tag("calculix", &ply.ply)?;
-            v.push((sibling(out, &format!("_{tag}{ext}")), ply));
-        }
-        v
-    } else {
-        vec![(out.to_path_buf(), &map.plies[0])]
-    };
+    let targets = check(map, out, material)?;
     for (path, ply) in &targets {
         write_atomic(path, |w| write_deck(mesh, ply, material, w))?;
     }
     Ok(targets.into_iter().map(|(p, _)| p).collect())
+}
+
+/// What [`write_flow`] checks before it writes (the material name, ply names that become file
+/// names): the deck of each ply, or why none can be written.
+pub(crate) fn check<'a>(
+    map: &'a LayupMap,
+    out: &Path,
+    material: &str,
+) -> Result<Vec<(PathBuf, &'a PlyMap)>, ExportError> {
+    check_material_name(material).map_err(|reason| ExportError::FlowInvalid { format: "calculix", reason })?;
+    ply_files("calculix", map, out)
 }
 
 /// The flow mesh as Abaqus/CalculiX input: its nodes (set DRAPE_NODES) and shell elements (S3

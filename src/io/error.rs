@@ -3,12 +3,14 @@ use std::io;
 use std::path::PathBuf;
 
 impl ExportError {
-    /// Whether the user's output path is at fault (a folder that cannot be created, a file
-    /// where a folder should be, no permission to write): bad input, exit code 2.
+    /// Whether the input is at fault: the user's output path (a folder that cannot be created,
+    /// a file where a folder should be, no permission to write), a ply name, or a flow export
+    /// that the mesh, the plies or the options do not allow (nothing written): bad input, exit
+    /// code 2.
     pub fn is_bad_input(&self) -> bool {
         use io::ErrorKind::*;
         match self {
-            ExportError::CreateDir { .. } | ExportError::BadName { .. } => true,
+            ExportError::CreateDir { .. } | ExportError::BadName { .. } | ExportError::FlowInvalid { .. } => true,
             ExportError::Write { source, .. } => {
                 matches!(source.kind(), PermissionDenied | NotADirectory | IsADirectory | ReadOnlyFilesystem | NotFound)
             }

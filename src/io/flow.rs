@@ -14,7 +14,7 @@
 //! values), so a bad map writes nothing; each file is written with [`crate::io::write_atomic`].
 use super::rtmsim::RtmsimRegion;
 use super::{abaqus, calculix, csv, nastran, optistruct, rtmsim, vtk, ExportError};
-use crate::mapping::{ElementFibres, FlowMesh, LayupMap};
+use crate::mapping::{ElementFibres, FlowMesh, LayupMap, PlyMap};
 use std::path::{Path, PathBuf};
 
 /// A format of fibre data on a flow mesh.
@@ -120,7 +120,7 @@ pub fn write_flow_with(
     out: &Path,
     options: &FlowOptions,
 ) -> Result<Vec<PathBuf>, ExportError> {
-    check(mesh, map, format.name())?;
+    check_flow(mesh, map, format, out, options)?;
     match format {
         FlowFormat::Vtu => vtk::write_flow(mesh, map, out, options.vtu).map(|()| vec![out.to_path_buf()]),
         FlowFormat::Nastran => nastran::write_flow(mesh, map, out),
@@ -130,6 +130,30 @@ pub fn write_flow_with(
         FlowFormat::Rtmsim => rtmsim::write_flow(mesh, map, out).map(|r| r.files),
         FlowFormat::Csv => csv::write_flow(mesh, map, out).map(|()| vec![out.to_path_buf()]),
     }
+}
+
+/// Everything [`write_flow_with`] checks before it opens a file, for `format` written to `out`:
+/// the map against the mesh (sizes, finite values) and what the format itself needs (ply names
+/// that become file names, the CalculiX material name, RTMsim's permeability and field widths,
+/// the property and material of every PID of a Nastran or OptiStruct deck).
+/// Returns notes on what the files will carry that the flow mesh or the plies did not give. A
+/// run checks every format of its export with this before it writes any file, so a map that a
+/// format cannot write stops it with nothing written.
+pub fn check_flow(
+    mesh: &FlowMesh,
+    map: &LayupMap,
+    format: FlowFormat,
+    out: &Path,
+    options: &FlowOptions,
+) -> Result<Vec<String>, ExportError> {
+    check(mesh, map, format.name())?;
+    Ok(match format {
+        FlowFormat::Vtu | FlowFormat::Abaqus | FlowFormat::Csv => Vec::new(),
+        FlowFormat::Nastran => nastran::write::check(mesh, map, out)?,
+        FlowFormat::Calculix => calculix::check(map, out, &options.material_name).map(|_| Vec::new())?,
+        FlowFormat::OptiStruct => optistruct::check(mesh, map)?,
+        FlowFormat::Rtmsim => rtmsim::check(mesh, map, out).map(|()| Vec::new())?,
+    })
 }
 
 /// What [`write_rtmsim`] wrote and how it grouped the elements.
@@ -256,6 +280,20 @@ fn check_fibres(f: &ElementFibres, format: &'static str, ply: &str, id: u64) -> 
 pub(crate) fn sibling(out: &Path, suffix: &str) -> PathBuf {
     let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     out.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// The file of each ply for the formats that write one deck a ply: `out` for one net, and for a
+/// layup `STEM_<ply>.<ext>` beside `out`, in stacking order.
+pub(crate) fn ply_files<'a>(
+    format: &'static str,
+    map: &'a LayupMap,
+    out: &Path,
+) -> Result<Vec<(PathBuf, &'a PlyMap)>, ExportError> {
+    if !map.layup {
+        return Ok(vec![(out.to_path_buf(), &map.plies[0])]);
+    }
+    let ext = out.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    map.plies.iter().map(|ply| Ok((sibling(out, &format!("_{}{ext}", file_tag(format, &ply.ply)?)), ply))).collect()
 }
 
 /// A ply name as part of a file name: refused if it could leave the directory.

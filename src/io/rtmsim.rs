@@ -181,7 +181,25 @@ fn distance(a: &RtmsimRegion, b: &RtmsimRegion) -> f64 {
         + a.refdir.dot(&b.refdir).abs().min(1.0).acos().to_degrees() / DIRECTION_BIN_DEG
 }
 
+/// Write the RTMsim mesh and parameter file beside `out` (see the module documentation).
 pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<RtmsimReport, ExportError> {
+    let (report, region_of) = plan(mesh, map, out)?;
+    let mesh_name = report.files[0].file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    write_atomic(&report.files[0], |w| {
+        write_mesh(mesh, &report.regions, &region_of, &report.uncovered, report.uncovered_set, w)
+    })?;
+    write_atomic(&report.files[1], |w| write_input(&mesh_name, &report.regions, report.uncovered_set, w))?;
+    Ok(report)
+}
+
+/// Everything [`write_flow`] checks and computes before it writes: the regions and each
+/// element's region (`usize::MAX` where no ply covers it). An error here means nothing is written.
+pub(crate) fn check(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(), ExportError> {
+    plan(mesh, map, out).map(drop)
+}
+
+/// The report [`write_flow`] returns and each element's region, or why the map cannot be written.
+fn plan(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<(RtmsimReport, Vec<usize>), ExportError> {
     let mesh_path = sibling(out, ".bdf");
     let input_path = sibling(out, "_input.txt");
     let (cells, uncovered) = cells(mesh, map)?;
@@ -255,9 +273,7 @@ pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<
     }
     // The elements no ply covers: a SET after the covered regions' SETs.
     let uncovered_set = (!uncovered.is_empty()).then_some(regions.len());
-    write_atomic(&mesh_path, |w| write_mesh(mesh, &regions, &region_of, &uncovered, uncovered_set, w))?;
-    write_atomic(&input_path, |w| write_input(&mesh_name, &regions, uncovered_set, w))?;
-    Ok(RtmsimReport {
+    let report = RtmsimReport {
         files: vec![mesh_path, input_path],
         groups_found,
         regions,
@@ -265,7 +281,8 @@ pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<
         uncovered,
         uncovered_set,
         max_direction_error_deg,
-    })
+    };
+    Ok((report, region_of))
 }
 
 fn short(x: f64) -> String {

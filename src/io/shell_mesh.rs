@@ -119,7 +119,7 @@ impl Builder {
         Ok(Builder {
             files: vec![path.to_path_buf()],
             scale,
-            mesh: FlowMesh { path: path.to_path_buf(), ..FlowMesh::default() },
+            mesh: FlowMesh { path: path.to_path_buf(), scale, ..FlowMesh::default() },
             node_index: IdMap::default(),
             element_loc: IdMap::default(),
             pending: Vec::new(),

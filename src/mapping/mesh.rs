@@ -38,7 +38,7 @@ pub struct FlowElement {
 }
 
 /// A shell mesh of the part, in metres.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct FlowMesh {
     /// The file it was read from.
     pub path: PathBuf,
@@ -48,6 +48,63 @@ pub struct FlowMesh {
     pub node_ids: Vec<u64>,
     /// The elements, in file order.
     pub elements: Vec<FlowElement>,
+    /// Metres per length unit of the file (1 for metres, 0.001 for millimetres): writers that
+    /// carry the file's own cards through write lengths back in its unit.
+    pub scale: f64,
+    /// The property and material cards of the file, for the writers of its family to carry
+    /// through (Nastran: PSHELL, PCOMP, PCOMPG, MAT1, MAT2, MAT8); empty for other formats.
+    pub cards: MeshCards,
+}
+
+impl Default for FlowMesh {
+    fn default() -> Self {
+        FlowMesh {
+            path: PathBuf::new(),
+            nodes: Vec::new(),
+            node_ids: Vec::new(),
+            elements: Vec::new(),
+            scale: 1.0,
+            cards: MeshCards::default(),
+        }
+    }
+}
+
+/// One property or material card of a flow mesh's file, kept as read (in the file's units).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MeshCard {
+    /// The card's name, upper case (`PSHELL`, `MAT8`, ...).
+    pub name: String,
+    /// Its id (the PID of a property, the MID of a material): its first data field.
+    pub id: u64,
+    /// Its data fields as text, the id first, in small-field numbering (eight a line, blanks
+    /// kept as empty strings), each at most 15 characters.
+    pub fields: Vec<String>,
+    /// Where it was read: `file line n`.
+    pub origin: String,
+}
+
+/// The property and material cards a flow mesh's file gives (see [`FlowMesh::cards`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MeshCards {
+    /// Property cards, in file order.
+    pub properties: Vec<MeshCard>,
+    /// Material cards, in file order.
+    pub materials: Vec<MeshCard>,
+    /// Cards of the same families that are not carried (temperature-dependent or nonlinear
+    /// materials, say), named with where they are, for the writers to say so.
+    pub not_carried: Vec<String>,
+}
+
+impl MeshCards {
+    /// The property card with PID `id`.
+    pub fn property(&self, id: u64) -> Option<&MeshCard> {
+        self.properties.iter().find(|c| c.id == id)
+    }
+
+    /// The material card with MID `id`.
+    pub fn material(&self, id: u64) -> Option<&MeshCard> {
+        self.materials.iter().find(|c| c.id == id)
+    }
 }
 
 impl FlowMesh {
@@ -96,6 +153,72 @@ impl FlowMesh {
         let d = d - n * n.dot(&d);
         let len = d.norm();
         (len > 0.0).then(|| d / len)
+    }
+}
+
+/// An element with an area at most this times its longest edge squared, or with a G1 -> G2 edge
+/// (in its plane) at most this times its longest edge, has no frame to map fibres into: its
+/// corners are coincident or in a line, or G1 and G2 coincide. Far below any real element's
+/// aspect ratio; only rounding separates such an element from an exactly degenerate one.
+pub const DEGENERATE_RATIO: f64 = 1e-12;
+
+/// Why an element has no frame (normal and first edge) to map fibres into.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Degeneracy {
+    /// Its corners are coincident or in a line (a repeated node in a triangle, or opposite corners
+    /// of a quad the same node, give this too).
+    ZeroArea {
+        /// Its area, in m^2.
+        area: f64,
+        /// Its longest edge, in m.
+        longest_edge: f64,
+    },
+    /// G1 and G2 coincide (the same node, or two nodes at one place), so there is no first edge
+    /// to measure the material angle THETA from.
+    NoFirstEdge {
+        /// The file id of G1.
+        g1: u64,
+        /// The file id of G2.
+        g2: u64,
+    },
+}
+
+impl std::fmt::Display for Degeneracy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Degeneracy::ZeroArea { area, longest_edge } => write!(
+                f,
+                "zero area ({area:.3e} m^2 with a longest edge of {longest_edge:.3e} m): its corners are coincident or in a line"
+            ),
+            Degeneracy::NoFirstEdge { g1, g2 } if g1 == g2 => {
+                write!(f, "G1 and G2 are the same node {g1}: it has no first edge to measure THETA from")
+            }
+            Degeneracy::NoFirstEdge { g1, g2 } => {
+                write!(f, "G1 (node {g1}) and G2 (node {g2}) coincide: it has no first edge to measure THETA from")
+            }
+        }
+    }
+}
+
+impl FlowMesh {
+    /// Why element `e` has no frame to map fibres into, or `None` when it has one (see
+    /// [`DEGENERATE_RATIO`]). A quad with one repeated corner away from G1-G2 is a triangle
+    /// written as a quad (as Abaqus allows) and has a frame.
+    pub fn degeneracy(&self, e: usize) -> Option<Degeneracy> {
+        let c = self.corners(e);
+        let longest_edge = (0..c.len()).map(|k| (c[(k + 1) % c.len()] - c[k]).norm()).fold(0.0, f64::max);
+        let area = self.area(e);
+        if !(area > DEGENERATE_RATIO * longest_edge * longest_edge) {
+            return Some(Degeneracy::ZeroArea { area, longest_edge });
+        }
+        let n = self.area_normal(e) / (2.0 * area);
+        let d = c[1] - c[0];
+        let d = d - n * n.dot(&d);
+        if !(d.norm() > DEGENERATE_RATIO * longest_edge) {
+            let el = &self.elements[e];
+            return Some(Degeneracy::NoFirstEdge { g1: self.node_ids[el.nodes[0]], g2: self.node_ids[el.nodes[1]] });
+        }
+        None
     }
 }
 

@@ -7,7 +7,7 @@ use crate::geometry::{Point, Vector};
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
 pub use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP, VF_MAX_HEX};
-pub use mesh::{ElementShape, FlowElement, FlowMesh};
+pub use mesh::{Degeneracy, ElementShape, FlowElement, FlowMesh, MeshCard, MeshCards, DEGENERATE_RATIO};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
@@ -49,6 +49,72 @@ pub struct PlyMap {
     pub ply: String,
     /// One entry per flow element.
     pub elements: Vec<Option<ElementFibres>>,
+    /// The ply's fabric as its material card gives it, `None` for a ply without a card.
+    pub fabric: Option<PlyFabric>,
+}
+
+/// What a ply's material card says of the fabric in its plane, for the writers that give a
+/// solver a material (the MAT8 of the Nastran and OptiStruct decks): the fibre families' tensile
+/// rigidities at zero strain, the shear stiffness at zero shear and the areal mass, with the
+/// ply's thickness as laid. The card models a pin-jointed net: the families do not couple (no
+/// Poisson effect). These are the dry fabric's constants, not a cured laminate's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlyFabric {
+    /// The card's name.
+    pub card: String,
+    /// Warp tensile rigidity per unit width at zero strain, N/m.
+    pub tension_warp: f64,
+    /// Weft tensile rigidity per unit width at zero strain, N/m.
+    pub tension_weft: f64,
+    /// Shear stiffness dM/dg at zero shear, N/m per rad.
+    pub shear: f64,
+    /// Areal mass, kg/m^2.
+    pub areal_mass: f64,
+    /// The ply's thickness as laid flat (t0), m.
+    pub thickness: f64,
+}
+
+/// The orthotropic constants of a ply of [`PlyFabric`], per unit volume (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FabricModuli {
+    /// E1 = warp rigidity / t0, Pa.
+    pub e1: f64,
+    /// E2 = weft rigidity / t0, Pa.
+    pub e2: f64,
+    /// G12 = shear stiffness / t0, Pa.
+    pub g12: f64,
+    /// NU12: 0 (the families do not couple).
+    pub nu12: f64,
+    /// Density = areal mass / t0, kg/m^3.
+    pub density: f64,
+}
+
+impl PlyFabric {
+    /// The fabric of `card` in a ply `thickness` (m) thick.
+    pub fn new(card: &crate::material::MaterialCard, thickness: f64) -> PlyFabric {
+        use crate::material::laws::Fibre;
+        PlyFabric {
+            card: card.name.clone(),
+            tension_warp: card.tension(Fibre::Warp, 0.0).2,
+            tension_weft: card.tension(Fibre::Weft, 0.0).2,
+            shear: card.shear(0.0).2,
+            areal_mass: card.areal_mass,
+            thickness,
+        }
+    }
+
+    /// Its constants per unit volume: the rigidities per unit width and the areal mass over the
+    /// thickness, so that a shell of that thickness has the card's rigidities and mass.
+    pub fn moduli(&self) -> FabricModuli {
+        let t = self.thickness;
+        FabricModuli {
+            e1: self.tension_warp / t,
+            e2: self.tension_weft / t,
+            g12: self.shear / t,
+            nu12: 0.0,
+            density: self.areal_mass / t,
+        }
+    }
 }
 
 /// Every ply of a layup mapped onto one flow mesh, with laminate-level fields.
@@ -145,14 +211,6 @@ pub enum MapError {
         /// The ply.
         ply: String,
     },
-    /// A flow element has no area.
-    #[error("flow mesh {path} element {id} is degenerate (zero area): mend the mesh in its pre-processor")]
-    DegenerateElement {
-        /// The flow mesh.
-        path: std::path::PathBuf,
-        /// The element.
-        id: u64,
-    },
     /// The ply covers no element of the flow mesh.
     #[error("ply '{ply}' covers none of the {elements} elements of flow mesh {path}: {cause}")]
     NotCovered {
@@ -189,7 +247,8 @@ fn in_plane(v: &Vector, n: &Vector) -> Option<Vector> {
 
 /// Map one draped net onto a flow mesh: one entry per flow element, `None` where the ply does
 /// not cover it (the element centroid's closest point on the net lies on the net's edge, or the
-/// net is further than `settings.max_distance` from it). Elements are independent, so the work
+/// net is further than `settings.max_distance` from it) and where the element is degenerate
+/// ([`FlowMesh::degeneracy`]: it has no frame to map into). Elements are independent, so the work
 /// is spread over rayon's threads and the result does not depend on their number.
 pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Result<PlyMap, MapError> {
     let settings_error = |message: String| MapError::Settings { ply: net.name.clone(), message };
@@ -203,29 +262,30 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
         )));
     }
     let sampler = NetSampler::new(net).ok_or_else(|| MapError::EmptyNet { ply: net.name.clone() })?;
-    let elements: Result<Vec<Option<ElementFibres>>, MapError> = (0..mesh.elements.len())
+    let elements: Vec<Option<ElementFibres>> = (0..mesh.elements.len())
         .into_par_iter()
         .map(|e| {
-            let normal = mesh
-                .normal(e)
-                .ok_or_else(|| MapError::DegenerateElement { path: mesh.path.clone(), id: mesh.elements[e].id })?;
-            let Some(hit) = sampler.cover(&mesh.centroid(e), settings.max_distance) else {
-                return Ok(None);
+            // A degenerate element has no frame: not covered ([`map_plies`] names it).
+            if mesh.degeneracy(e).is_some() {
+                return None;
+            }
+            let (Some(normal), Some(reference)) = (mesh.normal(e), mesh.first_edge(e)) else {
+                return None;
             };
+            let hit = sampler.cover(&mesh.centroid(e), settings.max_distance)?;
             let (w3, f3) = (hit.warp, hit.weft);
             // Angles are measured about the element's own normal (right-handed over G1, G2, G3),
             // as the solvers that read THETA measure them, whichever side the ply lies on.
             let (Some(warp), Some(weft)) = (in_plane(&w3, &normal), in_plane(&f3, &normal)) else {
-                return Ok(None); // the element stands edge-on to the ply: not covered
+                return None; // the element stands edge-on to the ply: not covered
             };
             let shear = crate::kinematic::net::corner_shear(&warp, &weft);
-            let reference = mesh.first_edge(e).expect("a non-degenerate element has a first edge");
             let theta = signed_angle(&reference, &warp, &normal);
             let angle_change =
                 in_plane(&settings.nominal_warp, &normal).map_or(0.0, |n| signed_angle(&n, &warp, &normal));
             let (thickness, vf) = settings.cavity.sheared(settings.thickness, settings.vf, shear);
             let permeability = settings.permeability.map(|m| m.tensor(vf, &warp, &weft, &normal));
-            Ok(Some(ElementFibres {
+            Some(ElementFibres {
                 warp,
                 weft,
                 normal,
@@ -236,10 +296,10 @@ pub fn map_net(net: &DrapeNet, mesh: &FlowMesh, settings: &PlyMapSettings) -> Re
                 nominal_thickness: settings.thickness,
                 vf,
                 permeability,
-            }))
+            })
         })
         .collect();
-    Ok(PlyMap { ply: net.name.clone(), elements: elements? })
+    Ok(PlyMap { ply: net.name.clone(), elements, fabric: None })
 }
 
 /// One ply to map onto a flow mesh: its net and what it is made of.
@@ -266,11 +326,15 @@ pub fn map_plies(
     layup: bool,
     note: &mut dyn FnMut(&str),
 ) -> Result<LayupMap, MapError> {
+    if let Some(n) = degenerate_note(mesh) {
+        note(&n);
+    }
     let mut maps = Vec::with_capacity(plies.len());
     for p in plies {
         let (settings, notes) = PlyMapSettings::for_net(p.net, p.card, p.thickness, cavity, p.permeability);
         notes.iter().for_each(|n| note(n));
-        let map = map_net(p.net, mesh, &settings)?;
+        let mut map = map_net(p.net, mesh, &settings)?;
+        map.fabric = p.card.map(|c| PlyFabric::new(c, settings.thickness));
         if !mesh.elements.is_empty() && map.elements.iter().all(Option::is_none) {
             return Err(MapError::NotCovered {
                 ply: p.net.name.clone(),
@@ -282,6 +346,26 @@ pub fn map_plies(
         maps.push(map);
     }
     Ok(LayupMap::new(maps, layup, mesh.elements.len()))
+}
+
+/// Degenerate elements named in a note, at most this many by id.
+const DEGENERATE_LISTED: usize = 10;
+
+/// The note on the mesh's degenerate elements (mapped as not covered), `None` when it has none.
+fn degenerate_note(mesh: &FlowMesh) -> Option<String> {
+    let bad: Vec<(u64, Degeneracy)> =
+        (0..mesh.elements.len()).filter_map(|e| mesh.degeneracy(e).map(|d| (mesh.elements[e].id, d))).collect();
+    let (first_id, first) = bad.first()?;
+    let mut ids: Vec<String> = bad.iter().take(DEGENERATE_LISTED).map(|(id, _)| id.to_string()).collect();
+    if bad.len() > DEGENERATE_LISTED {
+        ids.push(format!("and {} more", bad.len() - DEGENERATE_LISTED));
+    }
+    Some(format!(
+        "flow mesh {}: {} degenerate element(s) ({}) have no frame to map fibres into and are marked not covered; element {first_id}: {first}. Mend them in the mesh's pre-processor",
+        mesh.path.display(),
+        bad.len(),
+        ids.join(", ")
+    ))
 }
 
 /// A mesh this many times larger or smaller than the net (in size) is taken to be in other units.
@@ -521,11 +605,68 @@ mod tests {
             vf,
             permeability: None,
         };
-        let a = PlyMap { ply: "a".into(), elements: vec![Some(f(1e-3, 0.5)), None] };
-        let b = PlyMap { ply: "b".into(), elements: vec![Some(f(3e-3, 0.6)), None] };
+        let a = PlyMap { ply: "a".into(), elements: vec![Some(f(1e-3, 0.5)), None], fabric: None };
+        let b = PlyMap { ply: "b".into(), elements: vec![Some(f(3e-3, 0.6)), None], fabric: None };
         let m = LayupMap::new(vec![a, b], true, 2);
         assert!((m.thickness[0] - 4e-3).abs() < 1e-18 && m.thickness[1] == 0.0);
         assert!((m.mean_vf[0].unwrap() - 0.575).abs() < 1e-12 && m.mean_vf[1].is_none());
         assert!(m.permeability.iter().all(Option::is_none));
+    }
+
+    /// Elements with a repeated node, coincident corners or corners in a line: a named note, the
+    /// element marked not covered, the rest mapped as before; a quad collapsed to a triangle away
+    /// from G1-G2 keeps its frame and is mapped.
+    #[test]
+    fn degenerate_elements_are_named_and_skipped_and_the_rest_is_mapped() {
+        let net = plate_net(0.0);
+        for turn in [0.0, 0.4, -1.1] {
+            let mut mesh = quad_mesh(4, 0.03, turn);
+            let clean = map_net(&net, &mesh, &settings(Cavity::Fixed)).unwrap();
+            let n = mesh.elements.len();
+            assert!(clean.elements.iter().all(Option::is_some));
+            // G1 = G2 (the panic of issue 34), G2 at G1's place, a triangle with a repeated
+            // node, a quad whose opposite corners are one node, and a quad collapsed at G3 = G4.
+            let nodes = |k: usize| mesh.elements[k].nodes.clone();
+            let (a, b, c, d) = (nodes(0), nodes(1), nodes(2), nodes(3));
+            mesh.elements[0].nodes = vec![a[0], a[0], a[2], a[3]];
+            let moved = mesh.nodes.len();
+            mesh.nodes.push(mesh.nodes[b[0]]);
+            mesh.node_ids.push(9999);
+            mesh.elements[1].nodes = vec![b[0], moved, b[2], b[3]];
+            mesh.elements[2] =
+                FlowElement { shape: ElementShape::Tria3, nodes: vec![c[0], c[1], c[0]], ..mesh.elements[2].clone() };
+            mesh.elements[3].nodes = vec![d[0], d[1], d[0], d[3]];
+            mesh.elements[4].nodes = vec![
+                mesh.elements[4].nodes[0],
+                mesh.elements[4].nodes[1],
+                mesh.elements[4].nodes[2],
+                mesh.elements[4].nodes[2],
+            ];
+            let ids: Vec<u64> = mesh.elements.iter().map(|e| e.id).collect();
+            assert!(matches!(mesh.degeneracy(0), Some(Degeneracy::NoFirstEdge { g1, g2 }) if g1 == g2));
+            assert!(matches!(mesh.degeneracy(1), Some(Degeneracy::NoFirstEdge { g1, g2 }) if g2 == 9999 && g1 != g2));
+            assert!(matches!(mesh.degeneracy(2), Some(Degeneracy::ZeroArea { .. })));
+            assert!(matches!(mesh.degeneracy(3), Some(Degeneracy::ZeroArea { .. })));
+            assert_eq!(mesh.degeneracy(4), None, "a quad collapsed at G3 = G4 is a triangle");
+            let mut notes = Vec::new();
+            let card = None;
+            let plies = [PlyToMap { net: &net, card, thickness: Some(3e-4), permeability: None }];
+            let map = map_plies(&mesh, &plies, Cavity::Fixed, false, &mut |m| notes.push(m.to_string())).unwrap();
+            let ply = &map.plies[0];
+            assert!(ply.elements[..4].iter().all(Option::is_none));
+            assert!(ply.elements[4..].iter().all(Option::is_some), "the rest is mapped");
+            for e in 5..n {
+                assert_eq!(ply.elements[e].map(|f| f.theta), clean.elements[e].map(|f| f.theta));
+            }
+            let degenerate: Vec<&String> = notes.iter().filter(|m| m.contains("degenerate")).collect();
+            assert_eq!(degenerate.len(), 1, "{notes:?}");
+            let listed = format!("({}, {}, {}, {})", ids[0], ids[1], ids[2], ids[3]);
+            assert!(
+                degenerate[0].contains("4 degenerate element(s)") && degenerate[0].contains(&listed),
+                "{}",
+                degenerate[0]
+            );
+            assert!(degenerate[0].contains("same node"), "{}", degenerate[0]);
+        }
     }
 }

@@ -5,15 +5,18 @@
 //! Order, so that bad input costs nothing computed: the plies' settings are checked, the flow
 //! export's mesh is read and the plies' cards checked for what it asks, the tool is read, the
 //! output folder is checked ([`super::folder`]), every ply is draped (a bad ply stops
-//! the run before any file is written), then each net is written, the flat patterns are nested
-//! and drawn, the plies are mapped onto the scene's flow mesh, `layup.json` is written listing
-//! every file, and last the files of an earlier run into the folder that this one did not write
-//! are removed.
+//! the run before any file is written), the flat patterns are made and nested (a ply too wide
+//! for the roll stops the run before any file is written), the plies are mapped onto the scene's
+//! flow mesh and the map checked against every format the export asks for (a ply that covers no
+//! element, or a map a format cannot write, stops the run before any file is written), then each
+//! net is written, the flat patterns are drawn, the flow files are written, `layup.json` is written
+//! listing every file, and last the files of an earlier run into the folder that this one did
+//! not write are removed.
 use super::folder::{prepare, FolderError};
 use super::scene::{Scene, SceneExport};
 use crate::geometry::ToolSurface;
 use crate::io::drawing::{write_cutting_plan, PatternError};
-use crate::io::flow::{write_flow_with, FlowOptions};
+use crate::io::flow::{check_flow, write_flow_with, FlowOptions};
 use crate::io::layup_json::{self, LAYUP_FILE};
 use crate::io::{
     kinematic_net_path, read_flow_mesh, read_tool, write_json, write_net, ExportError, Format, ReadToolError,
@@ -258,6 +261,13 @@ pub fn run(
     let mut results = drape_layup(&scene.layup, &tool, |index, name| on(Event::Draping { index, count, name }))
         .map_err(|error| RunError::Layup { scene: scene.path.clone(), error })?;
     on(Event::Draped);
+    // The flat patterns are nested and the flow export is mapped and checked before the first
+    // file is written.
+    let cutting = plan_cutting(scene, &results)?;
+    let mapped = match (&scene.export, &flow) {
+        (Some(export), Some(flow)) => Some(map_flow(scene, export, flow, &results, out)?),
+        _ => None,
+    };
     folder.create()?;
     let mut unconverged = Vec::new();
     for (ply, r) in scene.layup.plies.iter().zip(results.iter_mut()) {
@@ -294,14 +304,11 @@ pub fn run(
         written.extend(files);
     }
     on(Event::Layup { scene, results: &results });
-    let (nesting, patterns) = cutting_plan(scene, &results, out, &mut written, on)?;
+    let (nesting, patterns) = write_cutting(cutting, out, &mut written, on)?;
     // The flow export before the table, so that the table lists its files.
-    let export_row = match &scene.export {
-        Some(export) => {
-            let flow = flow.as_ref().expect("read with the export");
-            Some(export_flow(scene, export, flow, &results, out, &mut written, on)?)
-        }
-        None => None,
+    let export_row = match (&scene.export, &flow, &mapped) {
+        (Some(export), Some(flow), Some(mapped)) => Some(export_flow(export, flow, mapped, out, &mut written, on)?),
+        _ => None,
     };
     let files = folder.names(&written);
     let table = LayupTable {
@@ -339,17 +346,23 @@ pub fn run(
     Ok(())
 }
 
-/// Flat patterns of every ply, nested on the roll: `patterns.dxf`, `patterns.svg` and one SVG a
-/// ply. Plies without a complete cell have no pattern and are named; a pattern not cut along the
-/// line its ply asks for says why. Returns the nesting (when there is a pattern) and the patterns.
-fn cutting_plan(
-    scene: &Scene,
-    results: &[PlyResult],
-    out: &Path,
-    written: &mut Vec<PathBuf>,
-    on: &mut dyn FnMut(Event),
-) -> Result<(Option<Nesting>, Vec<FlatPattern>), RunError> {
-    let mut patterns = Vec::new();
+/// Flat patterns of every ply, nested on the roll, before anything is written (a ply too wide
+/// for the roll stops the run with nothing written).
+struct Cutting {
+    patterns: Vec<FlatPattern>,
+    /// Per ply in stacking order: its pattern's index, or its name when it has no complete cell
+    /// (so no pattern).
+    plies: Vec<Result<usize, String>>,
+    /// The roll width assumed when the scene gives none.
+    assumed_width: Option<f64>,
+    nesting: Option<Nesting>,
+}
+
+/// Flat patterns of every ply, nested on the roll. Plies without a complete cell have no pattern
+/// and are named; a pattern not cut along the line its ply asks for says why ([`write_cutting`]
+/// reports both).
+fn plan_cutting(scene: &Scene, results: &[PlyResult]) -> Result<Cutting, RunError> {
+    let mut cutting = Cutting { patterns: Vec::new(), plies: Vec::new(), assumed_width: None, nesting: None };
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         // A ply draped with an outline is cut along it (without a margin).
         let outline = match &ply.settings.extent {
@@ -358,47 +371,75 @@ fn cutting_plan(
         };
         match ply_pattern(&r.net, outline, scene.cutting_margin) {
             Ok(p) => {
-                for warning in &p.warnings {
-                    on(Event::PatternWarning { ply: &p.ply, warning });
-                }
-                patterns.push(p)
+                cutting.plies.push(Ok(cutting.patterns.len()));
+                cutting.patterns.push(p);
             }
-            Err(FlatError::NoCells { ply }) => on(Event::NoPattern { ply: &ply }),
+            Err(FlatError::NoCells { ply }) => cutting.plies.push(Err(ply)),
             Err(e) => return Err(RunError::Flat(e)),
         }
     }
-    if patterns.is_empty() {
-        return Ok((None, patterns));
+    if cutting.patterns.is_empty() {
+        return Ok(cutting);
     }
     let rotation = if scene.rotate_patterns { Rotation::AllowQuarterTurn } else { Rotation::WarpAlongRoll };
-    let roll_width = match scene.roll_width {
-        Some(w) => w,
-        None => {
-            // Without a roll width the pieces go on a roll as wide as the widest of them.
-            let width = patterns.iter().map(|p| p.size()[1]).fold(0.0, f64::max);
-            on(Event::RollWidthAssumed { width });
-            width
-        }
-    };
-    let nesting = nest(&patterns, roll_width, scene.nesting_gap, rotation).map_err(RunError::Flat)?;
-    let files = write_cutting_plan(&patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
-    on(Event::CuttingPlan { pieces: patterns.len(), nesting: &nesting, files: &files });
-    written.extend(files);
-    Ok((Some(nesting), patterns))
+    let roll_width = scene.roll_width.unwrap_or_else(|| {
+        // Without a roll width the pieces go on a roll as wide as the widest of them.
+        let width = cutting.patterns.iter().map(|p| p.size()[1]).fold(0.0, f64::max);
+        cutting.assumed_width = Some(width);
+        width
+    });
+    cutting.nesting = Some(nest(&cutting.patterns, roll_width, scene.nesting_gap, rotation).map_err(RunError::Flat)?);
+    Ok(cutting)
 }
 
-/// Map every ply onto the scene's resin-flow mesh and write the formats it asks for as
-/// `DIR/flow.<ext>` (`FlowFormat::scene_file`; field names prefixed by the ply); returns the
-/// layup table's record of it.
-fn export_flow(
+/// Report the cutting plan and draw it: `patterns.dxf`, `patterns.svg` and one SVG a ply.
+/// Returns the nesting (when there is a pattern) and the patterns.
+fn write_cutting(
+    cutting: Cutting,
+    out: &Path,
+    written: &mut Vec<PathBuf>,
+    on: &mut dyn FnMut(Event),
+) -> Result<(Option<Nesting>, Vec<FlatPattern>), RunError> {
+    for ply in &cutting.plies {
+        match ply {
+            Ok(k) => {
+                let p = &cutting.patterns[*k];
+                for warning in &p.warnings {
+                    on(Event::PatternWarning { ply: &p.ply, warning });
+                }
+            }
+            Err(ply) => on(Event::NoPattern { ply }),
+        }
+    }
+    let Some(nesting) = cutting.nesting else { return Ok((None, cutting.patterns)) };
+    if let Some(width) = cutting.assumed_width {
+        on(Event::RollWidthAssumed { width });
+    }
+    let files = write_cutting_plan(&cutting.patterns, &nesting, out, "patterns").map_err(RunError::Pattern)?;
+    on(Event::CuttingPlan { pieces: cutting.patterns.len(), nesting: &nesting, files: &files });
+    written.extend(files);
+    Ok((Some(nesting), cutting.patterns))
+}
+
+/// Every ply on the flow mesh, checked against the export's formats, before anything is written.
+struct MappedFlow {
+    map: LayupMap,
+    /// What the mapping assumed and the formats will write in the mesh's stead, for the events.
+    notes: Vec<String>,
+    /// Time to map and check, ms.
+    ms: f64,
+}
+
+/// Map every ply onto the scene's resin-flow mesh and check the map against every format the
+/// export asks for (`io::flow::check_flow`), so that a ply that covers no element, or a map a
+/// format cannot write, stops the run before any file is written.
+fn map_flow(
     scene: &Scene,
     export: &SceneExport,
     flow: &FlowInput,
     results: &[PlyResult],
     out: &Path,
-    written: &mut Vec<PathBuf>,
-    on: &mut dyn FnMut(Event),
-) -> Result<ExportRow, RunError> {
+) -> Result<MappedFlow, RunError> {
     let t = Instant::now();
     let mesh = &flow.mesh;
     let plies: Vec<PlyToMap> = scene
@@ -414,9 +455,38 @@ fn export_flow(
             permeability: *permeability,
         })
         .collect();
-    let map = map_plies(mesh, &plies, export.cavity, true, &mut |n| on(Event::FlowNote(n))).map_err(RunError::Map)?;
-    let ms = flow.read_ms + t.elapsed().as_secs_f64() * 1e3;
-    on(Event::FlowMapped { path: &export.mesh, mesh, map: &map, ms });
+    let mut notes = Vec::new();
+    let map =
+        map_plies(mesh, &plies, export.cavity, true, &mut |n| notes.push(n.to_string())).map_err(RunError::Map)?;
+    for &format in &export.formats {
+        let path = out.join(format.scene_file());
+        notes.extend(check_flow(mesh, &map, format, &path, &flow_options(export))?);
+    }
+    Ok(MappedFlow { map, notes, ms: t.elapsed().as_secs_f64() * 1e3 })
+}
+
+/// The writers' options a scene's export asks for.
+fn flow_options(export: &SceneExport) -> FlowOptions {
+    FlowOptions { vtu: export.vtu, ..FlowOptions::default() }
+}
+
+/// Write the formats the scene's export asks for as `DIR/flow.<ext>` (`FlowFormat::scene_file`;
+/// field names prefixed by the ply) from the map [`map_flow`] checked; returns the layup table's
+/// record of it.
+fn export_flow(
+    export: &SceneExport,
+    flow: &FlowInput,
+    mapped: &MappedFlow,
+    out: &Path,
+    written: &mut Vec<PathBuf>,
+    on: &mut dyn FnMut(Event),
+) -> Result<ExportRow, RunError> {
+    let (mesh, map) = (&flow.mesh, &mapped.map);
+    for n in &mapped.notes {
+        on(Event::FlowNote(n));
+    }
+    let ms = flow.read_ms + mapped.ms;
+    on(Event::FlowMapped { path: &export.mesh, mesh, map, ms });
     let mut row = ExportRow {
         mesh: export.mesh.display().to_string(),
         elements: mesh.elements.len(),
@@ -440,8 +510,7 @@ fn export_flow(
             .collect(),
     };
     for &format in &export.formats {
-        let options = FlowOptions { vtu: export.vtu, ..FlowOptions::default() };
-        let files = write_flow_with(mesh, &map, format, &out.join(format.scene_file()), &options)?;
+        let files = write_flow_with(mesh, map, format, &out.join(format.scene_file()), &flow_options(export))?;
         on(Event::FlowWritten { files: &files });
         row.files.extend(files.iter().filter_map(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned()));
         written.extend(files);

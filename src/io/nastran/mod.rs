@@ -2,6 +2,7 @@
 //! layup ([`mod@write`]); OptiStruct and RTMsim decks are Nastran bulk data too and share the
 //! fields below. One parser reads a real field ([`parse_real`]), and the writers check every
 //! number they write with it (`fit_real`).
+pub(crate) mod cards;
 pub mod read;
 pub mod write;
 
@@ -83,6 +84,8 @@ pub(crate) fn fit_real(x: f64, width: usize) -> Option<String> {
         let s = format!("{x:.p$}");
         let s = if p == 0 { format!("{s}.") } else { s };
         let s = s.replacen("0.", ".", if s.starts_with("0.") || s.starts_with("-0.") { 1 } else { 0 });
+        // Trailing zeros after the point carry nothing ("250.25000000000" is "250.25").
+        let s = if s.contains('.') { s.trim_end_matches('0').to_string() } else { s };
         if s.len() <= width {
             consider(s);
             break;
@@ -197,6 +200,8 @@ mod tests {
             }
         }
         assert_eq!(fit_real(0.5, 8).unwrap(), "0.5");
+        assert_eq!(fit_real(250.25000000000003, 15).unwrap(), "250.25");
+        assert_eq!(fit_real(-1500.0000000000002, 15).unwrap(), "-1500.");
         assert_eq!(fit_real(-1.0e-7, 8).unwrap(), "-1.e-7");
         assert_eq!(parse_real("1.5-3"), Some(1.5e-3));
         assert_eq!(parse_real("-.5+2"), Some(-50.0));

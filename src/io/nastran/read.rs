@@ -19,11 +19,13 @@
 //!
 //! Reals take Nastran's forms: `1.-3` = 1e-3, `-.5+2` = -50, `1.5D-3`, `7.`; a blank coordinate
 //! is 0. An element's blank PID is its EID (Nastran's default). Cards starting with `C` that are
-//! not shells (CTRIA6, CQUAD8, CHEXA, CBAR, CONM2, ...) are counted and skipped; other cards
-//! (PSHELL, MAT1, PCOMP, ...) are ignored.
+//! not shells (CTRIA6, CQUAD8, CHEXA, CBAR, CONM2, ...) are counted and skipped. The shells'
+//! property and material cards (PSHELL, PCOMP, PCOMPG, MAT1, MAT2, MAT8) are kept as read in
+//! [`FlowMesh::cards`], for the Nastran and OptiStruct writers to carry through; other MAT cards
+//! (MATT8, MATS1, MAT9, ...) are named there as not carried; other cards are ignored.
 use super::parse_real;
 use crate::io::shell_mesh::{read_bytes, Builder, FlowMeshError, Loc};
-use crate::mapping::FlowMesh;
+use crate::mapping::{FlowMesh, MeshCard};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -345,6 +347,11 @@ impl Reader {
                     return Err(b.syntax(loc, format!("coordinate system {cid} is defined twice: ids must be unique")));
                 }
             }
+            "PSHELL" | "PCOMP" | "PCOMPG" | "MAT1" | "MAT2" | "MAT8" => keep_card(b, card, loc)?,
+            n if n.starts_with("MAT") => {
+                let at = format!("{} line {}", b.files[loc.file].display(), loc.line);
+                b.mesh.cards.not_carried.push(format!("{n} {} ({at})", card.field(0)));
+            }
             n if n.starts_with("CORD") => {
                 if let Some(cid) = int(0, "CID").ok().flatten() {
                     self.other_cords.insert(cid, n.to_string());
@@ -416,6 +423,53 @@ impl Reader {
         let ex = ey.cross(&ez);
         Ok(Frame { kind: c.kind, origin: a, axes: [ex, ey, ez] })
     }
+}
+
+/// Keep a property (PSHELL, PCOMP, PCOMPG) or material (MAT1, MAT2, MAT8) card for the writers
+/// to carry through: its fields as text, a real too long for a large field (a free field can be
+/// any length) rewritten in 15 characters. A card whose id is not a number is listed as not
+/// carried; an id defined twice is refused, as Nastran refuses it.
+fn keep_card(b: &mut Builder, card: &Card, loc: Loc) -> Result<(), FlowMeshError> {
+    let name = card.name.as_str();
+    let at = format!("{} line {}", b.files[loc.file].display(), loc.line);
+    let Ok(id) = card.field(0).parse::<u64>() else {
+        b.mesh.cards.not_carried.push(format!("{name} '{}' ({at}: its id is not a number)", card.field(0)));
+        return Ok(());
+    };
+    let mut fields: Vec<String> = Vec::with_capacity(card.fields.len());
+    for k in 0..card.fields.len() {
+        let f = card.field(k);
+        if f.len() < super::LARGE {
+            fields.push(f.to_string());
+            continue;
+        }
+        match parse_real(f).and_then(|x| super::fit_real(x, super::LARGE - 1)) {
+            Some(short) => fields.push(short),
+            None => {
+                b.mesh.cards.not_carried.push(format!("{name} {id} ({at}: field {} '{f}' is too long)", k + 2));
+                return Ok(());
+            }
+        }
+    }
+    while fields.last().is_some_and(String::is_empty) {
+        fields.pop();
+    }
+    let material = name.starts_with("MAT");
+    let list = if material { &b.mesh.cards.materials } else { &b.mesh.cards.properties };
+    if let Some(first) = list.iter().find(|c| c.id == id) {
+        let what = if material { "material" } else { "property" };
+        return Err(b.syntax(
+            loc,
+            format!("{what} id {id} is defined twice ({} first at {}): ids must be unique", first.name, first.origin),
+        ));
+    }
+    let kept = MeshCard { name: name.to_string(), id, fields, origin: at };
+    if material {
+        b.mesh.cards.materials.push(kept);
+    } else {
+        b.mesh.cards.properties.push(kept);
+    }
+    Ok(())
 }
 
 /// A coordinate system resolved to the basic one.

@@ -9,14 +9,18 @@
 //! the deck is `out`; for a layup each ply gets its own deck `STEM_<ply>.<ext>` beside `out`
 //! (same GRIDs and element ids in all of them).
 //!
-//! The deck is bulk data only, to `INCLUDE` in the bulk section of your own deck, which defines
-//! the properties and materials: every element keeps the property id (PID) it has in the flow
-//! mesh (elements of a mesh without PIDs, like OBJ, get [`DEFAULT_PID`]), so a solver, or
-//! pyNastran with cross-referencing, finds the user's PSHELL/PCOMP and MAT cards. Elements the
-//! ply does not cover keep their PID and get no THETA (the field is left blank, and a comment
-//! lists them).
+//! The deck is bulk data only, the flow mesh's model without executive or case control: it
+//! reads alone (pyNastran `read_bdf(deck, xref=True, punch=True)` cross-references every element
+//! to its property and material) and takes the place of the mesh's file in your deck (`INCLUDE`
+//! it after BEGIN BULK). Every element keeps the property id (PID) it has in the flow mesh
+//! (elements of a mesh without PIDs, like OBJ, get [`DEFAULT_PID`]); the properties and
+//! materials are the mesh's own, carried through, or, for a PID the mesh gives none for, a
+//! PSHELL and MAT8 from the ply's material card ([`super::cards`]). Lengths are in the flow
+//! mesh's unit, as its cards are. Elements the ply does not cover keep their PID and get no
+//! THETA (the field is left blank, and a comment lists them).
+use super::cards::{self, Cards};
 use super::{large, real};
-use crate::io::flow::{deg, file_tag, sibling};
+use crate::io::flow::{deg, ply_files};
 use crate::io::{write_atomic, ExportError};
 use crate::mapping::{ElementShape, FlowElement, FlowMesh, LayupMap, PlyMap};
 use std::io::{self, Write};
@@ -35,27 +39,40 @@ pub(crate) fn pid(el: &FlowElement) -> u64 {
 }
 
 pub(crate) fn write_flow(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Vec<PathBuf>, ExportError> {
-    let ext = out.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
-    let targets: Vec<(PathBuf, &PlyMap)> = if map.layup {
-        let mut v = Vec::new();
-        for ply in &map.plies {
-            let tag = file_tag("nastran", &ply.ply)?;
-            v.push((sibling(out, &format!("_{tag}{ext}")), ply));
-        }
-        v
-    } else {
-        vec![(out.to_path_buf(), &map.plies[0])]
-    };
-    for (path, ply) in &targets {
-        write_atomic(path, |w| write_deck(mesh, ply, w))?;
+    let decks = plan(mesh, map, out)?;
+    for (path, ply, cards) in &decks {
+        write_atomic(path, |w| write_deck(mesh, ply, cards, w))?;
     }
-    Ok(targets.into_iter().map(|(p, _)| p).collect())
+    Ok(decks.into_iter().map(|(p, _, _)| p).collect())
 }
 
-fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<()> {
-    writeln!(w, "$ drape: material orientation of ply '{}' on flow mesh {}", ply.ply, mesh.path.display())?;
-    writeln!(w, "$ THETA (deg) from edge G1->G2 to the warp. Bulk data to INCLUDE after BEGIN BULK in your deck,")?;
-    writeln!(w, "$ which defines the properties (PIDs as in the flow mesh, {DEFAULT_PID} where it had none) and materials.")?;
+/// What [`write_flow`] checks before it writes (ply names become file names; every PID gets its
+/// property and materials): the notes on the cards drape writes in the mesh's stead, or why no
+/// deck can be written.
+pub(crate) fn check(mesh: &FlowMesh, map: &LayupMap, out: &Path) -> Result<Vec<String>, ExportError> {
+    Ok(plan(mesh, map, out)?.into_iter().flat_map(|(_, _, c)| c.notes).collect())
+}
+
+/// Each ply's deck: its file, the ply and its property and material cards.
+fn plan<'a>(mesh: &FlowMesh, map: &'a LayupMap, out: &Path) -> Result<Vec<(PathBuf, &'a PlyMap, Cards)>, ExportError> {
+    ply_files("nastran", map, out)?
+        .into_iter()
+        .map(|(path, ply)| Ok((path, ply, cards::nastran(mesh, ply)?)))
+        .collect()
+}
+
+fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, cards: &Cards, w: &mut W) -> io::Result<()> {
+    comment(w, &format!("drape: material orientation of ply '{}' on flow mesh {}", ply.ply, mesh.path.display()))?;
+    comment(
+        w,
+        &format!(
+            "THETA (deg) from edge G1->G2 to the warp. The mesh's model as bulk data (lengths in its unit, {} m), with the properties and materials of its PIDs ({DEFAULT_PID} where it had none): it reads alone, and takes the mesh file's place after BEGIN BULK in your deck.",
+            mesh.scale
+        ),
+    )?;
+    for c in &cards.comments {
+        comment(w, c)?;
+    }
     let uncovered: Vec<u64> =
         mesh.elements.iter().zip(&ply.elements).filter(|(_, f)| f.is_none()).map(|(e, _)| e.id).collect();
     if !uncovered.is_empty() {
@@ -75,13 +92,39 @@ fn write_deck<W: Write>(mesh: &FlowMesh, ply: &PlyMap, w: &mut W) -> io::Result<
         let theta = f.as_ref().map(|f| real(deg(f.theta)));
         write_element(mesh, el, pid(el), theta, w)?;
     }
+    write_cards(cards, w)
+}
+
+/// Comment lines per [`COMMENT_WIDTH`]: `$ ` and the text, broken at blanks.
+pub(crate) fn comment<W: Write>(w: &mut W, text: &str) -> io::Result<()> {
+    let mut line = String::from("$");
+    for word in text.split_whitespace() {
+        if line.len() > 2 && line.len() + 1 + word.len() > COMMENT_WIDTH {
+            writeln!(w, "{line}")?;
+            line = String::from("$  ");
+        }
+        line.push(' ');
+        line.push_str(word);
+    }
+    writeln!(w, "{line}")
+}
+
+/// Width comment lines are broken at (a word longer than that goes on a line of its own).
+const COMMENT_WIDTH: usize = 80;
+
+/// The property and material cards, large fields.
+pub(crate) fn write_cards<W: Write>(cards: &Cards, w: &mut W) -> io::Result<()> {
+    for e in &cards.entries {
+        large(w, &e.name, &e.fields)?;
+    }
     Ok(())
 }
 
-/// Every node as a large-field GRID*.
+/// Every node as a large-field GRID*, in the mesh's own length unit.
 pub(crate) fn write_grids<W: Write>(mesh: &FlowMesh, w: &mut W) -> io::Result<()> {
+    let s = mesh.scale;
     for (p, id) in mesh.nodes.iter().zip(&mesh.node_ids) {
-        large(w, "GRID", &[id.to_string(), String::new(), real(p.x), real(p.y), real(p.z)])?;
+        large(w, "GRID", &[id.to_string(), String::new(), real(p.x / s), real(p.y / s), real(p.z / s)])?;
     }
     Ok(())
 }
