@@ -4,6 +4,10 @@
 use super::flow::VF_MAX_HEX;
 use super::laws::{Bending, Fibre, KnitParams, ShearLaw, Tension, TensionLaw};
 
+/// Shear past a card's calibrated range by less than this (deg) is within it: a drape or test
+/// run to the calibrated angle itself lands a little past it.
+pub const SHEAR_RANGE_TOLERANCE_DEG: f64 = 0.05;
+
 /// Why a material card could not be read or used. The message names the card, the line and
 /// the field at fault, and what is expected.
 #[derive(Debug, thiserror::Error)]
@@ -28,6 +32,10 @@ pub struct MaterialCard {
     pub tension: Tension,
     /// In-plane shear.
     pub shear: ShearLaw,
+    /// The largest shear angle (deg) the shear law was calibrated to (`[shear]
+    /// calibrated_max_deg`, written by `drape calibrate`): beyond it the law is extrapolated, and
+    /// what uses it there says so ([`Self::shear_range_warning`]). `None`: not recorded.
+    pub shear_calibrated_max_deg: Option<f64>,
     /// Flexural rigidities per unit width, N m.
     pub bending: Bending,
     /// What resin-flow exports need (optional `[flow]` section).
@@ -101,6 +109,14 @@ impl MaterialCard {
             }
         }
         self.shear.check()?;
+        if let Some(a) = self.shear_calibrated_max_deg {
+            if !(a > 0.0 && a <= 90.0) {
+                return Err((
+                    "shear.calibrated_max_deg".into(),
+                    format!("must lie in (0, 90] degrees (the largest shear angle of the calibration), got {a}"),
+                ));
+            }
+        }
         positive("bending.warp", self.bending.warp, "flexural rigidity, N m")?;
         positive("bending.weft", self.bending.weft, "flexural rigidity, N m")?;
         Ok(())
@@ -156,6 +172,19 @@ impl MaterialCard {
             Some(s) if !s.trim().is_empty() => format!("{s}; {note}"),
             _ => note,
         });
+    }
+
+    /// A warning when a use of the shear law reaches `max_shear_deg`, more than
+    /// [`SHEAR_RANGE_TOLERANCE_DEG`] past the angle the law was calibrated to; `None` within it
+    /// or when the card records no range.
+    pub fn shear_range_warning(&self, max_shear_deg: f64) -> Option<String> {
+        let cal = self.shear_calibrated_max_deg?;
+        (max_shear_deg > cal + SHEAR_RANGE_TOLERANCE_DEG).then(|| {
+            format!(
+                "shear reaches {max_shear_deg:.1} deg, beyond the {cal:.1} deg that the shear law of material card '{}' was calibrated to: the law is extrapolated there",
+                self.name
+            )
+        })
     }
 
     /// Flexural rigidity per unit width of a fibre family, N m.
