@@ -181,7 +181,7 @@ impl MaterialCard {
         let cal = self.shear_calibrated_max_deg?;
         (max_shear_deg > cal + SHEAR_RANGE_TOLERANCE_DEG).then(|| {
             format!(
-                "shear reaches {max_shear_deg:.1} deg, beyond the {cal:.1} deg that the shear law of material card '{}' was calibrated to: the law is extrapolated there",
+                "shear reaches {max_shear_deg:.1} deg, beyond the {cal:.1} deg that the shear law of material card '{}' was calibrated to: past it the law is an extrapolation",
                 self.name
             )
         })
