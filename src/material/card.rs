@@ -413,7 +413,9 @@ mod tests {
 
     #[test]
     fn round_trip_through_toml() {
-        for mut card in all_cards() {
+        for (k, mut card) in all_cards().into_iter().enumerate() {
+            // Every other card records the range its shear law was calibrated over.
+            card.shear_calibrated_max_deg = (k % 2 == 0).then_some(34.471_234_5);
             card.source = Some("Someone et al. \"quoted\"\n2024, p. 3 \\ x".into());
             card.areal_mass = 0.1 + 0.2; // not a short decimal
             card.bending.warp = 1.0 / 3.0 * 1e-7;
@@ -469,6 +471,12 @@ mod tests {
                 9,
             ),
             (card_with(LINEAR, POLY).replace("[bending]\nwarp = 1.0e-7\n", "[bending]\n"), "missing field `warp`", 14),
+            (
+                card_with(LINEAR, POLY).replace("3.0]", "3.0]\ncalibrated_max_deg = 95.0"),
+                "`shear.calibrated_max_deg`",
+                13,
+            ),
+            (card_with(LINEAR, TWO).replace("= 35.0", "= 35.0\ncalibrated_max_deg = -1"), "calibrated_max_deg", 15),
         ];
         let mut wrong = Vec::new();
         for (text, needle, line) in cases {
@@ -481,6 +489,20 @@ mod tests {
             }
         }
         assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    }
+
+    #[test]
+    fn uses_past_the_calibrated_range_are_named() {
+        let mut card = parse(&card_with(LINEAR, TWO)).unwrap();
+        assert_eq!(card.shear_calibrated_max_deg, None);
+        assert_eq!(card.shear_range_warning(80.0), None); // no range recorded: nothing to say
+        let card2 = parse(&card_with(LINEAR, &format!("{TWO}\ncalibrated_max_deg = 35.0"))).unwrap();
+        assert_eq!(card2.shear_calibrated_max_deg, Some(35.0));
+        card.shear_calibrated_max_deg = Some(35.0);
+        assert_eq!(card, card2);
+        assert_eq!(card.shear_range_warning(35.0 + 0.5 * SHEAR_RANGE_TOLERANCE_DEG), None);
+        let w = card.shear_range_warning(41.26).unwrap();
+        assert!(w.contains("41.3 deg") && w.contains("35.0 deg") && w.contains("'t'"), "{w}");
     }
 
     fn materials_dir() -> std::path::PathBuf {
