@@ -2,9 +2,9 @@
 //!
 //! ```text
 //! drape calibrate picture-frame --data CSV --side L [--data CSV --side L ...] [--law polynomial:3|two-slope]
-//!       [--max-angle DEG] [--units m|mm] --card BASE.toml --out NEW.toml
+//!       [--max-angle DEG] [--min-angle DEG] [--units m|mm] --card BASE.toml --out NEW.toml
 //! drape calibrate bias-extension --data CSV --length L --width W [--data CSV --length L --width W ...] [--law ...]
-//!       [--max-angle DEG] [--units m|mm] --card BASE.toml --out NEW.toml
+//!       [--max-angle DEG] [--min-angle DEG] [--units m|mm] --card BASE.toml --out NEW.toml
 //! drape calibrate knit --data CSV --direction warp|weft --card BASE.toml --out NEW.toml
 //! ```
 //!
@@ -241,7 +241,8 @@ fn fit_and_write(
     let range = AngleRange { min_deg: f.min_angle, max_deg: max_angle };
     let fit = fit_shear(samples, f.law, range).map_err(fit_failure)?;
     let cross = cross_predictions(samples, f.law, range);
-    let unit = |m: f64| m / unit_scale(&f.units).unwrap_or(1.0);
+    // A length in the units given, without the rounding of the scaling (230, not 229.99999999999997).
+    let unit = |m: f64| (m / unit_scale(&f.units).unwrap_or(1.0) * 1e9).round() / 1e9;
     println!(
         "{test} fit of {} sample{} from {} to {max_angle} deg of shear{}, in normalised shear force (N/m):",
         samples.len(),

@@ -12,10 +12,11 @@
 //!   own Fsh(gamma/2) for the zones B, exact (no interpolation) and one residual per point. The
 //!   recursion of eq. 18 on the data alone ([`ShearRig::normalise`]) gives each sample's curve:
 //!   the scale of each band's relative error and the curves drawn in the fit report.
-//! - **Small angles count.** The angles are cut into bands of [`BAND_DEG`]; the fit minimises the
-//!   mean over bands of the squared relative rms error of the band (rms residual over rms
-//!   normalised force; each sample counts equally within a band), so a 50 % error at 3 deg
-//!   weighs as much as one at 30 deg. The same band errors are reported.
+//! - **Small angles count.** The angles are cut into bands of [`BAND_DEG`] (a band of fewer than
+//!   [`MIN_BAND_POINTS`] points joined to its neighbour); the fit minimises the mean over bands of
+//!   the squared relative rms error of the band (rms residual over rms normalised force; each
+//!   sample counts equally within a band), so a 50 % error at 3 deg weighs as much as one at
+//!   30 deg. The same band errors are reported.
 //! - **Only where the test's kinematics hold.** Points past `max_angle_deg` are left out (bias
 //!   extension: [`BIAS_EXTENSION_MAX_ANGLE_DEG`] by default; beyond it intra-ply slip makes the
 //!   real angles smaller than the kinematics say). The fit records the largest angle it used,
@@ -381,42 +382,70 @@ fn band_of(gamma: f64) -> usize {
     ((gamma.to_degrees() / BAND_DEG).ceil() as usize).saturating_sub(1)
 }
 
-/// Points grouped into bands of angle, and within a band by group (sample).
+/// Points grouped into bands of angle, and within a band by group (sample). A band of fewer
+/// than [`MIN_BAND_POINTS`] points is joined to the next (the last to the one before), so that
+/// one point never carries a band's weight.
 struct Bands {
     /// Per point: its band (an index into `stats`).
     slot: Vec<usize>,
     /// Per point: its group.
     group: Vec<usize>,
-    /// Per band: its index (band_of), the points per group, and the mean over groups of each
-    /// group's mean square of the data.
-    stats: Vec<(usize, BTreeMap<usize, usize>, f64)>,
+    /// Per band: the first and last [`band_of`] it spans, the points per group, and the mean
+    /// over groups of each group's mean square of the data.
+    stats: Vec<(usize, usize, BTreeMap<usize, usize>, f64)>,
 }
+
+/// Fewest points a band of angle is measured on.
+const MIN_BAND_POINTS: usize = 5;
 
 impl Bands {
     /// `points`: (angle rad, group, data value).
     fn new(points: &[(f64, usize, f64)]) -> Bands {
-        let mut by_band: BTreeMap<usize, BTreeMap<usize, (usize, f64)>> = BTreeMap::new();
-        for &(g, s, v) in points {
-            let e = by_band.entry(band_of(g)).or_default().entry(s).or_insert((0, 0.0));
+        let mut counts: BTreeMap<usize, usize> = BTreeMap::new();
+        for p in points {
+            *counts.entry(band_of(p.0)).or_insert(0) += 1;
+        }
+        // Runs of bands holding at least MIN_BAND_POINTS points (a short last run joins the one before).
+        let mut runs: Vec<(usize, usize, usize)> = Vec::new();
+        for (&b, &n) in &counts {
+            match runs.last_mut() {
+                Some(r) if r.2 < MIN_BAND_POINTS => {
+                    r.1 = b;
+                    r.2 += n;
+                }
+                _ => runs.push((b, b, n)),
+            }
+        }
+        if runs.len() > 1 && runs[runs.len() - 1].2 < MIN_BAND_POINTS {
+            let last = runs.pop().expect("more than one run");
+            let r = runs.last_mut().expect("one run left");
+            r.1 = last.1;
+            r.2 += last.2;
+        }
+        let slot_of = |g: f64| runs.iter().position(|r| band_of(g) <= r.1).unwrap_or(0);
+        let mut sums: Vec<BTreeMap<usize, (usize, f64)>> = vec![BTreeMap::new(); runs.len()];
+        let slot: Vec<usize> = points.iter().map(|p| slot_of(p.0)).collect();
+        for (k, &(_, s, v)) in points.iter().enumerate() {
+            let e = sums[slot[k]].entry(s).or_insert((0, 0.0));
             e.0 += 1;
             e.1 += v * v;
         }
-        let stats: Vec<(usize, BTreeMap<usize, usize>, f64)> = by_band
-            .into_iter()
-            .map(|(b, groups)| {
-                let msd = groups.values().map(|(n, ss)| ss / *n as f64).sum::<f64>() / groups.len() as f64;
-                (b, groups.into_iter().map(|(s, (n, _))| (s, n)).collect(), msd)
+        let stats = runs
+            .iter()
+            .zip(sums)
+            .map(|(r, groups)| {
+                let msd = groups.values().map(|(n, ss)| ss / *n as f64).sum::<f64>() / groups.len().max(1) as f64;
+                (r.0, r.1, groups.into_iter().map(|(s, (n, _))| (s, n)).collect(), msd)
             })
             .collect();
-        let slot = points.iter().map(|p| stats.iter().position(|s| s.0 == band_of(p.0)).unwrap_or(0)).collect();
         Bands { slot, group: points.iter().map(|p| p.1).collect(), stats }
     }
 
     /// A band's data scale (mean square), kept above a small share of the largest band's so a
     /// band of zero forces cannot take an infinite weight.
     fn scale(&self, slot: usize) -> f64 {
-        let top = self.stats.iter().map(|s| s.2).fold(0.0, f64::max);
-        self.stats[slot].2.max(1e-12 * top)
+        let top = self.stats.iter().map(|s| s.3).fold(0.0, f64::max);
+        self.stats[slot].3.max(1e-12 * top)
     }
 
     /// Least-squares weights making sum_i w_i r_i^2 the mean over bands of each band's squared
@@ -425,7 +454,7 @@ impl Bands {
         let nb = self.stats.len() as f64;
         (0..self.slot.len())
             .map(|i| {
-                let (_, groups, _) = &self.stats[self.slot[i]];
+                let groups = &self.stats[self.slot[i]].2;
                 let n = groups.get(&self.group[i]).copied().unwrap_or(1) as f64;
                 1.0 / (nb * groups.len() as f64 * n * self.scale(self.slot[i]))
             })
@@ -442,11 +471,11 @@ impl Bands {
         self.stats
             .iter()
             .enumerate()
-            .map(|(k, (b, groups, _))| {
+            .map(|(k, (first, last, groups, _))| {
                 let mse = sums[k].iter().map(|(s, ss)| ss / groups[s] as f64).sum::<f64>() / groups.len() as f64;
                 BandError {
-                    from_deg: *b as f64 * BAND_DEG,
-                    to_deg: (*b + 1) as f64 * BAND_DEG,
+                    from_deg: *first as f64 * BAND_DEG,
+                    to_deg: (*last + 1) as f64 * BAND_DEG,
                     points: groups.values().sum(),
                     rms_relative: (mse / self.scale(k)).sqrt(),
                 }

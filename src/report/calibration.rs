@@ -1,7 +1,8 @@
 //! The picture of a shear fit (`drape calibrate`, `NEW.fit.png`): on the left each sample's
 //! force against displacement with the law's force, on the right each sample's normalised
 //! shear force against the shear angle (the energy normalisation that puts samples of every size
-//! on one curve) with the law's, the fitted range marked.
+//! on one curve) with the law's, the fitted range marked; below, each point's relative force
+//! error against its angle, where a misfit at small angles shows as plainly as one at large.
 use super::render::{register_fonts, to_png, DrawResult};
 use crate::material::calibrate::{normalised_shear_force, rig_force, ShearFit, ShearSample};
 use plotters::coord::Shift;
@@ -44,16 +45,19 @@ pub fn draw_fit<DB: DrawingBackend>(
 ) -> DrawResult {
     root.fill(&WHITE).map_err(de)?;
     let title = format!(
-        "{} fit up to {:.1} deg: R^2 {:.5}, rms relative error {:.2}% over {} points",
+        "{} fit from {} to {:.1} deg: R^2 {:.5}, rms relative error {:.2}% over {} points",
         fit.law.law_name(),
+        fit.range.min_deg,
         fit.calibrated_max_deg,
         fit.r_squared,
         100.0 * fit.rms_relative,
         fit.points
     );
     let root = root.titled(&title, (FONT, 20)).map_err(de)?;
-    let (left, right) = root.split_horizontally(root.dim_in_pixel().0 as i32 / 2);
+    let (top_area, bottom) = root.split_vertically(root.dim_in_pixel().1 as i32 * 62 / 100);
+    let (left, right) = top_area.split_horizontally(top_area.dim_in_pixel().0 as i32 / 2);
     let cal = fit.calibrated_max_deg.to_radians();
+    draw_relative_errors(&bottom, fit, samples)?;
 
     // Left: force against displacement (mm).
     let mut dmax: f64 = 0.0;
@@ -182,4 +186,58 @@ pub fn draw_fit<DB: DrawingBackend>(
         .position(SeriesLabelPosition::UpperLeft)
         .draw()
         .map_err(de)
+}
+
+/// Relative errors shown up to this (a point past it is drawn at the edge).
+const ERROR_CLIP: f64 = 0.5;
+
+/// Each point's F_law / F - 1 (%) against its angle, the fitted range shaded.
+fn draw_relative_errors<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    fit: &ShearFit,
+    samples: &[ShearSample],
+) -> DrawResult {
+    let pts: Vec<Vec<(f64, f64)>> = samples
+        .iter()
+        .map(|s| {
+            s.data
+                .iter()
+                .filter_map(|&(d, f)| {
+                    let (g, _) = s.rig.shear(d)?;
+                    let law = rig_force(&fit.law, &s.rig, d)?;
+                    (g > 0.0 && f != 0.0)
+                        .then(|| (g.to_degrees(), (law / f - 1.0).clamp(-ERROR_CLIP, ERROR_CLIP) * 100.0))
+                })
+                .collect()
+        })
+        .collect();
+    let gmax = pts.iter().flatten().map(|p| p.0).fold(fit.calibrated_max_deg, f64::max);
+    let reach = (fit.calibrated_max_deg + 20.0).max(1.5 * fit.calibrated_max_deg).min(89.0);
+    let xmax = gmax.min(reach);
+    let lim = 100.0 * ERROR_CLIP;
+    let mut chart = ChartBuilder::on(area)
+        .caption("relative force error of the law at each point, F_law / F - 1 (filled: fitted)", (FONT, 16))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(65)
+        .build_cartesian_2d(padded(0.0, xmax), -lim * 1.05..lim * 1.05)
+        .map_err(de)?;
+    chart.configure_mesh().x_desc("shear angle, deg").y_desc("error, %").label_style((FONT, 13)).draw().map_err(de)?;
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(fit.range.min_deg, -lim), (fit.calibrated_max_deg, lim)],
+            RGBColor(230, 240, 255).filled(),
+        )))
+        .map_err(de)?;
+    chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, 0.0), (xmax, 0.0)], BLACK))).map_err(de)?;
+    for (k, p) in pts.iter().enumerate() {
+        let c = PALETTE[k % PALETTE.len()];
+        chart
+            .draw_series(p.iter().filter(|q| q.0 <= xmax).map(|&(g, e)| {
+                let inside = fit.range.holds(g.to_radians());
+                Circle::new((g, e), 3, if inside { c.filled() } else { c.stroke_width(1) })
+            }))
+            .map_err(de)?;
+    }
+    Ok(())
 }
