@@ -164,6 +164,9 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     for p in written {
         println!("  wrote {}", p.display());
     }
+    if let Some(w) = card.as_ref().and_then(|c| c.shear_range_warning(stats.max_abs.to_degrees())) {
+        println!("warning: ply '{}': {w}", net.name);
+    }
     match &net.meta.solver {
         Some(s) if !s.converged => Err(Failure::Compute(anyhow::anyhow!(
             "the mechanical solver stopped without equilibrium: {}; the last accepted state was written",

@@ -8,6 +8,7 @@ use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
 use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
 use crate::mechanics::{ContactMode, SolverSettings};
+use crate::pipeline::unit_scale;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -27,9 +28,13 @@ pub struct RefineArgs {
     /// Kinematic net (`<ply>.drape.json` from `drape kinematic` or `drape run`).
     #[arg(long)]
     pub net: PathBuf,
-    /// Tool surface (OBJ, STL, or a shell mesh: .inp, .bdf, .msh), in the net's units (metres).
+    /// Tool surface (OBJ, STL, or a shell mesh: .inp, .bdf, .msh).
     #[arg(long)]
     pub tool: PathBuf,
+    /// Units of the tool file: m or mm (default: the units the net records its tool was read
+    /// in, else m). The net itself is in metres.
+    #[arg(long)]
+    pub units: Option<String>,
     /// Material card (TOML).
     #[arg(long)]
     pub material: PathBuf,
@@ -85,8 +90,12 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     if !(friction.is_finite() && friction >= 0.0) {
         return Err(input(anyhow::anyhow!("--friction must be a finite number >= 0, got {friction}")));
     }
+    let scale = match &a.units {
+        Some(u) => unit_scale(u).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?,
+        None => net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or(1.0),
+    };
     let t_load = Instant::now();
-    let tool = crate::io::read_tool(&a.tool, 1.0).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
+    let tool = crate::io::read_tool(&a.tool, scale).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
     crate::kinematic::fishnet::check_spacing_on_tool(&tool, net.spacing)
@@ -131,6 +140,10 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     print_solver(&refined);
     for p in written {
         println!("  wrote {}", p.display());
+    }
+    let max_shear = out.shear_stats(DEFAULT_LOCKING_ANGLE_DEG.to_radians()).max_abs.to_degrees();
+    if let Some(w) = material.shear_range_warning(max_shear) {
+        println!("warning: ply '{}': {w}", out.name);
     }
     if let Some(slide) = &refined.slide {
         return Err(compute(anyhow::anyhow!("{}; the last state was written", slide.describe())));

@@ -9,7 +9,7 @@ use super::{compute, input, Failure};
 use crate::io::Format;
 use crate::kinematic::provenance::Stability;
 use crate::layup::stack::PlyResult;
-use crate::layup::table::CoverageOf;
+use crate::layup::table::{shear_range_warning, CoverageOf};
 use crate::layup::{LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
 use crate::pipeline::run::{run as run_scene, Event, RunError};
 use crate::pipeline::Scene;
@@ -209,6 +209,11 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 "UNSTABLE: ply '{}' is an equilibrium but a saddle of the energy, not a minimum (the second-order check on its solver: line); the ply key escape_saddles = true tries to move it off (off by default: it can slide fabric past the tool's open edges)\n",
                 ply.settings.name
             );
+        }
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if let Some(w) = shear_range_warning(ply, r) {
+            out += &format!("warning: ply '{}': {w}\n", ply.settings.name);
         }
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {

@@ -304,6 +304,9 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
             println!("{} cases: {}", s.cases.len(), text.join(", "));
         }
     }
+    if let Some(w) = st::shear_range_warning(dir) {
+        println!("warning: {w}");
+    }
     let files = crate::report::study::draw(dir, &finished).map_err(|m| compute(anyhow::anyhow!(m)))?;
     for f in files {
         println!("wrote {}", f.display());

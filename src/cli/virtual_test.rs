@@ -1,10 +1,14 @@
 //! `drape test ...`: virtual material tests writing JSON.
 //!
 //! ```text
-//! drape test cantilever --material CARD --direction warp|weft --length L [--nodes N] --out F
-//! drape test picture-frame --material CARD --side L --displacement D [--steps S] --spacing H --out F
-//! drape test bias-extension --material CARD --length L --width W --displacement D [--steps S] --spacing H --out F
+//! drape test cantilever --material CARD --direction warp|weft --length L [--nodes N] [--units m|mm] --out F
+//! drape test picture-frame --material CARD --side L --displacement D [--steps S] --spacing H [--units m|mm] --out F
+//! drape test bias-extension --material CARD --length L --width W --displacement D [--steps S] --spacing H [--units m|mm] --out F
 //! ```
+//!
+//! Lengths are read in `--units` (default m); the output is in metres. A shear test that takes
+//! the sample past the angle its card's shear law was calibrated to (`[shear]
+//! calibrated_max_deg`) prints a warning and lists it in `"warnings"`.
 //!
 //! The two shear tests write `{"displacement": [...], "force": [...], "net": {"grid": [nu, nv],
 //! "nodes": [[x,y,z] | null, ...], ...}, ...}`: the crosshead displacement (m) and force (N, on
@@ -13,13 +17,15 @@
 //! `i * nv + j`, null for nodes outside the sample). Extra keys: `"test"`, `"sample"` (the
 //! dimensions and spacing the net realises), `"net".spacing`, `"net".cell_shear_deg` (final
 //! cell shear, null for incomplete cells), `"steps"` (requested, completed), `"converged"`,
-//! `"iterations"`, `"notes"` (adjustments made to the request).
+//! `"iterations"`, `"notes"` (adjustments made to the request), `"warnings"`.
 use super::{compute, input, Failure};
 use crate::io::write_atomic;
+use crate::material::test_kinematics::{BiasExtensionKinematics, PictureFrameKinematics};
 use crate::material::{Fibre, MaterialCard};
 use crate::mechanics::virtual_tests::{
     bias_extension, cantilever, picture_frame, BiasExtension, PictureFrame, ShearTest,
 };
+use crate::pipeline::unit_scale;
 use clap::{Args, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
@@ -49,12 +55,15 @@ pub enum VirtualTest {
         /// Fibre direction along the strip.
         #[arg(long, value_enum)]
         direction: Direction,
-        /// Free length of the strip, m.
+        /// Free length of the strip.
         #[arg(long)]
         length: f64,
         /// Nodes along the strip.
         #[arg(long, default_value_t = 21)]
         nodes: usize,
+        /// Units of the lengths given: m or mm.
+        #[arg(long, default_value = "m")]
+        units: String,
         /// Output JSON file: {"nodes": [[x,y,z], ...]} from the clamp to the tip.
         #[arg(long)]
         out: PathBuf,
@@ -65,18 +74,21 @@ pub enum VirtualTest {
         /// Material card (TOML).
         #[arg(long)]
         material: PathBuf,
-        /// Frame side L (hinge to hinge, = sample side), m.
+        /// Frame side L (hinge to hinge, = sample side).
         #[arg(long)]
         side: f64,
-        /// Final crosshead displacement, m (below (2 - sqrt 2) L, where the frame closes).
+        /// Final crosshead displacement (below (2 - sqrt 2) L, where the frame closes).
         #[arg(long)]
         displacement: f64,
         /// Equal load steps up to the displacement.
         #[arg(long, default_value_t = 10)]
         steps: usize,
-        /// Fibre spacing of the net, m (adjusted to a whole number of cells per side, >= 2).
+        /// Fibre spacing of the net (adjusted to a whole number of cells per side, >= 2).
         #[arg(long)]
         spacing: f64,
+        /// Units of the lengths given: m or mm.
+        #[arg(long, default_value = "m")]
+        units: String,
         /// Output JSON file.
         #[arg(long)]
         out: PathBuf,
@@ -87,21 +99,24 @@ pub enum VirtualTest {
         /// Material card (TOML).
         #[arg(long)]
         material: PathBuf,
-        /// Free length L between the clamps, m (L >= 2 W).
+        /// Free length L between the clamps (L >= 2 W).
         #[arg(long)]
         length: f64,
-        /// Width W, m.
+        /// Width W.
         #[arg(long)]
         width: f64,
-        /// Final clamp displacement, m (below (sqrt 2 - 1)(L - W), 90 deg in the central zone).
+        /// Final clamp displacement (below (sqrt 2 - 1)(L - W), 90 deg in the central zone).
         #[arg(long)]
         displacement: f64,
         /// Equal load steps up to the displacement.
         #[arg(long, default_value_t = 10)]
         steps: usize,
-        /// Fibre spacing of the net, m (adjusted so that the clamp corners are nodes).
+        /// Fibre spacing of the net (adjusted so that the clamp corners are nodes).
         #[arg(long)]
         spacing: f64,
+        /// Units of the lengths given: m or mm.
+        #[arg(long, default_value = "m")]
+        units: String,
         /// Output JSON file.
         #[arg(long)]
         out: PathBuf,
@@ -110,24 +125,37 @@ pub enum VirtualTest {
 
 pub fn run(a: TestArgs) -> Result<(), Failure> {
     match a.test {
-        VirtualTest::PictureFrame { material, side, displacement, steps, spacing, out } => {
+        VirtualTest::PictureFrame { material, side, displacement, steps, spacing, units, out } => {
+            let s = scale(&units)?;
             check_out(&out)?;
             let card = MaterialCard::load(&material).map_err(input)?;
-            let spec = PictureFrame { side, spacing, displacement, steps };
+            let spec = PictureFrame { side: side * s, spacing: spacing * s, displacement: displacement * s, steps };
             let result = picture_frame(&card, &spec).map_err(|m| input(anyhow::anyhow!(m)))?;
             let sample = serde_json::json!({"side": result.sample.0, "spacing": result.sample.2});
-            finish_shear_test("picture-frame", &result, sample, &out)
+            // The frame shears the whole sample to its nominal angle.
+            let nominal = PictureFrameKinematics { side: spec.side }.shear(last_displacement(&result)).map(|g| g.0);
+            finish_shear_test("picture-frame", &result, sample, &card, nominal, &out)
         }
-        VirtualTest::BiasExtension { material, length, width, displacement, steps, spacing, out } => {
+        VirtualTest::BiasExtension { material, length, width, displacement, steps, spacing, units, out } => {
+            let s = scale(&units)?;
             check_out(&out)?;
             let card = MaterialCard::load(&material).map_err(input)?;
-            let spec = BiasExtension { length, width, spacing, displacement, steps };
+            let spec = BiasExtension {
+                length: length * s,
+                width: width * s,
+                spacing: spacing * s,
+                displacement: displacement * s,
+                steps,
+            };
             let result = bias_extension(&card, &spec).map_err(|m| input(anyhow::anyhow!(m)))?;
             let sample =
                 serde_json::json!({"length": result.sample.0, "width": result.sample.1, "spacing": result.sample.2});
-            finish_shear_test("bias-extension", &result, sample, &out)
+            let kinematics = BiasExtensionKinematics { length: spec.length, width: spec.width };
+            let nominal = kinematics.shear(last_displacement(&result)).map(|g| g.0);
+            finish_shear_test("bias-extension", &result, sample, &card, nominal, &out)
         }
-        VirtualTest::Cantilever { material, direction, length, nodes, out } => {
+        VirtualTest::Cantilever { material, direction, length, nodes, units, out } => {
+            let length = length * scale(&units)?;
             let card = MaterialCard::load(&material).map_err(input)?;
             let fibre = match direction {
                 Direction::Warp => Fibre::Warp,
@@ -163,6 +191,16 @@ pub fn run(a: TestArgs) -> Result<(), Failure> {
     }
 }
 
+/// Metres per unit of `--units`.
+fn scale(units: &str) -> Result<f64, Failure> {
+    unit_scale(units).map_err(|m| input(anyhow::anyhow!("--units: {m}")))
+}
+
+/// The crosshead displacement the test reached (0 before any step).
+fn last_displacement(r: &ShearTest) -> f64 {
+    r.displacement.last().copied().unwrap_or(0.0)
+}
+
 /// Refuse an output path whose directory does not exist (before any computation).
 fn check_out(out: &std::path::Path) -> Result<(), Failure> {
     let dir = match out.parent() {
@@ -179,13 +217,19 @@ fn check_out(out: &std::path::Path) -> Result<(), Failure> {
 }
 
 /// Write a shear test's JSON, print a summary, and fail (exit code 1) if a load step did not
-/// reach equilibrium (the file then holds the steps up to the last equilibrium).
+/// reach equilibrium (the file then holds the steps up to the last equilibrium). `nominal`: the
+/// rig's shear (rad) at the displacement reached; with the largest cell shear it says whether
+/// the card's shear law was used past its calibrated range.
 fn finish_shear_test(
     name: &str,
     r: &ShearTest,
     sample: serde_json::Value,
+    card: &MaterialCard,
+    nominal: Option<f64>,
     out: &std::path::Path,
 ) -> Result<(), Failure> {
+    let reached_deg = r.cell_shears().iter().flatten().fold(nominal.unwrap_or(0.0), |m, g| m.max(g.abs())).to_degrees();
+    let warnings: Vec<String> = card.shear_range_warning(reached_deg).into_iter().collect();
     let nodes: Vec<serde_json::Value> = r
         .nodes
         .iter()
@@ -203,6 +247,7 @@ fn finish_shear_test(
         "converged": r.ok(),
         "iterations": r.iterations(),
         "notes": r.notes,
+        "warnings": warnings,
     });
     let finite =
         r.force.iter().all(|f| f.is_finite()) && r.nodes.iter().all(|p| p.coords.iter().all(|c| c.is_finite()));
@@ -215,6 +260,9 @@ fn finish_shear_test(
         .map_err(compute)?;
     for note in &r.notes {
         println!("note: {note}");
+    }
+    for w in &warnings {
+        println!("warning: {name} test: {w}");
     }
     let cells = r.cell_shears().iter().flatten().count();
     let (d, f) = (r.displacement.last().copied().unwrap_or(0.0), r.force.last().copied().unwrap_or(0.0));

@@ -177,6 +177,18 @@ pub struct LayupRow {
     /// Offset vertices moved off their normals to bridge tight concave corners.
     #[serde(default)]
     pub offset_bridged_vertices: Option<usize>,
+    /// When the ply shears past the angle its material card's shear law was calibrated to:
+    /// the warning ([`shear_range_warning`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_range_warning: Option<String>,
+}
+
+/// A warning when a ply's largest shear is past the angle its material card's shear law was
+/// calibrated to (the card it is refined with, else its own); `None` within it, without a card,
+/// or for a card that records no range.
+pub fn shear_range_warning(ply: &Ply, result: &PlyResult) -> Option<String> {
+    let card = ply.refinement.as_ref().map(|r| &r.material).or(ply.material.as_ref().map(|m| &m.card))?;
+    card.shear_range_warning(result.stats.max_abs_shear.to_degrees())
 }
 
 /// What a ply's coverage is a share of.
@@ -267,6 +279,7 @@ impl LayupRow {
             offset_m: Some(result.offset.max_distance),
             offset_folded_triangles: Some(result.offset.folded),
             offset_bridged_vertices: Some(result.offset.relaxed),
+            shear_range_warning: shear_range_warning(ply, result),
             // Filled in by the run from the ply's pattern.
             pattern_cut: None,
             pattern_margin_m: None,

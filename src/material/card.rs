@@ -4,6 +4,10 @@
 use super::flow::VF_MAX_HEX;
 use super::laws::{Bending, Fibre, KnitParams, ShearLaw, Tension, TensionLaw};
 
+/// Shear past a card's calibrated range by less than this (deg) is within it: a drape or test
+/// run to the calibrated angle itself lands a little past it.
+pub const SHEAR_RANGE_TOLERANCE_DEG: f64 = 0.05;
+
 /// Why a material card could not be read or used. The message names the card, the line and
 /// the field at fault, and what is expected.
 #[derive(Debug, thiserror::Error)]
@@ -28,6 +32,10 @@ pub struct MaterialCard {
     pub tension: Tension,
     /// In-plane shear.
     pub shear: ShearLaw,
+    /// The largest shear angle (deg) the shear law was calibrated to (`[shear]
+    /// calibrated_max_deg`, written by `drape calibrate`): beyond it the law is extrapolated, and
+    /// what uses it there says so ([`Self::shear_range_warning`]). `None`: not recorded.
+    pub shear_calibrated_max_deg: Option<f64>,
     /// Flexural rigidities per unit width, N m.
     pub bending: Bending,
     /// What resin-flow exports need (optional `[flow]` section).
@@ -109,6 +117,14 @@ impl MaterialCard {
             }
         }
         self.shear.check()?;
+        if let Some(a) = self.shear_calibrated_max_deg {
+            if !(a > 0.0 && a <= 90.0) {
+                return Err((
+                    "shear.calibrated_max_deg".into(),
+                    format!("must lie in (0, 90] degrees (the largest shear angle of the calibration), got {a}"),
+                ));
+            }
+        }
         positive("bending.warp", self.bending.warp, "flexural rigidity, N m")?;
         positive("bending.weft", self.bending.weft, "flexural rigidity, N m")?;
         Ok(())
@@ -164,6 +180,19 @@ impl MaterialCard {
             Some(s) if !s.trim().is_empty() => format!("{s}; {note}"),
             _ => note,
         });
+    }
+
+    /// A warning when a use of the shear law reaches `max_shear_deg`, more than
+    /// [`SHEAR_RANGE_TOLERANCE_DEG`] past the angle the law was calibrated to; `None` within it
+    /// or when the card records no range.
+    pub fn shear_range_warning(&self, max_shear_deg: f64) -> Option<String> {
+        let cal = self.shear_calibrated_max_deg?;
+        (max_shear_deg > cal + SHEAR_RANGE_TOLERANCE_DEG).then(|| {
+            format!(
+                "shear reaches {max_shear_deg:.1} deg, beyond the {cal:.1} deg that the shear law of material card '{}' was calibrated to: past it the law is an extrapolation",
+                self.name
+            )
+        })
     }
 
     /// Flexural rigidity per unit width of a fibre family, N m.
@@ -392,7 +421,9 @@ mod tests {
 
     #[test]
     fn round_trip_through_toml() {
-        for mut card in all_cards() {
+        for (k, mut card) in all_cards().into_iter().enumerate() {
+            // Every other card records the range its shear law was calibrated over.
+            card.shear_calibrated_max_deg = (k % 2 == 0).then_some(34.471_234_5);
             card.source = Some("Someone et al. \"quoted\"\n2024, p. 3 \\ x".into());
             card.areal_mass = 0.1 + 0.2; // not a short decimal
             card.bending.warp = 1.0 / 3.0 * 1e-7;
@@ -448,6 +479,12 @@ mod tests {
                 9,
             ),
             (card_with(LINEAR, POLY).replace("[bending]\nwarp = 1.0e-7\n", "[bending]\n"), "missing field `warp`", 14),
+            (
+                card_with(LINEAR, POLY).replace("3.0]", "3.0]\ncalibrated_max_deg = 95.0"),
+                "`shear.calibrated_max_deg`",
+                13,
+            ),
+            (card_with(LINEAR, TWO).replace("= 35.0", "= 35.0\ncalibrated_max_deg = -1"), "calibrated_max_deg", 15),
         ];
         let mut wrong = Vec::new();
         for (text, needle, line) in cases {
@@ -460,6 +497,20 @@ mod tests {
             }
         }
         assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    }
+
+    #[test]
+    fn uses_past_the_calibrated_range_are_named() {
+        let mut card = parse(&card_with(LINEAR, TWO)).unwrap();
+        assert_eq!(card.shear_calibrated_max_deg, None);
+        assert_eq!(card.shear_range_warning(80.0), None); // no range recorded: nothing to say
+        let card2 = parse(&card_with(LINEAR, &format!("{TWO}\ncalibrated_max_deg = 35.0"))).unwrap();
+        assert_eq!(card2.shear_calibrated_max_deg, Some(35.0));
+        card.shear_calibrated_max_deg = Some(35.0);
+        assert_eq!(card, card2);
+        assert_eq!(card.shear_range_warning(35.0 + 0.5 * SHEAR_RANGE_TOLERANCE_DEG), None);
+        let w = card.shear_range_warning(41.26).unwrap();
+        assert!(w.contains("41.3 deg") && w.contains("35.0 deg") && w.contains("'t'"), "{w}");
     }
 
     fn materials_dir() -> std::path::PathBuf {

@@ -20,6 +20,9 @@
 //! law = "polynomial"        # M = c1 g + c3 g^3 + c5 g^5 + ...
 //! coefficients = [0.5, 2.0] # [c1, c3, ...], N/m
 //!
+//! calibrated_max_deg = 35.0 # optional: the law was fitted to test data up to this angle;
+//!                           # uses beyond it warn (written by `drape calibrate`)
+//!
 //! [bending]                 # flexural rigidity per unit width, N m
 //! warp = 1.0e-7
 //! weft = 1.0e-7
@@ -164,6 +167,7 @@ impl MaterialCard {
             ("shear.locking_angle_deg", s.locking_angle_deg.as_ref().map(|v| v.span())),
             ("shear.angles_deg", s.angles_deg.as_ref().map(|v| v.span())),
             ("shear.moments", s.moments.as_ref().map(|v| v.span())),
+            ("shear.calibrated_max_deg", s.calibrated_max_deg.as_ref().map(|v| v.span())),
         ] {
             if let Some(sp) = sp {
                 lines.note(f, sp);
@@ -233,6 +237,7 @@ impl MaterialCard {
             source: raw.source,
             tension,
             shear,
+            shear_calibrated_max_deg: s.calibrated_max_deg.map(Spanned::into_inner),
             bending: Bending { warp: b.warp.into_inner(), weft: b.weft.into_inner() },
             flow: raw.flow.map(|f| {
                 let f = f.into_inner();
@@ -295,6 +300,9 @@ impl MaterialCard {
                 let _ = writeln!(s, "angles_deg = {}", list(t.angles_deg()));
                 let _ = writeln!(s, "moments = {}", list(t.moments()));
             }
+        }
+        if let Some(a) = self.shear_calibrated_max_deg {
+            let _ = writeln!(s, "calibrated_max_deg = {} # deg: the law was fitted to test data up to here", f(a));
         }
         s.push_str("\n[bending] # flexural rigidity per unit width, N m\n");
         let _ = writeln!(s, "warp = {}\nweft = {}", f(self.bending.warp), f(self.bending.weft));
@@ -412,6 +420,7 @@ struct RawShear {
     locking_angle_deg: Option<Spanned<f64>>,
     angles_deg: Option<Spanned<Vec<f64>>>,
     moments: Option<Spanned<Vec<f64>>>,
+    calibrated_max_deg: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]

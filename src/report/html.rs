@@ -113,6 +113,16 @@ pub(crate) fn page(p: &Page) -> String {
     let source = if p.layup.is_some() { "from layup.json" } else { "computed from the nets (no layup.json)" };
     let _ = writeln!(h, "<h2 id=\"layup\">Layup</h2>\n<p class=\"small\">Table {source}. Shear angles in degrees; the locking angle is where the fabric stops shearing freely.</p>");
     layup_table(&mut h, &p.rows);
+    // Plies sheared past the range their card's shear law was calibrated over.
+    let range_warnings: Vec<(&str, &str)> =
+        p.rows.iter().filter_map(|r| Some((r.name.as_str(), r.shear_range_warning.as_deref()?))).collect();
+    if !range_warnings.is_empty() {
+        let _ = writeln!(h, "<ul id=\"shear-range-warnings\" class=\"warning\">");
+        for (ply, w) in &range_warnings {
+            let _ = writeln!(h, "<li>warning: ply {}: {}</li>", escape(ply), escape(w));
+        }
+        let _ = writeln!(h, "</ul>");
+    }
     if let Some(n) = p.layup.as_ref().and_then(|l| l.nesting.as_ref()) {
         let _ = writeln!(
             h,

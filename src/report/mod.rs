@@ -23,6 +23,7 @@
 //!
 //! Text is rendered with the DejaVu Sans font compiled into the program (crate `dejavu`,
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
+pub mod calibration;
 pub mod change;
 mod html;
 mod raster;

@@ -69,6 +69,23 @@ fn write_result(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<(Fini
     })
 }
 
+/// A warning when the cases of the study in `dir` shear the ply past the angle its material
+/// card's shear law was calibrated to: how many cases, and how far. `None` within the range,
+/// for a ply without a card or a card that records no range, or when the scene cannot be read
+/// again.
+pub fn shear_range_warning(dir: &Path) -> Option<String> {
+    let plan = runner::read_plan(dir).ok()?;
+    let scene = crate::pipeline::Scene::load(&plan.scene).ok()?;
+    let ply = scene.layup.plies.iter().find(|p| p.settings.name == plan.ply)?;
+    let card = ply.refinement.as_ref().map(|r| &r.material).or(ply.material.as_ref().map(|m| &m.card))?;
+    let records = collect(&plan, dir).ok()?;
+    let shears: Vec<f64> = records.iter().filter_map(|r| r.result.max_shear_deg).collect();
+    let max = shears.iter().copied().fold(0.0, f64::max);
+    let warning = card.shear_range_warning(max)?;
+    let past = shears.iter().filter(|s| card.shear_range_warning(**s).is_some()).count();
+    Some(format!("{past} of {} cases of ply '{}': {warning}", records.len(), plan.ply))
+}
+
 /// Run `plan` into `dir`: prepare the folder (or resume the study in it), run the cases of
 /// `shard` `jobs` at a time, and when the folder then holds every case, write the study's file.
 pub fn run_plan(
