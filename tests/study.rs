@@ -31,6 +31,11 @@ fn write_cap(dir: &Path, name: &str, radius: f64, triangles: usize) -> PathBuf {
     path
 }
 
+/// The texts of an SVG picture, trimmed.
+fn svg_texts(svg: &str) -> Vec<String> {
+    svg.split("<text").skip(1).filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim().to_string())).collect()
+}
+
 /// The fabric a cap's ply covers from the pole, |u|, |v| <= REACH R: well inside the Chebyshev
 /// net's range (it collapses at |u v| = 1.86 R^2), with up to 40 deg of shear at its corners.
 const REACH: f64 = 0.8;
@@ -130,6 +135,110 @@ fn every_run_s_reported_error_is_its_error_against_the_chebyshev_net() {
         for f in ["speed_accuracy.png", "speed_accuracy.svg"] {
             assert!(std::fs::metadata(out.join(f)).unwrap().len() > 1000, "{f}");
         }
+        // The chart names the reference, labels its error axis at each decade and at 2 and 5
+        // between the least and the largest error, and marks each point with its spacing.
+        let texts = svg_texts(&std::fs::read_to_string(out.join("speed_accuracy.svg")).unwrap());
+        assert!(texts.contains(&format!("reference: {}", reference.label())), "the chart names its reference: {texts:?}");
+        let errors: Vec<f64> = sa.points.iter().filter_map(|p| p.error_max_deg).collect();
+        let (lo, hi) = errors.iter().fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(*e), b.max(*e)));
+        let mut labels = 0;
+        for k in -5..2 {
+            for m in [1.0, 2.0, 5.0] {
+                let v = m * 10f64.powi(k);
+                if (lo..=hi).contains(&v) {
+                    let text = format!("{}", format!("{v:.2e}").parse::<f64>().unwrap());
+                    assert!(texts.contains(&text), "no label {text} on the axes: {texts:?}");
+                    labels += 1;
+                }
+            }
+        }
+        assert!(labels >= 3, "{lo}..{hi}: {labels} labels");
+        for d in &cap.per_radius {
+            let text = format!("{} mm", drape::study::speed_accuracy::mm(r / d));
+            assert!(texts.contains(&text), "no point labelled {text}: {texts:?}");
+        }
+    }
+}
+
+/// A ply with a material card: the reference is the pressed drape on the finest tool given
+/// (`--tools`), which the study presses there as well as on the scene's tool; every run, the
+/// coarser tool's pressed drape and auto included, is measured against it, and the same model's
+/// difference between the two tools is reported. Shards merged give the unsharded study's
+/// errors, and a study run again into its folder resumes every case and writes the same result.
+#[test]
+fn a_carded_ply_is_measured_against_the_pressed_drape_on_the_finest_tool() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = format!(
+        "units = \"m\"\ntool = {:?}\n[materials]\nglass = {:?}\n[[ply]]\nname = \"p0\"\norigin = [0.0, 0.0, 0.1]\nwarp = [1.0, 0.0, 0.0]\nmaterial = \"glass\"\nspacing = 0.008\ngrid = [21, 21]\n",
+        repo("geometries/hemisphere/hemisphere-2k.obj"),
+        repo("materials/glass-plain-weave.toml")
+    );
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let fine = repo("geometries/hemisphere/hemisphere-20k.obj");
+    let run = |out: &Path, extra: &[&str]| {
+        let a = drape()
+            .args(["study", "speed-accuracy"])
+            .arg(&path)
+            .arg("--out")
+            .arg(out)
+            .args(["--spacings=0.016,0.008", "--mechanical-spacings=0.008", "--repeats", "1", "--tools"])
+            .arg(&fine)
+            .args(extra)
+            .assert()
+            .success();
+        String::from_utf8_lossy(&a.get_output().stdout).to_string()
+    };
+    let whole = dir.path().join("whole");
+    let stdout = run(&whole, &[]);
+    let sa: SpeedAccuracy = read(&whole.join("speed_accuracy.json"));
+    let reference = &sa.reference;
+    assert_eq!(reference.kind, ReferenceKind::Mechanical, "{}", reference.why);
+    assert_eq!(reference.method, "mechanical-pressed");
+    assert_eq!((reference.tool.as_path(), reference.tool_triangles), (fine.as_path(), 20_164));
+    assert_eq!(reference.spacing, 0.008);
+    // One mechanical spacing: taken as drawn, and said so.
+    assert!(!reference.convergence.extrapolated && reference.convergence.note.contains("one spacing"));
+    assert!(stdout.contains(&format!("reference: {}", reference.describe())), "{stdout}");
+    // Pressed on both tools; auto on the scene's only.
+    let pressed: Vec<usize> =
+        sa.points.iter().filter(|p| p.method == "mechanical-pressed").map(|p| p.tool_triangles).collect();
+    assert_eq!(pressed, [2_116, 20_164]);
+    assert!(sa.points.iter().filter(|p| p.method == "auto").all(|p| p.tool_triangles == 2_116));
+    // The coarser tool's pressed drape is the tool difference, and an error like any other.
+    let coarse = sa.points.iter().find(|p| p.method == "mechanical-pressed" && p.tool_triangles == 2_116).unwrap();
+    let difference = reference.tool_difference.as_ref().expect("two tools");
+    assert_eq!((difference.tool_triangles, difference.spacing), (2_116, 0.008));
+    assert_eq!(coarse.error_max_deg, Some(difference.max_deg));
+    assert!(difference.max_deg > 1e-3, "the tools differ: {}", difference.max_deg);
+    let own = sa.points.iter().find(|p| p.method == "mechanical-pressed" && p.tool_triangles == 20_164).unwrap();
+    assert_eq!(own.error_max_deg, Some(0.0), "the reference against itself");
+    // Every kinematic run is measured, on both tools and surfaces.
+    assert!(sa.points.iter().all(|p| p.error_max_deg.is_some() && p.compared > 0), "{:?}", sa.points);
+    // Auto on the coarser tool is judged by the finer tool's drape, even at its spacing.
+    for a in &sa.auto {
+        let verdict = a.verdict(reference).unwrap();
+        assert!(!verdict.contains("nothing finer"), "{verdict}");
+    }
+    // Resumed: every case from the earlier run, the same result.
+    let before = std::fs::read(whole.join("speed_accuracy.json")).unwrap();
+    let n = sa.points.len();
+    assert!(run(&whole, &[]).contains(&format!("{n} cases ({n} from an earlier run)")));
+    assert_eq!(std::fs::read(whole.join("speed_accuracy.json")).unwrap(), before);
+    // Two shards merged: the unsharded study's errors and reference.
+    let (s1, s2, merged) = (dir.path().join("s1"), dir.path().join("s2"), dir.path().join("merged"));
+    run(&s1, &["--shard", "1/2"]);
+    run(&s2, &["--shard", "2/2"]);
+    drape().args(["study", "merge"]).arg(&s1).arg(&s2).arg("--out").arg(&merged).assert().success();
+    let m: SpeedAccuracy = read(&merged.join("speed_accuracy.json"));
+    assert_eq!(m.reference, sa.reference);
+    for (a, b) in sa.points.iter().zip(&m.points) {
+        assert_eq!((&a.method, &a.surface, a.spacing, a.tool_triangles), (&b.method, &b.surface, b.spacing, b.tool_triangles));
+        let close = |x: Option<f64>, y: Option<f64>| match (x, y) {
+            (Some(x), Some(y)) => (x - y).abs() < 1e-9,
+            (x, y) => x == y,
+        };
+        assert!(close(a.error_max_deg, b.error_max_deg), "{} {}: {:?} / {:?}", a.method, a.spacing, a.error_max_deg, b.error_max_deg);
     }
 }
 

@@ -17,7 +17,8 @@ pub struct StudyArgs {
 /// The studies.
 #[derive(Debug, Subcommand)]
 pub enum StudyCommand {
-    /// Every method at a range of spacings: error against time, and the Pareto front.
+    /// Every method at a range of spacings: error against one reference per ply (the most
+    /// complete model the ply allows, on the finest tool) against time, and the Pareto front.
     SpeedAccuracy(SpeedAccuracyArgs),
     /// Sweep the conditions that break drape methods and map the outcomes.
     Stability(StabilityArgs),
@@ -40,7 +41,9 @@ pub struct Common {
     /// The ply studied (default: the scene's first).
     #[arg(long)]
     pub ply: Option<String>,
-    /// Further resolutions of the tool, comma-separated files in the scene's units.
+    /// Further resolutions of the tool, comma-separated files in the scene's units. In
+    /// speed-accuracy the finest tool given (the most triangles) carries the one reference
+    /// every run is measured against.
     #[arg(long, value_delimiter = ',')]
     pub tools: Vec<PathBuf>,
     /// Cases run at once (default: the machine's cores). Times are per case, so use 1 for
