@@ -33,7 +33,10 @@ fn write_cap(dir: &Path, name: &str, radius: f64, triangles: usize) -> PathBuf {
 
 /// The texts of an SVG picture, trimmed.
 fn svg_texts(svg: &str) -> Vec<String> {
-    svg.split("<text").skip(1).filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim().to_string())).collect()
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim().to_string()))
+        .collect()
 }
 
 /// The fabric a cap's ply covers from the pole, |u|, |v| <= REACH R: well inside the Chebyshev
@@ -138,7 +141,10 @@ fn every_run_s_reported_error_is_its_error_against_the_chebyshev_net() {
         // The chart names the reference, labels its error axis at each decade and at 2 and 5
         // between the least and the largest error, and marks each point with its spacing.
         let texts = svg_texts(&std::fs::read_to_string(out.join("speed_accuracy.svg")).unwrap());
-        assert!(texts.contains(&format!("reference: {}", reference.label())), "the chart names its reference: {texts:?}");
+        assert!(
+            texts.contains(&format!("reference: {}", reference.label())),
+            "the chart names its reference: {texts:?}"
+        );
         let errors: Vec<f64> = sa.points.iter().filter_map(|p| p.error_max_deg).collect();
         let (lo, hi) = errors.iter().fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(*e), b.max(*e)));
         let mut labels = 0;
@@ -233,12 +239,22 @@ fn a_carded_ply_is_measured_against_the_pressed_drape_on_the_finest_tool() {
     let m: SpeedAccuracy = read(&merged.join("speed_accuracy.json"));
     assert_eq!(m.reference, sa.reference);
     for (a, b) in sa.points.iter().zip(&m.points) {
-        assert_eq!((&a.method, &a.surface, a.spacing, a.tool_triangles), (&b.method, &b.surface, b.spacing, b.tool_triangles));
+        assert_eq!(
+            (&a.method, &a.surface, a.spacing, a.tool_triangles),
+            (&b.method, &b.surface, b.spacing, b.tool_triangles)
+        );
         let close = |x: Option<f64>, y: Option<f64>| match (x, y) {
             (Some(x), Some(y)) => (x - y).abs() < 1e-9,
             (x, y) => x == y,
         };
-        assert!(close(a.error_max_deg, b.error_max_deg), "{} {}: {:?} / {:?}", a.method, a.spacing, a.error_max_deg, b.error_max_deg);
+        assert!(
+            close(a.error_max_deg, b.error_max_deg),
+            "{} {}: {:?} / {:?}",
+            a.method,
+            a.spacing,
+            a.error_max_deg,
+            b.error_max_deg
+        );
     }
 }
 

@@ -145,7 +145,8 @@ pub fn draw_speed_accuracy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, s:
         // Each point says its spacing.
         chart
             .draw_series(xy.iter().map(|&(x, y, d)| {
-                EmptyElement::at((x, y)) + Text::new(format!("{} mm", mm(d)), (7, -16), (FONT, 11).into_font().color(&c))
+                EmptyElement::at((x, y))
+                    + Text::new(format!("{} mm", mm(d)), (7, -16), (FONT, 11).into_font().color(&c))
             }))
             .map_err(de)?;
         entries.push((name, c));
@@ -380,7 +381,8 @@ mod tests {
 
     #[test]
     fn log_axes_are_labelled_at_each_decade_and_at_2_and_5() {
-        let close = |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * y);
+        let close =
+            |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * y);
         let t = log_ticks(3e-4, 0.3);
         assert!(close(&t, &[5e-4, 1e-3, 2e-3, 5e-3, 0.01, 0.02, 0.05, 0.1, 0.2]), "{t:?}");
         // The ends themselves when they fall on a label; a narrow range still has one.

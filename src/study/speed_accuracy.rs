@@ -144,20 +144,20 @@ pub fn reference_models(ply: &Ply) -> Vec<ReferenceModel> {
             why: "the ply is a free drape, which only the mechanical model draws".into(),
         }];
     }
-    let kinematic = |why: &str| ReferenceModel {
-        method: own_kinematic_method(ply),
-        surface: SurfaceKind::Smooth,
-        why: why.into(),
-    };
+    let kinematic =
+        |why: &str| ReferenceModel { method: own_kinematic_method(ply), surface: SurfaceKind::Smooth, why: why.into() };
     if has_card(ply) {
         vec![
             ReferenceModel {
                 method: StudyMethod::MechanicalPressed,
                 surface: SurfaceKind::Facets,
-                why: "the ply has a material card, so the pressed mechanical drape is the most complete model it allows"
-                    .into(),
+                why:
+                    "the ply has a material card, so the pressed mechanical drape is the most complete model it allows"
+                        .into(),
             },
-            kinematic("the kinematic net of the ply's generators on the smooth surface is the most complete model after it"),
+            kinematic(
+                "the kinematic net of the ply's generators on the smooth surface is the most complete model after it",
+            ),
         ]
     } else {
         vec![kinematic(
@@ -739,7 +739,7 @@ fn usable(r: &CaseRecord) -> Option<&ShearField> {
 }
 
 /// The runs of `records` with `select`, usable in a limit, coarsest first.
-fn runs_of<'a>(records: &'a [CaseRecord], select: impl Fn(&Variant) -> bool) -> Vec<(f64, &'a ShearField)> {
+fn runs_of(records: &[CaseRecord], select: impl Fn(&Variant) -> bool) -> Vec<(f64, &ShearField)> {
     let mut runs: Vec<(f64, &ShearField)> = records
         .iter()
         .filter(|r| select(&r.case.variant))
@@ -792,9 +792,7 @@ fn reference_of(plan: &Plan, records: &[CaseRecord]) -> (Reference, Option<Shear
             })
             .filter_map(|r| Some((r.result.tool_triangles, usable(r)?)))
             .max_by_key(|(n, _)| *n)
-            .and_then(|(n, f)| {
-                Some(ToolDifference { tool_triangles: n, spacing: df, max_deg: compare_at(ff, f).0? })
-            });
+            .and_then(|(n, f)| Some(ToolDifference { tool_triangles: n, spacing: df, max_deg: compare_at(ff, f).0? }));
         let reference = Reference {
             kind,
             method: model.method.name().into(),
@@ -823,8 +821,7 @@ fn own_limits(plan: &Plan, records: &[CaseRecord], points: &mut [SpeedPoint]) ->
     }
     let mut out = Vec::new();
     for ((method, surface, tool), ks) in groups {
-        let runs =
-            runs_of(records, |v| v.method == method && v.surface.name() == surface && v.tool.as_path() == tool);
+        let runs = runs_of(records, |v| v.method == method && v.surface.name() == surface && v.tool.as_path() == tool);
         if runs.len() < 2 {
             continue;
         }
@@ -1032,6 +1029,83 @@ mod tests {
             .iter()
             .map(|&(u, v)| (f.at(u, v).unwrap() - (1.0 + 0.5 * u - 0.3 * v)).abs())
             .fold(0.0, f64::max)
+    }
+
+    /// A record of `method` on `surface` of `tool` at `d` with `field`, converged or not.
+    fn record(
+        index: usize,
+        method: StudyMethod,
+        surface: SurfaceKind,
+        tool: &str,
+        d: f64,
+        field: ShearField,
+        converged: Option<bool>,
+    ) -> CaseRecord {
+        let variant = Variant { surface, ..Variant::baseline(method, PathBuf::from(tool), d) };
+        let case = Case { index, variant, params: BTreeMap::new(), repeats: 1, keep_field: true };
+        let mut result = super::super::case::CaseResult::refused("ok".into(), 10);
+        result.time_s = 1.0;
+        result.converged = converged;
+        result.field = Some(field);
+        CaseRecord { case, result }
+    }
+
+    #[test]
+    fn the_reference_is_the_most_complete_model_that_gave_a_usable_run() {
+        let (pressed, geodesic) = (StudyMethod::MechanicalPressed, StudyMethod::KinematicGeodesic);
+        let models = vec![
+            ReferenceModel { method: pressed, surface: SurfaceKind::Facets, why: "pressed".into() },
+            ReferenceModel { method: geodesic, surface: SurfaceKind::Smooth, why: "kinematic".into() },
+        ];
+        let plan = |records: &[CaseRecord]| Plan {
+            kind: StudyKind::SpeedAccuracy,
+            scene: PathBuf::from("/s.toml"),
+            ply: "p".into(),
+            axes: None,
+            symmetries: Vec::new(),
+            reference: Some(ReferencePlan {
+                tool: PathBuf::from("/fine.obj"),
+                tool_triangles: 10,
+                models: models.clone(),
+            }),
+            cases: records.iter().map(|r| r.case.clone()).collect(),
+        };
+        let smooth = |k, d| record(k, geodesic, SurfaceKind::Smooth, "/fine.obj", d, field(d, 3.0, 2.0), None);
+        // The pressed drape did not converge on the finest tool: the kinematic net is the
+        // reference, extrapolated at its formal order, and the reason says why.
+        let records = vec![
+            record(0, pressed, SurfaceKind::Facets, "/fine.obj", 0.25, field(0.25, 1.0, 2.0), Some(false)),
+            smooth(1, 0.5),
+            smooth(2, 0.25),
+            record(3, geodesic, SurfaceKind::Facets, "/coarse.obj", 0.25, field(0.25, 9.0, 2.0), None),
+        ];
+        let sa = evaluate(&plan(&records), &records);
+        assert_eq!(sa.reference.kind, ReferenceKind::Kinematic);
+        assert_eq!(sa.reference.why, "mechanical-pressed gave no usable run on this tool; kinematic");
+        assert!(sa.reference.convergence.extrapolated && !sa.reference.convergence.order_measured);
+        // Errors against the exact limit: 3 d^2 for the smooth runs, 9 d^2 on the coarse tool;
+        // the unconverged pressed drape is measured too (1 d^2).
+        let errors: Vec<f64> = sa.points.iter().map(|p| p.error_max_deg.unwrap()).collect();
+        for (e, want) in errors.iter().zip([0.0625, 0.75, 0.1875, 0.5625]) {
+            assert!((e - want).abs() < 1e-12, "{errors:?}");
+        }
+        // Its own convergence beside it: the smooth runs' own limit is the reference's.
+        assert!((sa.points[1].own_error_max_deg.unwrap() - 0.75).abs() < 1e-12);
+        // With the pressed drape converged it is the reference, taken as drawn (one spacing).
+        let mut converged = records.clone();
+        converged[0].result.converged = Some(true);
+        let sa = evaluate(&plan(&converged), &converged);
+        assert_eq!((sa.reference.kind, sa.reference.why.as_str()), (ReferenceKind::Mechanical, "pressed"));
+        assert_eq!(sa.points[0].error_max_deg, Some(0.0));
+        // Nothing usable on the finest tool: no reference, and why.
+        let coarse_only = vec![records[3].clone()];
+        let sa = evaluate(&plan(&coarse_only), &coarse_only);
+        assert_eq!(sa.reference.kind, ReferenceKind::None);
+        assert!(sa
+            .reference
+            .describe()
+            .contains("none of mechanical-pressed, kinematic-geodesic gave a usable run on fine.obj"));
+        assert_eq!(sa.points[0].error_max_deg, None);
     }
 
     #[test]
