@@ -4,7 +4,7 @@
 //! saved; bad input refused.
 use assert_cmd::Command;
 use drape::kinematic::fabric_field::ShearField;
-use drape::study::speed_accuracy::SpeedAccuracy;
+use drape::study::speed_accuracy::{ReferenceKind, SpeedAccuracy};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -322,7 +322,7 @@ fn the_study_reports_the_error_auto_keeps_and_the_cost_it_saves() {
     );
     let out = dir.path().join("study");
     let (stdout, sa) = study(&path, &out, "0.004", "0.004,0.002");
-    assert_eq!(sa.reference.kind, "mechanical");
+    assert_eq!(sa.reference.kind, ReferenceKind::Mechanical);
     assert_eq!(sa.reference.spacing, 0.002);
     assert_eq!(sa.auto.len(), 2, "auto at both mechanical spacings");
     let at = sa.auto.iter().find(|a| a.spacing == 0.004).unwrap();
@@ -429,7 +429,7 @@ fn the_study_of_auto_on_the_bundled_cylinder_keeps_no_error_and_reports_its_cost
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("study");
     let (_, sa) = study(&repo("geometries/cylinder/scene.toml"), &out, "0.004", "0.004");
-    assert_eq!(sa.reference.kind, "mechanical");
+    assert_eq!(sa.reference.kind, ReferenceKind::Mechanical);
     assert_eq!(sa.reference.spacing, 0.004);
     assert_eq!(sa.auto_not_run, None);
     assert_eq!(sa.auto.len(), 1);

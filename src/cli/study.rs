@@ -17,7 +17,8 @@ pub struct StudyArgs {
 /// The studies.
 #[derive(Debug, Subcommand)]
 pub enum StudyCommand {
-    /// Every method at a range of spacings: error against time, and the Pareto front.
+    /// Every method at a range of spacings: error against one reference per ply (the most
+    /// complete model the ply allows, on the finest tool) against time, and the Pareto front.
     SpeedAccuracy(SpeedAccuracyArgs),
     /// Sweep the conditions that break drape methods and map the outcomes.
     Stability(StabilityArgs),
@@ -40,7 +41,9 @@ pub struct Common {
     /// The ply studied (default: the scene's first).
     #[arg(long)]
     pub ply: Option<String>,
-    /// Further resolutions of the tool, comma-separated files in the scene's units.
+    /// Further resolutions of the tool, comma-separated files in the scene's units. In
+    /// speed-accuracy the finest tool given (the most triangles) carries the one reference
+    /// every run is measured against.
     #[arg(long, value_delimiter = ',')]
     pub tools: Vec<PathBuf>,
     /// Cases run at once (default: the machine's cores). Times are per case, so use 1 for
@@ -221,7 +224,10 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
     println!("wrote {}", path.display());
     match &finished {
         Finished::SpeedAccuracy(s) => {
-            println!("reference: {} ({}, d = {:.4} m)", s.reference.method, s.reference.kind, s.reference.spacing);
+            println!("reference: {}", s.reference.describe());
+            println!(
+                "err: each run's distance from that reference (its spacing, the tool's facets and its model alike); own: its distance from its own limit (its own convergence, not an error)"
+            );
             // On a symmetric scene each run names the image of the reference it is measured in.
             let symmetric = !s.reference.symmetries.is_empty();
             if symmetric {
@@ -233,25 +239,29 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
             }
             let image = |x: &str| if symmetric { format!(" {x:>12}") } else { String::new() };
             println!(
-                "{:<22} {:>9} {:>8} {:>10} {:>11} {:>11}{}  outcome",
+                "{:<22} {:>9} {:>8} {:>9} {:>10} {:>11} {:>11} {:>11}{}  outcome",
                 "method",
                 "d (m)",
                 "surface",
+                "triangles",
                 "time (s)",
                 "err max",
                 "err rms",
+                "own max",
                 image("image")
             );
             for p in &s.points {
                 let e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.4}"));
                 println!(
-                    "{:<22} {:>9.5} {:>8} {:>10.4} {:>11} {:>11}{}  {}{}",
+                    "{:<22} {:>9.5} {:>8} {:>9} {:>10.4} {:>11} {:>11} {:>11}{}  {}{}",
                     p.method,
                     p.spacing,
                     p.surface,
+                    p.tool_triangles,
                     p.time_s,
                     e(p.error_max_deg),
                     e(p.error_rms_deg),
+                    e(p.own_error_max_deg),
                     image(p.reference_image.map_or("-", |m| m.name())),
                     p.outcome,
                     if p.pareto { "  (Pareto)" } else { "" }

@@ -73,6 +73,33 @@ impl FabricImage {
 /// between two.
 const ZERO_WEIGHT: f64 = 1e-9;
 
+/// Along one axis of `n` cell centres, the first centre and the weights of the point at centre
+/// coordinate `x`: the centre itself where the point is on one (to rounding), else the cubic
+/// through four consecutive centres, the ones around the point where the axis has them.
+/// `None` beyond half a cell past the outermost centres, or with fewer than four.
+fn cubic_stencil(x: f64, n: usize) -> Option<(isize, Vec<f64>)> {
+    if !(x >= -0.5 - ZERO_WEIGHT && x <= n as f64 - 0.5 + ZERO_WEIGHT) {
+        return None;
+    }
+    let k = x.round();
+    if (x - k).abs() <= ZERO_WEIGHT && k >= 0.0 && (k as usize) < n {
+        return Some((k as isize, vec![1.0]));
+    }
+    if n < 4 {
+        return None;
+    }
+    let i0 = (x.floor() as isize - 1).clamp(0, n as isize - 4);
+    let t = x - i0 as f64;
+    // Lagrange weights of the centres at 0, 1, 2, 3.
+    let w = vec![
+        -(t - 1.0) * (t - 2.0) * (t - 3.0) / 6.0,
+        t * (t - 2.0) * (t - 3.0) / 2.0,
+        -t * (t - 1.0) * (t - 3.0) / 2.0,
+        t * (t - 1.0) * (t - 2.0) / 6.0,
+    ];
+    Some((i0, w))
+}
+
 impl ShearField {
     /// The cell shear field of `net`.
     pub fn of(net: &DrapeNet) -> ShearField {
@@ -98,12 +125,7 @@ impl ShearField {
     /// it needs is missing: beyond the outermost cell centres the net has no second-order value,
     /// and a constant one would be a first-order error.
     pub fn at(&self, u: f64, v: f64) -> Option<f64> {
-        // Cell-centre coordinates: the centre of cell i sits at i.
-        let xc = u / self.spacing + self.origin_node.0 as f64 - 0.5;
-        let yc = v / self.spacing + self.origin_node.1 as f64 - 0.5;
-        if !xc.is_finite() || !yc.is_finite() {
-            return None;
-        }
+        let (xc, yc) = self.centre_coordinates(u, v)?;
         let (i, j) = (xc.floor() as isize, yc.floor() as isize);
         let (fx, fy) = (xc - i as f64, yc - j as f64);
         let mut sum = 0.0;
@@ -117,6 +139,36 @@ impl ShearField {
             }
         }
         Some(sum)
+    }
+
+    /// Shear at fabric coordinates (u, v), metres, degrees, read off a smooth field: the cubic
+    /// through the 4 x 4 cell centres around the point (fourth order: between its centres a
+    /// reference keeps the accuracy it has at them, where [`ShearField::at`]'s bilinear value
+    /// would add an error of the order of a fine net's own), the stencil shifted inward at the
+    /// edges; up to half a cell beyond the outermost centres (the cells' own area). A point on a
+    /// centre (to rounding) takes that centre's value. Where the stencil lacks a cell, the
+    /// bilinear value; `None` where that has none either.
+    pub fn interpolate(&self, u: f64, v: f64) -> Option<f64> {
+        let (xc, yc) = self.centre_coordinates(u, v)?;
+        let cubic = || {
+            let (i0, wx) = cubic_stencil(xc, self.cu)?;
+            let (j0, wy) = cubic_stencil(yc, self.cv)?;
+            let mut sum = 0.0;
+            for (a, wa) in wx.iter().enumerate() {
+                for (b, wb) in wy.iter().enumerate() {
+                    sum += wa * wb * self.cell(i0 + a as isize, j0 + b as isize)?;
+                }
+            }
+            Some(sum)
+        };
+        cubic().or_else(|| self.at(u, v))
+    }
+
+    /// Cell-centre coordinates of fabric point (u, v): the centre of cell i sits at i.
+    fn centre_coordinates(&self, u: f64, v: f64) -> Option<(f64, f64)> {
+        let xc = u / self.spacing + self.origin_node.0 as f64 - 0.5;
+        let yc = v / self.spacing + self.origin_node.1 as f64 - 0.5;
+        (xc.is_finite() && yc.is_finite()).then_some((xc, yc))
     }
 
     /// Fabric coordinates of the centre of cell (i, j), metres.
@@ -200,6 +252,33 @@ mod tests {
         for m in [FabricImage::WarpMirror, FabricImage::WeftMirror, FabricImage::Rotated] {
             assert_eq!(f.image(m).image(m), f);
         }
+    }
+
+    #[test]
+    fn cubic_fields_are_reproduced_up_to_the_cells_edges() {
+        // s = u^3 - 2 u v^2 + v over fabric coordinates on a 6 x 5 grid of 0.5 m cells.
+        let exact = |u: f64, v: f64| u * u * u - 2.0 * u * v * v + v;
+        let (cu, cv) = (6, 5);
+        let mut f = ShearField { spacing: 0.5, cu, cv, origin_node: (3, 2), shear_deg: vec![None; cu * cv] };
+        for i in 0..cu {
+            for j in 0..cv {
+                let (u, v) = f.cell_centre(i, j);
+                f.shear_deg[i * cv + j] = Some(exact(u, v));
+            }
+        }
+        // Inside, near the edges (stencil shifted) and half a cell beyond the outer centres.
+        for (u, v) in [(0.1, -0.2), (-1.3, 0.9), (1.45, -0.95), (-1.5, 1.25), (1.5, -1.0)] {
+            let s = f.interpolate(u, v).unwrap();
+            assert!((s - exact(u, v)).abs() < 1e-12, "at ({u},{v}): {s} against {}", exact(u, v));
+        }
+        assert_eq!(f.interpolate(1.6, 0.0), None, "beyond the cells");
+        // A missing cell in the stencil: the bilinear value where it has one.
+        f.shear_deg[2 * cv + 2] = None;
+        assert!(f.at(0.45, 0.4).is_some());
+        assert_eq!(f.interpolate(0.45, 0.4), f.at(0.45, 0.4));
+        // On a centre: that centre's value, whatever is missing around it.
+        let (u, v) = f.cell_centre(2, 3);
+        assert_eq!(f.interpolate(u, v), f.shear_deg[2 * cv + 3]);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! (`stability.svg/png`).
 use super::render::{register_fonts, to_png, to_svg, DrawResult};
 use crate::kinematic::fabric_field::FabricImage;
-use crate::study::speed_accuracy::SpeedAccuracy;
+use crate::study::speed_accuracy::{mm, three_figures, SpeedAccuracy, SpeedPoint};
 use crate::study::stability::Stability;
 use crate::study::Finished;
 use plotters::coord::Shift;
@@ -48,90 +48,141 @@ pub fn draw(dir: &Path, finished: &Finished) -> Result<Vec<PathBuf>, String> {
     Ok(files)
 }
 
-/// A number in at most three significant figures, for axis labels.
-fn short(x: f64) -> String {
-    format!("{}", format!("{x:.2e}").parse::<f64>().unwrap_or(x))
-}
-
-fn series_name(method: &str, surface: &str) -> String {
-    if surface == "facets" {
-        method.to_string()
-    } else {
-        format!("{method} ({surface})")
+/// The labelled values of a log axis over `lo..hi`: each decade and 2 and 5 times it.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
+        return Vec::new();
     }
+    let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    (a..=b)
+        .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
+        // Within the axis, to rounding of the powers of ten.
+        .filter(|v| *v >= lo * (1.0 - 1e-12) && *v <= hi * (1.0 + 1e-12))
+        .collect()
 }
 
-/// Error (max over the compared points) against time, one series per method, on log axes.
+/// The series a run belongs to: its method and surface, and its tool where the study ran on
+/// several.
+fn series_name(p: &SpeedPoint, several_tools: bool) -> String {
+    let mut name = format!("{} ({})", p.method, p.surface);
+    if several_tools {
+        name += &format!(" [{} tri]", p.tool_triangles);
+    }
+    name
+}
+
+/// Height of the title band above the chart, pixels.
+const TITLE_BAND: u32 = 64;
+
+/// Error (max over the compared points, against the study's one reference) against time, one
+/// series per method, on log axes labelled at each decade and at 2 and 5, each point marked
+/// with its spacing.
 pub fn draw_speed_accuracy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, s: &SpeedAccuracy) -> DrawResult {
     root.fill(&WHITE).map_err(de)?;
-    let pts: Vec<(&str, String, f64, f64, bool)> = s
+    let mut triangles: Vec<usize> = s.points.iter().map(|p| p.tool_triangles).collect();
+    triangles.sort_unstable();
+    triangles.dedup();
+    let several_tools = triangles.len() > 1;
+    // (series, time, error, on the Pareto front, spacing)
+    let pts: Vec<(String, f64, f64, bool, f64)> = s
         .points
         .iter()
         .filter_map(|p| {
             // The reference itself has no error to put on a log axis; the title names it.
             let e = p.error_max_deg.filter(|e| *e > 0.0)?.max(ERROR_FLOOR_DEG);
-            (p.time_s > 0.0).then(|| (p.method.as_str(), series_name(&p.method, &p.surface), p.time_s, e, p.pareto))
+            (p.time_s > 0.0).then(|| (series_name(p, several_tools), p.time_s, e, p.pareto, p.spacing))
         })
         .collect();
-    let reference = match s.reference.kind.as_str() {
-        "mechanical" => format!("{} at d = {:.4} m", s.reference.method, s.reference.spacing),
-        _ => "each method's Richardson limit".to_string(),
-    };
-    let title = format!("Ply {}: largest shear error against time (reference: {reference})", s.ply);
+    let (top, body) = root.split_vertically(TITLE_BAND);
+    top.draw(&Text::new(
+        format!("Ply {}: largest cell-shear error against time, every run against one reference", s.ply),
+        (20, 10),
+        (FONT, 18).into_font(),
+    ))
+    .map_err(de)?;
+    top.draw(&Text::new(format!("reference: {}", s.reference.label()), (20, 38), (FONT, 14).into_font()))
+        .map_err(de)?;
     if pts.is_empty() {
-        return root
-            .draw(&Text::new(format!("{title}: no run gave an error to chart"), (20, 20), (FONT, 20).into_font()))
-            .map_err(de);
+        return body.draw(&Text::new("no run gave an error to chart", (20, 20), (FONT, 20).into_font())).map_err(de);
     }
-    let (tmin, tmax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.2), b.max(p.2)));
-    let (emin, emax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.3), b.max(p.3)));
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, (FONT, 18))
+    // The reference's own uncertainty, drawn as a line: errors below it cannot be told apart
+    // from the reference's.
+    let uncertainty = s.reference.convergence.uncertainty_max_deg.filter(|u| *u > 0.0).map(|u| u.max(ERROR_FLOOR_DEG));
+    let (tmin, tmax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let (emin, emax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.2), b.max(p.2)));
+    let (emin, emax) = uncertainty.map_or((emin, emax), |u| (emin.min(u), emax.max(u)));
+    let (x0, x1, y0, y1) = (tmin / 2.0, tmax * 2.0, emin / 2.0, emax * 2.0);
+    // The legend in a column of its own, clear of the points.
+    let (plot, legend) = body.split_horizontally(body.dim_in_pixel().0.saturating_sub(LEGEND_COLUMN) as i32);
+    let mut chart = ChartBuilder::on(&plot)
         .margin(20)
         .x_label_area_size(50)
         .y_label_area_size(70)
-        .build_cartesian_2d((tmin / 2.0..tmax * 2.0).log_scale(), (emin / 2.0..emax * 2.0).log_scale())
+        .build_cartesian_2d(
+            (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+            (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+        )
         .map_err(de)?;
     chart
         .configure_mesh()
         .x_desc("time per ply, s")
-        .y_desc("largest cell-shear error, deg")
-        .x_label_formatter(&|x| short(*x))
-        .y_label_formatter(&|y| short(*y))
+        .y_desc("largest cell-shear error against the reference, deg")
+        .x_label_formatter(&|x| three_figures(*x))
+        .y_label_formatter(&|y| three_figures(*y))
         .label_style((FONT, 14))
         .draw()
         .map_err(de)?;
-    let mut series: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut series: BTreeMap<String, Vec<(f64, f64, f64)>> = BTreeMap::new();
     for p in &pts {
-        series.entry(p.1.clone()).or_default().push((p.2, p.3));
+        series.entry(p.0.clone()).or_default().push((p.1, p.2, p.4));
     }
+    let mut entries: Vec<(String, RGBColor)> = Vec::new();
     for (k, (name, mut xy)) in series.into_iter().enumerate() {
         let c = PALETTE[k % PALETTE.len()];
         xy.sort_by(|a, b| a.0.total_cmp(&b.0));
-        chart.draw_series(LineSeries::new(xy.clone(), c.stroke_width(2))).map_err(de)?;
+        chart.draw_series(LineSeries::new(xy.iter().map(|p| (p.0, p.1)), c.stroke_width(2))).map_err(de)?;
+        chart.draw_series(xy.iter().map(|&(x, y, _)| Circle::new((x, y), 5, c.filled()))).map_err(de)?;
+        // Each point says its spacing.
         chart
-            .draw_series(xy.iter().map(|&(x, y)| Circle::new((x, y), 5, c.filled())))
-            .map_err(de)?
-            .label(name)
-            .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+            .draw_series(xy.iter().map(|&(x, y, d)| {
+                EmptyElement::at((x, y))
+                    + Text::new(format!("{} mm", mm(d)), (7, -16), (FONT, 11).into_font().color(&c))
+            }))
+            .map_err(de)?;
+        entries.push((name, c));
     }
-    let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.4).map(|p| (p.2, p.3)).collect();
+    if let Some(u) = uncertainty {
+        chart.draw_series(LineSeries::new([(x0, u), (x1, u)], GREY.stroke_width(1))).map_err(de)?;
+    }
+    let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.3).map(|p| (p.1, p.2)).collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
-    chart
-        .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(1)))
-        .map_err(de)?
-        .label("Pareto front")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+    chart.draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(1))).map_err(de)?;
     chart.draw_series(front.iter().map(|&(x, y)| Circle::new((x, y), 9, BLACK.stroke_width(2)))).map_err(de)?;
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FONT, 14))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(de)
+    // The legend: the series, the Pareto front, the reference's own error, what the labels say.
+    let font = (FONT, 13).into_font();
+    let mut y = 30;
+    for (name, c) in &entries {
+        legend.draw(&Circle::new((14, y + 7), 5, c.filled())).map_err(de)?;
+        legend.draw(&Text::new(name.clone(), (28, y), font.clone())).map_err(de)?;
+        y += 22;
+    }
+    y += 8;
+    legend.draw(&Circle::new((14, y + 7), 9, BLACK.stroke_width(2))).map_err(de)?;
+    legend.draw(&Text::new("Pareto front", (28, y), font.clone())).map_err(de)?;
+    if uncertainty.is_some() {
+        y += 22;
+        legend.draw(&PathElement::new(vec![(4, y + 7), (24, y + 7)], GREY)).map_err(de)?;
+        legend.draw(&Text::new("the reference's own spacing error", (28, y), font.clone())).map_err(de)?;
+    }
+    y += 30;
+    legend.draw(&Text::new("each point: its spacing d", (4, y), font.clone())).map_err(de)?;
+    Ok(())
 }
+
+/// Width of the chart's legend column, pixels.
+const LEGEND_COLUMN: u32 = 300;
+/// The reference's own-error line.
+const GREY: RGBColor = RGBColor(120, 120, 120);
 
 /// Colour of an outcome on the stability map: green for `ok`, a fixed colour per reason.
 fn outcome_colour(outcome: &str, reasons: &[String]) -> RGBColor {
@@ -246,11 +297,10 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
         {
             let ok = s.points.iter().filter(|p| p.error_max_deg.is_some()).count();
             let summary = format!(
-                "Ply {}: {} runs ({ok} compared) against {} ({}); circled points are the Pareto front: no other run is both faster and more accurate.",
+                "Ply {}: {} runs ({ok} compared), every one against one reference: {}. A run's error is its distance from it, whatever its source (its spacing, the tool's facets, its model); each point is labelled with its spacing; circled points are the Pareto front: no other run is both faster and more accurate.",
                 s.ply,
                 s.points.len(),
-                if s.reference.kind == "mechanical" { format!("{} at d = {:.4} m", s.reference.method, s.reference.spacing) } else { "each method's Richardson limit".into() },
-                s.reference.kind
+                s.reference.describe()
             );
             // On a symmetric scene: the symmetries, and the runs measured in an image of the
             // reference rather than in the reference as it fell.
@@ -323,4 +373,21 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
         }
     }
     Ok(figures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_ticks;
+
+    #[test]
+    fn log_axes_are_labelled_at_each_decade_and_at_2_and_5() {
+        let close =
+            |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * y);
+        let t = log_ticks(3e-4, 0.3);
+        assert!(close(&t, &[5e-4, 1e-3, 2e-3, 5e-3, 0.01, 0.02, 0.05, 0.1, 0.2]), "{t:?}");
+        // The ends themselves when they fall on a label; a narrow range still has one.
+        assert!(close(&log_ticks(1e-3, 1.0), &[1e-3, 2e-3, 5e-3, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0]));
+        assert!(close(&log_ticks(2.1, 8.4), &[5.0]));
+        assert!(log_ticks(0.0, 1.0).is_empty() && log_ticks(1.0, f64::INFINITY).is_empty());
+    }
 }

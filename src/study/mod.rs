@@ -32,8 +32,8 @@ pub enum StudyError {
 /// A finished study's result.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Finished {
-    /// `speed_accuracy.json`.
-    SpeedAccuracy(speed_accuracy::SpeedAccuracy),
+    /// `speed_accuracy.json` (boxed: far larger than the other).
+    SpeedAccuracy(Box<speed_accuracy::SpeedAccuracy>),
     /// `stability.json`.
     Stability(stability::Stability),
 }
@@ -58,7 +58,7 @@ fn write_result(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<(Fini
             let r = speed_accuracy::evaluate(plan, records);
             let path = dir.join(speed_accuracy::FILE);
             write_pretty(&path, &r)?;
-            (Finished::SpeedAccuracy(r), path)
+            (Finished::SpeedAccuracy(Box::new(r)), path)
         }
         StudyKind::Stability => {
             let r = stability::evaluate(plan, records);

@@ -1,6 +1,7 @@
 //! What a study is: the scene, the ply, and the list of independent [`Case`]s it runs. A plan is
 //! written to `DIR/study.json` before any case runs; shards and resumed runs read it back, so
 //! every process of one study agrees on what case `k` is.
+use super::speed_accuracy::ReferencePlan;
 use super::StudyError;
 use crate::kinematic::fabric_field::FabricImage;
 use crate::kinematic::SurfaceKind;
@@ -187,6 +188,9 @@ pub struct Plan {
     /// ([`super::symmetry`]): a mechanical reference is compared in each of its images.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub symmetries: Vec<FabricImage>,
+    /// The speed-accuracy study's one reference: its tool and the models the ply allows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<ReferencePlan>,
     /// The cases, in order.
     pub cases: Vec<Case>,
 }

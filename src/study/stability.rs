@@ -247,6 +247,7 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
         ply: ply.settings.name.clone(),
         axes: Some(axes.map(|a| a.name().to_string())),
         symmetries: Vec::new(),
+        reference: None,
         cases,
     })
 }
