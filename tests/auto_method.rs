@@ -213,9 +213,9 @@ fn auto_runs_mechanics_where_the_kinematic_net_is_not_within_the_tolerance() {
     let steps = choice["indicators"]["probe_iterations"].as_u64().unwrap();
     let opening = match steps {
         1 => "one step towards mechanical equilibrium changes the shear".to_string(),
-        n => format!("{n} steps towards mechanical equilibrium change the shear"),
+        n => format!("{n} steps towards mechanical equilibrium"),
     };
-    assert!(reason.starts_with(&opening), "{reason}");
+    assert!(reason.starts_with(&opening) && reason.contains("the shear"), "{reason}");
     assert_eq!(choice["spacing_m"], 0.004);
     assert_eq!(json["method"], "mechanical");
     assert_eq!(json["meta"]["solver"]["converged"], true);
@@ -511,7 +511,8 @@ fn the_study_says_so_where_auto_is_outside_its_tolerance() {
     assert_eq!(sa.reference.spacing, 0.001);
     let a = sa.auto.iter().find(|a| a.spacing == 0.003).unwrap();
     assert_eq!(a.chosen, "mechanical", "{}", a.reason);
-    assert!(a.reason.contains("steps towards mechanical equilibrium change the shear by up to"), "{}", a.reason);
+    assert!(a.reason.contains("steps towards mechanical equilibrium"), "{}", a.reason);
+    assert!(a.reason.contains("the shear by up to"), "{}", a.reason);
     assert_eq!(a.tolerance_deg, 0.1);
     let e = a.error_max_deg.unwrap();
     assert!((0.15..1.4).contains(&e), "{e} deg from the pressed drape");
@@ -533,14 +534,14 @@ fn the_study_says_so_where_auto_is_outside_its_tolerance() {
 /// The bundled cone asks for auto. Its kinematic net is symmetric and unsheared, but under
 /// gravity the pressed ply slides down the slant (53 deg walls, friction 0.25) by most of a
 /// millimetre until its stiff fibres, tightening round the cone, press it on hard enough for
-/// friction to hold it; that changes the shear by about 1 deg, and one step of the model shows
-/// a few hundredths of it. The probe goes on until the nodes settle, so it sees the slide: at
-/// the default 1 deg tolerance the change on the smooth surface is within the model's share
-/// (the spacing needs almost none of it on a developable tool) and the kinematic net is kept;
-/// at 0.5 deg auto runs mechanics, which goes on from where the probe stopped (its start lies
-/// below the kinematic net's energy) to equilibrium. Frictionless and held by nothing, the ply
-/// may turn freely about the cone's axis: auto keeps the kinematic net (the ply as laid and
-/// held) and says NOT ASSURED.
+/// friction to hold it; that changes the shear by about 1 deg. The net on the facets, pressed
+/// onto the smooth tool, passes through larger changes on its way (the probe's limit of steps
+/// stops it there), so auto probes the net on the smooth surface too, which settles: at the
+/// default 1 deg tolerance its change is within the model's share (the spacing needs almost
+/// none of it on a developable tool) and the kinematic net on the smooth surface is kept; at
+/// 0.5 deg auto runs mechanics, which shears the ply by as much as the settled probe said.
+/// Frictionless and held by nothing, the ply may turn freely about the cone's axis: auto keeps
+/// the kinematic net (the ply as laid and held) and says NOT ASSURED.
 #[test]
 fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there() {
     let dir = tempfile::tempdir().unwrap();
@@ -549,9 +550,10 @@ fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there
     let row = &read_json(&out.join("layup.json"))["plies"][0];
     assert_eq!(row["method"], "kinematic", "{row}");
     let reason = row["method_choice"]["reason"].as_str().unwrap();
-    assert!(reason.contains("is kept"), "{reason}");
-    let probe = row["method_choice"]["indicators"]["equilibrium_step_deg"].as_f64().unwrap();
-    assert!((0.5..1.2).contains(&probe), "{reason}");
+    assert!(reason.contains("the kinematic net on the smooth surface is kept"), "{reason}");
+    assert_eq!(row["method_choice"]["surface"], "smooth", "{row}");
+    let probe = row["method_choice"]["indicators"]["smooth_equilibrium_step_deg"].as_f64().unwrap();
+    assert!((0.5..0.99).contains(&probe), "{reason}");
     let out = dir.path().join("frictionless");
     let scene = cone_scene(dir.path(), 1.0, "\nfriction = 0.0");
     drape().arg("run").arg(scene).arg("--out").arg(&out).assert().success();
@@ -568,8 +570,8 @@ fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there
     let choice = &row["method_choice"];
     let ind = &choice["indicators"];
     let steps = ind["probe_iterations"].as_u64().unwrap();
-    assert!((4..=drape::layup::auto::PROBE_MAX_ITERATIONS as u64).contains(&steps), "{ind}");
-    let probe = ind["equilibrium_step_deg"].as_f64().unwrap();
+    assert!((1..=drape::layup::auto::PROBE_MAX_ITERATIONS as u64).contains(&steps), "{ind}");
+    let probe = ind["smooth_equilibrium_step_deg"].as_f64().unwrap();
     assert!((0.5..1.2).contains(&probe), "{ind}");
     let net = read_json(&out.join("p0.drape.json"));
     let solver = &net["meta"]["solver"];
@@ -580,16 +582,14 @@ fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there
         solver["energy_final"].as_f64().unwrap(),
     );
     assert!(end <= start && start < kinematic, "{kinematic} -> {start} -> {end}");
-    // The probe stopped once the nodes settled, short of equilibrium: mechanics had iterations
-    // left to do from its state.
     assert!(solver["iterations"].as_u64().unwrap() >= 1, "{}", solver["iterations"]);
-    // What the probe saw is what mechanics did: the refined net's largest change of cell shear
-    // from the kinematic net agrees with the probe's to a tenth of the model's budget.
+    // What the settled probe saw is what mechanics did: the refined net's largest change of
+    // cell shear from the kinematic net agrees with the probe's to a quarter of the tolerance.
     let change = net["meta"]["change_from_kinematic"]["shear_deg"]
         .as_array()
         .unwrap()
         .iter()
         .filter_map(|v| v.as_f64())
         .fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!((change - probe).abs() < 0.05, "mechanics changed the shear by {change} deg, the probe saw {probe} deg");
+    assert!((change - probe).abs() < 0.125, "mechanics changed the shear by {change} deg, the probe saw {probe} deg");
 }

@@ -359,3 +359,49 @@ fn the_contact_of_a_refined_net_reads_back_from_its_json_and_with_vtk_from_its_v
         "interior pressures against {expected} Pa"
     );
 }
+
+/// The speed-accuracy study's friction axis on a half cylinder (developable: the kinematic net
+/// is exact): the ply's own friction (0.3) draws the reference; a firmer grip (0.6) holds the ply
+/// where the reference lies, within 0.5 deg, and without friction the ply slides, a named outcome
+/// on the chart's table, never an error measured from where it happened to stop.
+#[test]
+fn the_speed_accuracy_study_takes_friction_as_an_axis() {
+    let (r, angle) = (0.12, 40.0);
+    let tmp = tempfile::tempdir().unwrap();
+    let scene =
+        half_cylinder_scene(tmp.path(), r, &format!("angle_deg = {angle}\nfriction = 0.3\nmethod = \"mechanical\""));
+    let out = tmp.path().join("study");
+    let run = assert_cmd::Command::cargo_bin("drape")
+        .unwrap()
+        .args(["study", "speed-accuracy"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .args(["--spacings", "0.005", "--mechanical-spacings", "0.005", "--repeats", "1", "--frictions", "0.6,0"])
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    let sa: drape::study::speed_accuracy::SpeedAccuracy =
+        serde_json::from_str(&std::fs::read_to_string(out.join("speed_accuracy.json")).unwrap()).unwrap();
+    assert_eq!(sa.reference.method, "mechanical-pressed", "{}", sa.reference.why);
+    let at = |mu: Option<f64>| sa.points.iter().find(|p| p.method == "mechanical-pressed" && p.friction == mu).unwrap();
+    assert_eq!(at(None).outcome, "ok");
+    let firm = at(Some(0.6));
+    assert_eq!(firm.outcome, "ok");
+    let e = firm.error_max_deg.unwrap();
+    assert!(e < 0.5, "friction 0.6 against 0.3: {e} deg");
+    assert_eq!(at(Some(0.0)).outcome, "slides");
+    assert!(stdout.contains("mechanical-pressed mu=0.6"), "{stdout}");
+    assert!(stdout.contains("mechanical-pressed mu=0 "), "{stdout}");
+    // A friction that is no coefficient is refused before anything runs.
+    assert_cmd::Command::cargo_bin("drape")
+        .unwrap()
+        .args(["study", "speed-accuracy"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(tmp.path().join("bad"))
+        .args(["--frictions", "-0.1"])
+        .assert()
+        .code(2);
+    assert!(!tmp.path().join("bad").join("speed_accuracy.json").exists());
+}

@@ -74,6 +74,11 @@ pub struct SpeedAccuracyArgs {
     /// Timed repeats of each kinematic case (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub repeats: usize,
+    /// Coefficients of friction between ply and tool, comma-separated: the pressed mechanical
+    /// drape runs again at each (at the mechanical spacings), measured against the reference
+    /// drawn with the ply's own friction.
+    #[arg(long, value_delimiter = ',')]
+    pub frictions: Vec<f64>,
 }
 
 /// Arguments of `drape study stability`.
@@ -140,6 +145,7 @@ pub fn run(a: StudyArgs) -> Result<(), Failure> {
                 mechanical_spacings: none_if_empty(s.mechanical_spacings),
                 tools: s.common.tools.clone(),
                 repeats: s.repeats,
+                frictions: s.frictions,
             };
             let plan = speed_accuracy::plan(&scene, &opts).map_err(study_failure)?;
             execute(&plan, &s.common)
@@ -254,7 +260,7 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                 let e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.4}"));
                 println!(
                     "{:<22} {:>9.5} {:>8} {:>9} {:>10.4} {:>11} {:>11} {:>11}{}  {}{}",
-                    p.method,
+                    p.method_label(),
                     p.spacing,
                     p.surface,
                     p.tool_triangles,

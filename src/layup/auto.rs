@@ -486,6 +486,9 @@ pub fn choose(
     let steps = |p: &Probe| match p.iterations {
         0 => "the kinematic net is in mechanical equilibrium already (no step taken); the model changes".to_string(),
         1 => "one step towards mechanical equilibrium changes".to_string(),
+        n if p.unsettled => {
+            format!("{n} steps towards mechanical equilibrium (the probe's limit, the nodes still moving) change")
+        }
         n => format!("{n} steps towards mechanical equilibrium change"),
     };
     let (mechanical, mut reason) = match &step {
@@ -641,6 +644,9 @@ struct Probe {
     residual: f64,
     /// Iterations taken.
     iterations: usize,
+    /// Whether it stopped at the iteration limit before the nodes settled: its change is then
+    /// a state on the way, not where the ply goes.
+    unsettled: bool,
     /// The positions where it stopped, one per node of the net it started from.
     state: Vec<Point>,
     /// Where the pressed model finds that nothing holds the ply on the tool: why, in words.
@@ -673,6 +679,7 @@ fn equilibrium_probe(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Res
         change_deg,
         residual: report.residual,
         iterations: report.iterations.len(),
+        unsettled: refined.outcome() == crate::mechanics::solver::Outcome::IterationLimit,
         slides: refined.slide.as_ref().map(|s| s.describe()),
         state: refined.net.positions,
     })

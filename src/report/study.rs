@@ -64,7 +64,7 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
 /// The series a run belongs to: its method and surface, and its tool where the study ran on
 /// several.
 fn series_name(p: &SpeedPoint, several_tools: bool) -> String {
-    let mut name = format!("{} ({})", p.method, p.surface);
+    let mut name = format!("{} ({})", p.method_label(), p.surface);
     if several_tools {
         name += &format!(" [{} tri]", p.tool_triangles);
     }
@@ -313,7 +313,7 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                     .iter()
                     .filter_map(|p| {
                         let m = p.reference_image.filter(|m| *m != FabricImage::AsIs)?;
-                        Some(format!("{} ({}, d = {:.4} m): {}", p.method, p.surface, p.spacing, m.name()))
+                        Some(format!("{} ({}, d = {:.4} m): {}", p.method_label(), p.surface, p.spacing, m.name()))
                     })
                     .collect();
                 format!(

@@ -74,6 +74,10 @@ pub struct Options {
     pub tools: Vec<PathBuf>,
     /// Repeats of each kinematic case (the median time is reported); mechanical cases run once.
     pub repeats: usize,
+    /// Further coefficients of friction between ply and tool: the pressed mechanical drape runs
+    /// again at each (on the scene's tool, at the mechanical spacings), measured against the
+    /// one reference drawn with the ply's own friction: what friction changes, and what it costs.
+    pub frictions: Vec<f64>,
 }
 
 /// The methods that apply to `ply`.
@@ -221,6 +225,18 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
     if finest != tools[0] {
         mechanical_tools.push(finest.clone());
     }
+    if opts.frictions.iter().any(|mu| !(mu.is_finite() && *mu >= 0.0)) {
+        return Err(StudyError::Input(format!(
+            "frictions must be coefficients of 0 or more, got {:?}",
+            opts.frictions
+        )));
+    }
+    if !opts.frictions.is_empty() && !methods.contains(&StudyMethod::MechanicalPressed) {
+        return Err(StudyError::Input(format!(
+            "--frictions: ply {} has no pressed mechanical drape to vary the friction of (give it a material card; a free drape's friction is its stability study's axis)",
+            ply.settings.name
+        )));
+    }
     let mut cases = Vec::new();
     for method in methods {
         let (ds, ts, repeats) = if method.is_mechanical() {
@@ -239,6 +255,17 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
                 let params = BTreeMap::from([("spacing".to_string(), spacing)]);
                 cases.push(Case { index: cases.len(), variant, params, repeats, keep_field: true });
             }
+        }
+    }
+    // The friction axis: the pressed drape again at each coefficient.
+    for &mu in &opts.frictions {
+        for &spacing in &mech {
+            let variant = Variant {
+                friction: Some(mu),
+                ..Variant::baseline(StudyMethod::MechanicalPressed, tools[0].clone(), spacing)
+            };
+            let params = BTreeMap::from([("spacing".to_string(), spacing), ("friction".to_string(), mu)]);
+            cases.push(Case { index: cases.len(), variant, params, repeats: 1, keep_field: true });
         }
     }
     Ok(Plan {
@@ -424,6 +451,9 @@ pub struct OwnLimit {
     pub surface: String,
     /// Triangles of its tool.
     pub tool_triangles: usize,
+    /// The friction its cases set (the friction axis); absent for the ply's own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
     /// How its runs are carried to their limit.
     pub convergence: Convergence,
 }
@@ -439,6 +469,10 @@ pub struct SpeedPoint {
     pub surface: String,
     /// Triangles of the tool.
     pub tool_triangles: usize,
+    /// The coefficient of friction the case sets (the friction axis); absent where the ply's own
+    /// applies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
     /// Median time of the repeats, s.
     pub time_s: f64,
     /// Repeats timed.
@@ -467,6 +501,16 @@ pub struct SpeedPoint {
     /// On a symmetric scene: the image of the reference the errors are measured against.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_image: Option<FabricImage>,
+}
+
+impl SpeedPoint {
+    /// Its method for people: the method, and the friction where the case sets it.
+    pub fn method_label(&self) -> String {
+        match self.friction {
+            Some(mu) => format!("{} mu={}", self.method, three_figures(mu)),
+            None => self.method.clone(),
+        }
+    }
 }
 
 /// What `method = "auto"` saved at one spacing: its result against the reference and its cost
@@ -768,7 +812,9 @@ fn reference_of(plan: &Plan, records: &[CaseRecord]) -> (Reference, Option<Shear
     };
     let mut skipped: Vec<&str> = Vec::new();
     for model in &spec.models {
-        let runs = runs_of(records, |v| v.method == model.method && v.surface == model.surface && v.tool == spec.tool);
+        let runs = runs_of(records, |v| {
+            v.method == model.method && v.surface == model.surface && v.tool == spec.tool && v.friction.is_none()
+        });
         let Some((field, convergence)) = limit(&runs, formal_order(model.method)) else {
             skipped.push(model.method.name());
             continue;
@@ -787,6 +833,7 @@ fn reference_of(plan: &Plan, records: &[CaseRecord]) -> (Reference, Option<Shear
                 let v = &r.case.variant;
                 v.method == model.method
                     && v.surface == model.surface
+                    && v.friction.is_none()
                     && v.tool != spec.tool
                     && (v.spacing - df).abs() <= SAME_SPACING_REL * df
             })
@@ -814,14 +861,20 @@ fn reference_of(plan: &Plan, records: &[CaseRecord]) -> (Reference, Option<Shear
 /// Each method's own limit (per surface and tool) and every run's distance from it.
 fn own_limits(plan: &Plan, records: &[CaseRecord], points: &mut [SpeedPoint]) -> Vec<OwnLimit> {
     // Auto draws each spacing with the model it chooses there: it has no limit of its own.
-    let mut groups: BTreeMap<(StudyMethod, &str, &Path), Vec<usize>> = BTreeMap::new();
+    // A friction the case sets is another model (its bits: f64 is not Ord).
+    let mut groups: BTreeMap<(StudyMethod, &str, &Path, Option<u64>), Vec<usize>> = BTreeMap::new();
     for (k, r) in records.iter().enumerate().filter(|(_, r)| r.case.variant.method != StudyMethod::Auto) {
         let v = &r.case.variant;
-        groups.entry((v.method, v.surface.name(), v.tool.as_path())).or_default().push(k);
+        groups.entry((v.method, v.surface.name(), v.tool.as_path(), v.friction.map(f64::to_bits))).or_default().push(k);
     }
     let mut out = Vec::new();
-    for ((method, surface, tool), ks) in groups {
-        let runs = runs_of(records, |v| v.method == method && v.surface.name() == surface && v.tool.as_path() == tool);
+    for ((method, surface, tool, friction), ks) in groups {
+        let runs = runs_of(records, |v| {
+            v.method == method
+                && v.surface.name() == surface
+                && v.tool.as_path() == tool
+                && v.friction.map(f64::to_bits) == friction
+        });
         if runs.len() < 2 {
             continue;
         }
@@ -838,6 +891,7 @@ fn own_limits(plan: &Plan, records: &[CaseRecord], points: &mut [SpeedPoint]) ->
             method: method.name().into(),
             surface: surface.into(),
             tool_triangles: records[ks[0]].result.tool_triangles,
+            friction: friction.map(f64::from_bits),
             convergence,
         });
     }
@@ -853,6 +907,7 @@ pub fn evaluate(plan: &Plan, records: &[CaseRecord]) -> SpeedAccuracy {
             spacing: r.case.variant.spacing,
             surface: r.case.variant.surface.name().into(),
             tool_triangles: r.result.tool_triangles,
+            friction: r.case.variant.friction,
             time_s: r.result.time_s,
             repeats: r.result.times_s.len(),
             error_max_deg: None,
@@ -908,7 +963,10 @@ fn auto_costs(records: &[CaseRecord], points: &[SpeedPoint]) -> Vec<AutoCost> {
     let mechanical = |r: &CaseRecord| {
         records.iter().zip(points).find(|(m, _)| {
             let (a, b) = (&m.case.variant, &r.case.variant);
-            a.method == StudyMethod::MechanicalPressed && a.spacing == b.spacing && a.tool == b.tool
+            a.method == StudyMethod::MechanicalPressed
+                && a.friction.is_none()
+                && a.spacing == b.spacing
+                && a.tool == b.tool
         })
     };
     records
@@ -932,7 +990,9 @@ fn auto_costs(records: &[CaseRecord], points: &[SpeedPoint]) -> Vec<AutoCost> {
                 cost_ratio: mech_time.map(|m| p.time_s / m),
                 mechanical_within_tolerance_s: points
                     .iter()
-                    .filter(|m| m.method == StudyMethod::MechanicalPressed.name() && m.outcome == "ok")
+                    .filter(|m| {
+                        m.method == StudyMethod::MechanicalPressed.name() && m.friction.is_none() && m.outcome == "ok"
+                    })
                     .filter(|m| m.error_max_deg.is_some_and(|e| e <= c.tolerance_deg) && m.time_s > 0.0)
                     .map(|m| m.time_s)
                     .reduce(f64::min),
