@@ -10,6 +10,7 @@ mod chebyshev_reference;
 mod cli;
 mod cut_lines;
 mod developable;
+mod draw_in;
 mod energy_derivatives;
 mod energy_parallel;
 mod energy_sparse;

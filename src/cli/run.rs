@@ -135,7 +135,7 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
 /// The layup table: one row per ply in stacking order.
 fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     let mut out = format!(
-        "layup: {} plies on {}\n{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
+        "layup: {} plies on {}\n{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10} {:>9}\n",
         scene.layup.plies.len(),
         scene.tool.display(),
         "ply",
@@ -149,16 +149,17 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         "coverage",
         "fabric",
         "mass",
-        "offset"
+        "offset",
+        "draw-in"
     );
     out += &format!(
-        "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10}\n",
-        "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm"
+        "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10} {:>9}\n",
+        "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm", "mm"
     );
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         let s = &r.stats;
         out += &format!(
-            "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3}\n",
+            "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3} {:>9}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
             format!(
@@ -186,7 +187,18 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
             s.fabric_area,
             s.fabric_mass.map_or("-".to_string(), |m| format!("{m:.4}")),
             r.offset.max_distance * 1e3,
+            r.net
+                .meta
+                .draw_in
+                .as_ref()
+                .and_then(|d| d.largest_overall())
+                .map_or("-".to_string(), |e| format!("{:.2}", e.draw_in_m * 1e3)),
         );
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if let Some(d) = &r.net.meta.draw_in {
+            out += &format!("draw-in: ply '{}': {}\n", ply.settings.name, d.describe());
+        }
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         if let Some(refined) = &r.refined {

@@ -2,6 +2,7 @@
 //! other node as the intersection of the tool with a circle of points at distance d from two
 //! placed neighbours.
 pub mod coverage;
+pub mod draw_in;
 pub mod fabric_field;
 pub mod fishnet;
 pub mod generators;

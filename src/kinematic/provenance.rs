@@ -57,6 +57,9 @@ pub struct Provenance {
     /// For a refined net: how each node meets the tool (friction, stick and slip, pressure).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactRecord>,
+    /// How far the blank's edge moved in towards the seed, in plan ([`super::draw_in`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draw_in: Option<DrawIn>,
     /// For a ply draped with `method = "auto"`: what was chosen and why.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method_choice: Option<MethodChoice>,
@@ -372,6 +375,144 @@ impl Provenance {
         match serde_json::to_value(self) {
             Ok(Value::Object(map)) => map,
             _ => unreachable!("provenance serialises to a JSON object"),
+        }
+    }
+}
+
+/// A line through the origin node of the grid: a fibre or a diagonal, and which way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum DrawInLine {
+    /// Along the warp, away from the origin row (i increasing).
+    #[serde(rename = "+warp")]
+    WarpPlus,
+    /// Along the weft (j increasing).
+    #[serde(rename = "+weft")]
+    WeftPlus,
+    /// Along the warp, i decreasing.
+    #[serde(rename = "-warp")]
+    WarpMinus,
+    /// Along the weft, j decreasing.
+    #[serde(rename = "-weft")]
+    WeftMinus,
+    /// The diagonal of i and j increasing.
+    #[serde(rename = "+warp+weft")]
+    PlusPlus,
+    /// The diagonal of i decreasing, j increasing.
+    #[serde(rename = "-warp+weft")]
+    MinusPlus,
+    /// The diagonal of i and j decreasing.
+    #[serde(rename = "-warp-weft")]
+    MinusMinus,
+    /// The diagonal of i increasing, j decreasing.
+    #[serde(rename = "+warp-weft")]
+    PlusMinus,
+}
+
+impl DrawInLine {
+    /// The eight lines: the fibres first, then the diagonals.
+    pub const ALL: [DrawInLine; 8] = [
+        DrawInLine::WarpPlus,
+        DrawInLine::WeftPlus,
+        DrawInLine::WarpMinus,
+        DrawInLine::WeftMinus,
+        DrawInLine::PlusPlus,
+        DrawInLine::MinusPlus,
+        DrawInLine::MinusMinus,
+        DrawInLine::PlusMinus,
+    ];
+
+    /// One step along it on the grid, (di, dj).
+    pub fn step(self) -> (isize, isize) {
+        match self {
+            DrawInLine::WarpPlus => (1, 0),
+            DrawInLine::WeftPlus => (0, 1),
+            DrawInLine::WarpMinus => (-1, 0),
+            DrawInLine::WeftMinus => (0, -1),
+            DrawInLine::PlusPlus => (1, 1),
+            DrawInLine::MinusPlus => (-1, 1),
+            DrawInLine::MinusMinus => (-1, -1),
+            DrawInLine::PlusMinus => (1, -1),
+        }
+    }
+
+    /// Whether it runs along a fibre (else a diagonal).
+    pub fn is_fibre(self) -> bool {
+        let (di, dj) = self.step();
+        di == 0 || dj == 0
+    }
+
+    /// Its name in files and tables (`+warp`, `-warp+weft`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            DrawInLine::WarpPlus => "+warp",
+            DrawInLine::WeftPlus => "+weft",
+            DrawInLine::WarpMinus => "-warp",
+            DrawInLine::WeftMinus => "-weft",
+            DrawInLine::PlusPlus => "+warp+weft",
+            DrawInLine::MinusPlus => "-warp+weft",
+            DrawInLine::MinusMinus => "-warp-weft",
+            DrawInLine::PlusMinus => "+warp-weft",
+        }
+    }
+}
+
+/// The blank's edge on one line through the origin node.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EdgeDrawIn {
+    /// Which line.
+    pub line: DrawInLine,
+    /// The edge node (i, j): the last node the net reaches along the line.
+    pub node: [usize; 2],
+    /// Its distance from the origin node in the flat blank, m.
+    pub flat_m: f64,
+    /// Its distance from the origin node in plan, as draped, m.
+    pub plan_m: f64,
+    /// `flat_m - plan_m`, m: how far the edge moved in towards the seed (negative: out).
+    pub draw_in_m: f64,
+}
+
+/// A ply's draw-in (`meta.draw_in` in the net's JSON; its largest in the layup table).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DrawIn {
+    /// The unit normal of the plan the distances are measured in.
+    pub plan_normal: [f64; 3],
+    /// Where the plan normal comes from: `sheet` (a flat start's normal) or `seed` (the ply's
+    /// normal at its origin node).
+    pub plan_from: String,
+    /// One per line the net reaches beyond its origin node, fibres first.
+    pub edges: Vec<EdgeDrawIn>,
+}
+
+impl DrawIn {
+    /// The edge of the largest draw-in along the fibres, or along the diagonals.
+    pub fn largest(&self, fibres: bool) -> Option<&EdgeDrawIn> {
+        self.edges.iter().filter(|e| e.line.is_fibre() == fibres).max_by(|a, b| a.draw_in_m.total_cmp(&b.draw_in_m))
+    }
+
+    /// The edge of the largest draw-in on any line.
+    pub fn largest_overall(&self) -> Option<&EdgeDrawIn> {
+        self.edges.iter().max_by(|a, b| a.draw_in_m.total_cmp(&b.draw_in_m))
+    }
+
+    /// The draw-in in a few words, millimetres.
+    pub fn describe(&self) -> String {
+        let part = |fibres: bool, what: &str| {
+            self.largest(fibres).map(|e| format!("{what} up to {:.2} mm ({})", e.draw_in_m * 1e3, e.line.name()))
+        };
+        let parts: Vec<String> =
+            [part(true, "along the fibres"), part(false, "along the diagonals")].into_iter().flatten().collect();
+        if parts.is_empty() {
+            "no draw-in measured (the net reaches no node beyond its origin)".into()
+        } else {
+            format!("draw-in {} in the plan normal to {}", parts.join(", "), self.plan_from_words())
+        }
+    }
+
+    fn plan_from_words(&self) -> &'static str {
+        if self.plan_from == "sheet" {
+            "the flat sheet"
+        } else {
+            "the ply at its seed"
         }
     }
 }

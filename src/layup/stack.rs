@@ -313,6 +313,12 @@ pub fn drape_layup(
             None => (start_net, None, None),
         };
         net.meta.method_choice = choice.clone();
+        // The draw-in, in the plan of the flat sheet, else of the ply at its seed.
+        let plan = match start {
+            Start::Flat { normal } => Some((normal, "sheet")),
+            Start::Kinematic => crate::kinematic::draw_in::seed_normal(&net).map(|n| (n, "seed")),
+        };
+        net.meta.draw_in = plan.and_then(|(n, from)| crate::kinematic::draw_in::draw_in(&net, &n, from));
         // What later stages (exports, reports) need to know about the ply.
         net.meta.stack_offset_max_m = Some(offset.max_distance);
         net.meta.angle_deg = ply.angle_deg();

@@ -6,7 +6,7 @@ use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
 use crate::kinematic::coverage::SurfaceCoverage;
-use crate::kinematic::provenance::{ContactSummary, Stability};
+use crate::kinematic::provenance::{ContactSummary, DrawIn, Stability};
 use crate::kinematic::MethodChoice;
 use serde::{Deserialize, Serialize};
 
@@ -177,6 +177,10 @@ pub struct LayupRow {
     /// Offset vertices moved off their normals to bridge tight concave corners.
     #[serde(default)]
     pub offset_bridged_vertices: Option<usize>,
+    /// How far the blank's edge moved in towards the seed, in plan, along the fibres and the
+    /// diagonals through the origin node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draw_in: Option<DrawIn>,
     /// When the ply shears past the angle its material card's shear law was calibrated to:
     /// the warning ([`shear_range_warning`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -280,6 +284,7 @@ impl LayupRow {
             offset_folded_triangles: Some(result.offset.folded),
             offset_bridged_vertices: Some(result.offset.relaxed),
             shear_range_warning: shear_range_warning(ply, result),
+            draw_in: result.net.meta.draw_in.clone(),
             // Filled in by the run from the ply's pattern.
             pattern_cut: None,
             pattern_margin_m: None,

@@ -267,7 +267,7 @@ fn export_section(h: &mut String, e: &crate::layup::table::ExportRow) {
 fn layup_table(h: &mut String, rows: &[LayupRow]) {
     let _ = writeln!(
         h,
-        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage (share of the tool or outline covered)</th><th>draped area (m²)</th><th>offset (mm)</th></tr>"
+        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage (share of the tool or outline covered)</th><th>draped area (m²)</th><th>offset (mm)</th><th>draw-in (mm, fibres / diagonals)</th></tr>"
     );
     for r in rows {
         let material = r
@@ -276,7 +276,7 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             .map(|m| std::path::Path::new(m).file_stem().map_or(m.to_string(), |s| s.to_string_lossy().into_owned()));
         let _ = writeln!(
             h,
-            "<tr class=\"ply\"><td class=\"t\"><a href=\"#ply-{0}\">{0}</a></td><td class=\"t\">{1}</td><td>{2}</td><td class=\"t\">{3}</td><td>{4}</td><td>{5}</td><td>{6}</td><td>{7}</td><td>{8}</td><td>{9}</td><td>{10}</td></tr>",
+            "<tr class=\"ply\"><td class=\"t\"><a href=\"#ply-{0}\">{0}</a></td><td class=\"t\">{1}</td><td>{2}</td><td class=\"t\">{3}</td><td>{4}</td><td>{5}</td><td>{6}</td><td>{7}</td><td>{8}</td><td>{9}</td><td>{10}</td><td>{11}</td></tr>",
             escape(&r.name),
             escape(material.as_deref().unwrap_or("—")),
             num(r.angle_deg, 1),
@@ -295,6 +295,10 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             },
             num(r.draped_area_m2, 4),
             num(r.offset_m.map(|o| o * 1e3), 2),
+            r.draw_in.as_ref().map_or("—".to_string(), |d| {
+                let largest = |fibres: bool| num(d.largest(fibres).map(|e| e.draw_in_m * 1e3), 1);
+                format!("{} / {}", largest(true), largest(false))
+            }),
         );
     }
     let _ = writeln!(h, "</table>");
@@ -420,6 +424,16 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
         }
     }
     rows.push(png("contact").into_iter().map(|p| (p, "stick and slip · ")).collect());
+    // The draw-in in plan is linked, not shown: a page of every ply's pictures stays a page.
+    if let Some(p) = png("draw-in") {
+        let svg = p.trim_end_matches(".png").to_string() + ".svg";
+        let _ = writeln!(
+            h,
+            "<p class=\"small\">Draw-in, the blank flat and the ply draped in plan: <a href=\"{0}\">PNG</a> · <a href=\"{1}\">SVG</a></p>",
+            escape(&p),
+            escape(&svg)
+        );
+    }
     for row in rows.iter().filter(|r| !r.is_empty()) {
         let _ = writeln!(h, "<div class=\"pair\">");
         for (p, c) in row {

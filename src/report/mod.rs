@@ -16,6 +16,9 @@
 //!   shown beside `<ply>-shear.png`; and, when the net records how it meets the tool
 //!   (`meta.contact`), `<ply>-contact.png`: the stick/slip map (cells that stick, that slid and
 //!   how far, that hang off the tool, that the user held) with the friction and the largest slip;
+//!   and, when the net records its draw-in (`meta.draw_in`), `<ply>-draw-in.png/.svg`: the blank
+//!   flat and the ply draped, in plan, with how far the edge moved in along the fibres and the
+//!   diagonals through the seed;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
 //!   nets), laminate totals, the flow-mesh export as `layup.json` records it, what each node status means, the interactive 3D view (the
 //!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
@@ -25,6 +28,7 @@
 //! Bitstream Vera licence, which allows embedding), so no system fonts are needed.
 pub mod calibration;
 pub mod change;
+mod draw_in;
 mod html;
 mod raster;
 mod render;
@@ -936,6 +940,14 @@ fn draw_ply(
             Err(why) => notes.push(format!("no change picture: {why}")),
         }
         bar.inc(1);
+    }
+    if let Some(d) = &net.meta.draw_in {
+        write_pair(
+            &name("draw-in"),
+            |r| draw_in::draw_plan(r, net, d, &input.stem),
+            |r| draw_in::draw_plan(r, net, d, &input.stem),
+            &mut files,
+        )?;
     }
     if let Some(contact) = &net.meta.contact {
         let p = name("contact.png");
