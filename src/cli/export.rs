@@ -1,16 +1,12 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
 use super::{input, Failure};
-use crate::io::flow::{check_flow, write_flow_with, FlowFormat, FlowOptions};
-use crate::io::vtk::VtuEncoding;
-use crate::io::{read_flow_mesh, read_net};
-use crate::mapping::{map_plies, PlyMap, PlyToMap};
-use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP};
-use crate::material::MaterialCard;
-use crate::pipeline::unit_scale;
+use crate::io::read_net;
+use crate::mapping::PlyMap;
+use crate::material::flow::{Cavity, VF_CAP};
+use crate::pipeline::export::{export_net, ExportOptions};
 use clap::{Args, ValueEnum};
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::PathBuf;
 
 /// Cavity on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -66,89 +62,35 @@ pub struct ExportArgs {
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Failure> {
-    let format: FlowFormat = a.format.parse().map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
-    let vtu: VtuEncoding = a.vtu.parse().map_err(|m| input(anyhow::anyhow!("--vtu: {m}")))?;
-    let scale = unit_scale(&a.mesh_units).map_err(|m| input(anyhow::anyhow!("--mesh-units: {m}")))?;
-    if let Some(t) = a.thickness {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(input(anyhow::anyhow!("--thickness must be a positive length in metres, got {t}")));
-        }
-    }
-    crate::io::calculix::check_material_name(&a.material_name)
-        .map_err(|m| input(anyhow::anyhow!("--material-name: {m}")))?;
-    check_out_file(&a.out)?;
+    let options = ExportOptions {
+        mesh_units: a.mesh_units,
+        material: a.material,
+        thickness: a.thickness,
+        cavity: match a.cavity {
+            CavityArg::Fixed => Cavity::Fixed,
+            CavityArg::Free => Cavity::Free,
+        },
+        permeability: a.permeability,
+        fibre_radius: a.fibre_radius,
+        material_name: a.material_name,
+        vtu: a.vtu,
+    };
+    let plan = options.check(&a.format, &a.out)?;
     let net = read_net(&a.net).map_err(input)?;
-    let card_path = a.material.clone().or_else(|| net.meta.material.as_ref().map(PathBuf::from));
-    let card = match &card_path {
-        Some(p) => Some(MaterialCard::load(p).map_err(|e| {
-            input(anyhow::anyhow!(
-                "{e}{}",
-                if a.material.is_none() { " (the card the net records; give --material)" } else { "" }
-            ))
-        })?),
-        None => None,
-    };
-    let permeability = if a.permeability {
-        let radius = a.fibre_radius.or(card.as_ref().and_then(|c| c.flow).map(|f| f.fibre_radius)).ok_or_else(|| {
-            input(anyhow::anyhow!(
-                "--permeability needs a fibre radius: give --fibre-radius R (m) or a --material card with a [flow] section"
-            ))
-        })?;
-        if !(radius.is_finite() && radius > 0.0) {
-            return Err(input(anyhow::anyhow!("--fibre-radius must be a positive length in metres, got {radius}")));
-        }
-        Some(PermeabilityModel { fibre_radius: radius })
-    } else {
-        None
-    };
-    let cavity = match a.cavity {
-        CavityArg::Fixed => Cavity::Fixed,
-        CavityArg::Free => Cavity::Free,
-    };
-    let t = Instant::now();
-    let mesh = read_flow_mesh(&a.mesh, scale).map_err(input)?;
-    let read_ms = t.elapsed().as_secs_f64() * 1e3;
-    let ply = PlyToMap { net: &net, card: card.as_ref(), thickness: a.thickness, permeability };
-    let t = Instant::now();
-    let map = map_plies(&mesh, &[ply], cavity, false, &mut |n| eprintln!("note: {n}")).map_err(input)?;
-    let map_ms = t.elapsed().as_secs_f64() * 1e3;
+    let done = export_net(&net, &a.mesh, &a.out, &plan, &options, &mut |n| eprintln!("note: {n}"))?;
     println!(
-        "flow mesh {}: {} nodes, {} elements (read in {read_ms:.1} ms)",
+        "flow mesh {}: {} nodes, {} elements (read in {:.1} ms)",
         a.mesh.display(),
-        mesh.nodes.len(),
-        mesh.elements.len()
+        done.mesh.nodes.len(),
+        done.mesh.elements.len(),
+        done.read_ms
     );
-    println!("{}", coverage_line(&map.plies[0]));
-    println!("  mapped in {map_ms:.1} ms");
-    let options = FlowOptions { material_name: a.material_name.clone(), vtu };
-    for n in check_flow(&mesh, &map, format, &a.out, &options).map_err(super::write_failure)? {
-        eprintln!("note: {n}");
-    }
-    let written = write_flow_with(&mesh, &map, format, &a.out, &options).map_err(super::write_failure)?;
-    for p in written {
+    println!("{}", coverage_line(&done.map));
+    println!("  mapped in {:.1} ms", done.map_ms);
+    for p in done.files {
         println!("  wrote {}", p.display());
     }
     Ok(())
-}
-
-/// Check `--out` before anything is read: a file name (not a folder) whose folder is created
-/// like `drape run` creates its folder, and can be written.
-fn check_out_file(out: &Path) -> Result<(), Failure> {
-    let bad = |why: String| input(anyhow::anyhow!("--out {}: {why}", out.display()));
-    if out.is_dir() {
-        return Err(bad("is a folder: give a file name, like flow.vtu".into()));
-    }
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(parent).map_err(|e| {
-        bad(format!("cannot create its folder {} ({e}): give a path you can write to", parent.display()))
-    })?;
-    let probe = parent.join(format!(".drape-probe-{}", std::process::id()));
-    let probed = std::fs::write(&probe, b"");
-    let _ = std::fs::remove_file(&probe);
-    probed.map_err(|e| bad(format!("cannot write into {} ({e}): give a folder you can write to", parent.display())))
 }
 
 /// One line on a mapped ply: elements covered and their shear.

@@ -1,15 +1,9 @@
 //! `drape kinematic`: one ply from command-line arguments.
 use super::summary::summary_with;
 use super::{input, parse_pair, parse_vec3, Failure};
-use crate::geometry::{Point, ToolSurface, Vector};
-use crate::io::points::read_points;
+use crate::geometry::ToolSurface;
 use crate::io::{write_net_shears, Format};
-use crate::kinematic::fishnet::check_settings;
-use crate::kinematic::{drape, Extent, KinematicSettings, SurfaceKind};
-use crate::layup::auto::{drape_auto, DEFAULT_TOLERANCE_DEG};
-use crate::layup::{locking_angle_deg, AutoModel, Refinement};
-use crate::material::MaterialCard;
-use crate::pipeline::{parse_generators, unit_scale};
+use crate::pipeline::ply::{check_converged, read_tool, PlyOptions};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -81,80 +75,41 @@ pub struct KinematicArgs {
 
 pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
-    let scale = unit_scale(&a.units).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?;
-    let card = match &a.material {
-        Some(path) => Some(MaterialCard::load(path).map_err(|e| input(anyhow::anyhow!("--material: {e}")))?),
-        None => None,
-    };
-    let (locking_angle, _) = locking_angle_deg(a.locking_angle, card.as_ref());
-    if !(locking_angle > 0.0 && locking_angle < 90.0) {
-        return Err(input(anyhow::anyhow!(
-            "--locking-angle must lie strictly between 0 and 90 degrees, got {locking_angle}"
-        )));
-    }
-    let auto = match (a.method.as_str(), a.tolerance) {
-        ("kinematic", None) => None,
-        ("kinematic", Some(_)) => return Err(input(anyhow::anyhow!("--tolerance is for --method auto"))),
-        ("auto", t) => {
-            let t = t.unwrap_or(DEFAULT_TOLERANCE_DEG);
-            if !(t.is_finite() && t > 0.0) {
-                return Err(input(anyhow::anyhow!("--tolerance must be a positive angle in degrees, got {t}")));
-            }
-            let (Some(card), Some(path)) = (card.clone(), a.material.clone()) else {
-                return Err(input(anyhow::anyhow!(
-                    "--method auto weighs the kinematic net under a material card: give --material CARD.toml"
-                )));
-            };
-            Some((AutoModel { tolerance_deg: t }, Refinement::pressed(card, path)))
-        }
-        (other, _) => return Err(input(anyhow::anyhow!("--method: unknown method '{other}': use kinematic or auto"))),
-    };
-    let base = std::env::current_dir().unwrap_or_default();
-    let generators =
-        parse_generators(&a.generators, &base, scale).map_err(|m| input(anyhow::anyhow!("--generators: {m}")))?;
-    let surface: SurfaceKind = a.surface.parse().map_err(|m| input(anyhow::anyhow!("--surface: {m}")))?;
-    let extent = match (&a.grid, &a.outline) {
-        (Some([nu, nv]), _) => Extent::Grid { nu: *nu, nv: *nv, origin_node: a.origin_node.map(|[i, j]| (i, j)) },
-        (None, Some(f)) => {
-            Extent::Outline(read_points(f, scale).map_err(|m| input(anyhow::anyhow!("--outline: {m}")))?)
-        }
-        (None, None) => return Err(input(anyhow::anyhow!("give --grid NU,NV or --outline FILE"))),
-    };
-    let settings = KinematicSettings {
-        name: a.name.clone(),
-        origin: Point::from(Vector::from(a.origin) * scale),
-        warp: Vector::from(a.warp),
-        spacing: a.spacing * scale,
-        extent,
-        pre_shear: a.pre_shear.to_radians(),
-        generators,
-        max_shear: a.max_shear.to_radians(),
-        surface,
+    let options = PlyOptions {
+        origin: a.origin,
+        warp: a.warp,
+        spacing: a.spacing,
+        grid: a.grid,
+        outline: a.outline,
+        origin_node: a.origin_node,
+        pre_shear_deg: a.pre_shear,
+        generators: a.generators,
+        max_shear_deg: a.max_shear,
+        surface: a.surface,
+        locking_angle_deg: a.locking_angle,
+        method: a.method,
+        material: a.material,
+        tolerance_deg: a.tolerance,
+        units: a.units,
+        name: a.name,
     };
     // Cheap argument checks come before the (possibly slow) tool load.
-    check_settings(&settings).map_err(input)?;
+    let ply = options.prepare()?;
     let t_load = Instant::now();
-    let tool = crate::io::read_tool(&a.tool, scale).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
+    let tool = read_tool(&a.tool, ply.scale)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
-    let mut net = match &auto {
-        None => drape(&tool, &settings).map_err(input)?,
-        Some((model, refinement)) => {
-            let chosen = drape_auto(&tool, &settings, refinement, locking_angle.to_radians(), *model)
-                .map_err(|e| input(anyhow::anyhow!("{e}")))?;
-            let mut net = chosen.refined.map_or(chosen.kinematic, |(refined, _)| refined);
-            println!("auto: ran {}: {}", chosen.choice.headline(), chosen.choice.reason);
-            net.meta.method_choice = Some(chosen.choice);
-            net
-        }
-    };
+    let mut net = ply.drape(&tool)?;
+    if let Some(choice) = &net.meta.method_choice {
+        println!("auto: ran {}: {}", choice.headline(), choice.reason);
+    }
     net.timing.load_ms = load_ms;
     net.meta.tool = Some(a.tool.display().to_string());
-    net.meta.tool_scale = Some(scale);
+    net.meta.tool_scale = Some(ply.scale);
     let t_write = Instant::now();
     let (written, shears) = write_net_shears(&net, &a.out, &formats).map_err(super::write_failure)?;
     let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
-    let locking = locking_angle.to_radians();
+    let locking = ply.locking_angle_deg.to_radians();
     // The statistics from the shears the writer's checks computed (the same figures).
     let stats = match &shears {
         Some(s) => net.shear_stats_from(s, locking),
@@ -164,16 +119,10 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
     for p in written {
         println!("  wrote {}", p.display());
     }
-    if let Some(w) = card.as_ref().and_then(|c| c.shear_range_warning(stats.max_abs.to_degrees())) {
+    if let Some(w) = ply.shear_range_warning(stats.max_abs.to_degrees()) {
         println!("warning: ply '{}': {w}", net.name);
     }
-    match &net.meta.solver {
-        Some(s) if !s.converged => Err(Failure::Compute(anyhow::anyhow!(
-            "the mechanical solver stopped without equilibrium: {}; the last accepted state was written",
-            s.reason.as_deref().unwrap_or(&s.outcome)
-        ))),
-        _ => Ok(()),
-    }
+    check_converged(&net)
 }
 
 /// One line on what the mesh checks found.

@@ -13,62 +13,9 @@ mod virtual_test;
 
 use clap::{Parser, Subcommand};
 
-/// Exit code for bad input (arguments, files, scenes).
-pub const EXIT_BAD_INPUT: i32 = 2;
-/// Exit code for a computation that failed.
-pub const EXIT_FAILED: i32 = 1;
-
-/// A failed command: what went wrong and which exit code it earns.
-#[derive(Debug)]
-pub enum Failure {
-    /// The input is wrong; the message says how to fix it (exit code 2).
-    Input(anyhow::Error),
-    /// The computation failed (exit code 1).
-    Compute(anyhow::Error),
-}
-
-impl Failure {
-    /// Process exit code.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            Failure::Input(_) => EXIT_BAD_INPUT,
-            Failure::Compute(_) => EXIT_FAILED,
-        }
-    }
-    /// The message shown to the user: each cause once (a message that already quotes its
-    /// cause, as `cannot write X: <os error>. Check...` does, does not repeat it).
-    pub fn message(&self) -> String {
-        let (Failure::Input(e) | Failure::Compute(e)) = self;
-        let mut text = String::new();
-        for cause in e.chain() {
-            let part = cause.to_string();
-            if text.is_empty() {
-                text = part;
-            } else if !text.contains(&part) {
-                text = format!("{text}: {part}");
-            }
-        }
-        text
-    }
-}
-
-/// Tag an error as bad input.
-pub(crate) fn input<E: Into<anyhow::Error>>(e: E) -> Failure {
-    Failure::Input(e.into())
-}
-/// A file that could not be written: bad input when the user's output path is at fault.
-pub(crate) fn write_failure(e: crate::io::ExportError) -> Failure {
-    if e.is_bad_input() {
-        input(e)
-    } else {
-        compute(e)
-    }
-}
-
-/// Tag an error as a failed computation.
-pub(crate) fn compute<E: Into<anyhow::Error>>(e: E) -> Failure {
-    Failure::Compute(e.into())
-}
+// The failure type lives in the library, so the Python package reports the same messages.
+pub(crate) use crate::pipeline::failure::{compute, input, write_failure};
+pub use crate::pipeline::failure::{Failure, EXIT_BAD_INPUT, EXIT_FAILED};
 
 /// Plan how composite plies lie on a part: kinematic (fishnet) drape on OBJ tool surfaces.
 #[derive(Debug, Parser)]

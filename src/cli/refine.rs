@@ -1,14 +1,14 @@
 //! `drape refine`: mechanical refinement of a kinematic net.
 use super::kinematic::print_tool_report;
 use super::summary::summary;
-use super::{compute, input, parse_vec3, Failure};
-use crate::geometry::Vector;
+use super::{input, parse_vec3, Failure};
 use crate::io::{read_net, write_net, Format};
 use crate::layup::DEFAULT_LOCKING_ANGLE_DEG;
 use crate::material::MaterialCard;
-use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
-use crate::mechanics::{ContactMode, SolverSettings};
-use crate::pipeline::unit_scale;
+use crate::mechanics::refine::Refined;
+use crate::mechanics::ContactMode;
+use crate::pipeline::ply::read_tool;
+use crate::pipeline::refine::{check_refined, refine_net, RefineOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -81,55 +81,33 @@ pub struct RefineArgs {
 
 pub fn run(a: RefineArgs) -> Result<(), Failure> {
     let formats = Format::parse_list(&a.format).map_err(|m| input(anyhow::anyhow!("--format: {m}")))?;
-    if a.load_steps == 0 {
-        return Err(input(anyhow::anyhow!("--load-steps must be at least 1")));
-    }
-    let net = read_net(&a.net).map_err(input)?;
-    let material = MaterialCard::load(&a.material).map_err(input)?;
-    let friction = a.friction.or(material.friction).unwrap_or(0.0);
-    if !(friction.is_finite() && friction >= 0.0) {
-        return Err(input(anyhow::anyhow!("--friction must be a finite number >= 0, got {friction}")));
-    }
-    let scale = match &a.units {
-        Some(u) => unit_scale(u).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?,
-        None => net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or(1.0),
-    };
-    let t_load = Instant::now();
-    let tool = crate::io::read_tool(&a.tool, scale).map_err(|e| input(anyhow::anyhow!(e.to_string())))?;
-    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
-    print_tool_report(&a.tool, &tool);
-    crate::kinematic::fishnet::check_spacing_on_tool(&tool, net.spacing)
-        .map_err(|e| input(anyhow::anyhow!("net {}: {e}", a.net.display())))?;
-    let settings = RefineSettings {
+    let options = RefineOptions {
         mode: match a.mode {
             Mode::Pressed => ContactMode::Pressed,
             Mode::Free => ContactMode::Free,
         },
-        pressed_surface: if a.facets { PressedSurface::Facets } else { PressedSurface::Smooth },
-        gravity: Vector::from(a.gravity),
+        units: a.units,
+        facets: a.facets,
+        gravity: a.gravity,
         load_steps: a.load_steps,
-        solver: SolverSettings::default().max_iterations(a.max_iterations).escape_saddles(a.escape_saddles),
-        sheet: Default::default(),
         stick: a.stick,
-        friction,
-        holds: a
-            .hold
-            .iter()
-            .map(|&(i, j)| {
-                let (i0, j0) = net.origin_node;
-                [(i as f64 - i0 as f64) * net.spacing, (j as f64 - j0 as f64) * net.spacing]
-            })
-            .collect(),
+        friction: a.friction,
+        holds: a.hold.iter().map(|&(i, j)| [i, j]).collect(),
+        escape_saddles: a.escape_saddles,
+        max_iterations: a.max_iterations,
     };
-    let t = Instant::now();
-    let refined = refine(&net, &tool, &material, &settings).map_err(input)?;
-    let solve_ms = t.elapsed().as_secs_f64() * 1e3;
-    let mut out = refined.net.clone();
-    annotate(&mut out, &net, &refined, &a.material);
+    options.check()?;
+    let net = read_net(&a.net).map_err(input)?;
+    let material = MaterialCard::load(&a.material).map_err(input)?;
+    let settings = options.settings(&net, &material)?;
+    let scale = options.tool_scale(&net)?;
+    let t_load = Instant::now();
+    let tool = read_tool(&a.tool, scale)?;
+    let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
+    print_tool_report(&a.tool, &tool);
+    let (mut out, refined) = refine_net(&net, &a.net.display().to_string(), &tool, &material, &a.material, &settings)?;
     out.timing.load_ms = load_ms;
-    out.timing.generators_ms = 0.0;
-    out.timing.fill_ms = solve_ms;
-    out.timing.total_ms = load_ms + solve_ms;
+    out.timing.total_ms += load_ms;
     // The last consistent state is written even when the solver did not converge.
     let t_write = Instant::now();
     let written = write_net(&out, &a.out, &formats).map_err(super::write_failure)?;
@@ -145,16 +123,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     if let Some(w) = material.shear_range_warning(max_shear) {
         println!("warning: ply '{}': {w}", out.name);
     }
-    if let Some(slide) = &refined.slide {
-        return Err(compute(anyhow::anyhow!("{}; the last state was written", slide.describe())));
-    }
-    if !refined.ok() {
-        return Err(compute(anyhow::anyhow!(
-            "the mechanical solver stopped without equilibrium ({:?}); the last accepted state was written. Try more --load-steps or --max-iterations",
-            refined.outcome()
-        )));
-    }
-    Ok(())
+    check_refined(&refined)
 }
 
 /// A grid node `I,J`.

@@ -2,7 +2,11 @@
 //! the tool offset by the plies below it and refined where it asks, the nets, flat patterns,
 //! nesting, layup table and flow-mesh fields written ([`run`]). The command line only prints what
 //! [`run::run`] reports.
+pub mod export;
+pub mod failure;
 pub mod folder;
+pub mod ply;
+pub mod refine;
 pub mod run;
 pub mod scene;
 

@@ -1,0 +1,146 @@
+//! A kinematic net refined mechanically from the options of `drape refine`, as library calls:
+//! the command line and the Python package both come through here.
+use super::failure::{compute, input, Failure};
+use super::unit_scale;
+use crate::geometry::{ToolSurface, Vector};
+use crate::kinematic::DrapeNet;
+use crate::material::MaterialCard;
+use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
+use crate::mechanics::{ContactMode, SolverSettings};
+use std::path::Path;
+use std::time::Instant;
+
+/// The options of `drape refine` besides its files. [`Default`] gives the command line's
+/// defaults.
+#[derive(Debug, Clone)]
+pub struct RefineOptions {
+    /// Contact with the tool: pressed (nodes slide on it) or free (gravity drape).
+    pub mode: ContactMode,
+    /// Unit of the tool file, `m` or `mm` (default: the one the net records, else m).
+    pub units: Option<String>,
+    /// Pressed nodes slide on the facets as given instead of the smooth patches.
+    pub facets: bool,
+    /// Gravity, m/s^2.
+    pub gravity: [f64; 3],
+    /// Gravity is applied in this many steps.
+    pub load_steps: usize,
+    /// Free drape: nodes the tool holds up stay where they touch.
+    pub stick: bool,
+    /// Coulomb's coefficient (default: the card's `[contact] friction`, else 0).
+    pub friction: Option<f64>,
+    /// Grid nodes held in place.
+    pub holds: Vec<[usize; 2]>,
+    /// Move off a saddle the stability check finds and iterate on.
+    pub escape_saddles: bool,
+    /// Solver iteration limit per load step.
+    pub max_iterations: usize,
+}
+
+impl Default for RefineOptions {
+    fn default() -> Self {
+        RefineOptions {
+            mode: ContactMode::Pressed,
+            units: None,
+            facets: false,
+            gravity: [0.0, 0.0, -9.80665],
+            load_steps: 1,
+            stick: false,
+            friction: None,
+            holds: Vec::new(),
+            escape_saddles: false,
+            max_iterations: 100,
+        }
+    }
+}
+
+/// A contact mode by name: `pressed` or `free`.
+pub fn parse_mode(s: &str) -> Result<ContactMode, Failure> {
+    match s.trim() {
+        "pressed" => Ok(ContactMode::Pressed),
+        "free" => Ok(ContactMode::Free),
+        other => Err(input(anyhow::anyhow!("--mode: unknown mode '{other}': use pressed or free"))),
+    }
+}
+
+impl RefineOptions {
+    /// The checks that need no file.
+    pub fn check(&self) -> Result<(), Failure> {
+        if self.load_steps == 0 {
+            return Err(input(anyhow::anyhow!("--load-steps must be at least 1")));
+        }
+        Ok(())
+    }
+
+    /// Metres per unit of the tool file: the options' units, else the ones `net` records.
+    pub fn tool_scale(&self, net: &DrapeNet) -> Result<f64, Failure> {
+        match &self.units {
+            Some(u) => unit_scale(u).map_err(|m| input(anyhow::anyhow!("--units: {m}"))),
+            None => Ok(net.meta.tool_scale.filter(|s| s.is_finite() && *s > 0.0).unwrap_or(1.0)),
+        }
+    }
+
+    /// The solver's settings for `net` under `material` (friction, holds as offsets from the
+    /// seed node).
+    pub fn settings(&self, net: &DrapeNet, material: &MaterialCard) -> Result<RefineSettings, Failure> {
+        self.check()?;
+        let friction = self.friction.or(material.friction).unwrap_or(0.0);
+        if !(friction.is_finite() && friction >= 0.0) {
+            return Err(input(anyhow::anyhow!("--friction must be a finite number >= 0, got {friction}")));
+        }
+        let (i0, j0) = net.origin_node;
+        Ok(RefineSettings {
+            mode: self.mode,
+            pressed_surface: if self.facets { PressedSurface::Facets } else { PressedSurface::Smooth },
+            gravity: Vector::from(self.gravity),
+            load_steps: self.load_steps,
+            solver: SolverSettings::default().max_iterations(self.max_iterations).escape_saddles(self.escape_saddles),
+            sheet: Default::default(),
+            stick: self.stick,
+            friction,
+            holds: self
+                .holds
+                .iter()
+                .map(|&[i, j]| [(i as f64 - i0 as f64) * net.spacing, (j as f64 - j0 as f64) * net.spacing])
+                .collect(),
+        })
+    }
+}
+
+/// Refine `net` (called `label` in messages: its file) on `tool` under `material` (read from
+/// `material_path`): the refined net, annotated with its change from `net` and the solver's
+/// record, its solve time in `timing.fill_ms`, and the solver's result.
+pub fn refine_net(
+    net: &DrapeNet,
+    label: &str,
+    tool: &ToolSurface,
+    material: &MaterialCard,
+    material_path: &Path,
+    settings: &RefineSettings,
+) -> Result<(DrapeNet, Refined), Failure> {
+    crate::kinematic::fishnet::check_spacing_on_tool(tool, net.spacing)
+        .map_err(|e| input(anyhow::anyhow!("net {label}: {e}")))?;
+    let t = Instant::now();
+    let refined = refine(net, tool, material, settings).map_err(input)?;
+    let solve_ms = t.elapsed().as_secs_f64() * 1e3;
+    let mut out = refined.net.clone();
+    annotate(&mut out, net, &refined, material_path);
+    out.timing.generators_ms = 0.0;
+    out.timing.fill_ms = solve_ms;
+    out.timing.total_ms = solve_ms;
+    Ok((out, refined))
+}
+
+/// A ply that slides or a solver that stopped short is a failed computation, reported after the
+/// last state was written.
+pub fn check_refined(refined: &Refined) -> Result<(), Failure> {
+    if let Some(slide) = &refined.slide {
+        return Err(compute(anyhow::anyhow!("{}; the last state was written", slide.describe())));
+    }
+    if !refined.ok() {
+        return Err(compute(anyhow::anyhow!(
+            "the mechanical solver stopped without equilibrium ({:?}); the last accepted state was written. Try more --load-steps or --max-iterations",
+            refined.outcome()
+        )));
+    }
+    Ok(())
+}
