@@ -26,6 +26,7 @@
 pub mod calibration;
 pub mod change;
 mod html;
+pub mod optimise;
 mod raster;
 mod render;
 pub mod shade;
