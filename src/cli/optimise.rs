@@ -72,7 +72,11 @@ fn bad(message: String) -> Failure {
 fn polygon(text: &str, scale: f64) -> Result<Vec<[f64; 3]>, Failure> {
     let path = Path::new(text);
     let points = if path.is_file() {
-        read_points(path, scale).map_err(|m| bad(format!("--seed-polygon: {m}")))?.into_iter().map(|p| p.coords.into()).collect()
+        read_points(path, scale)
+            .map_err(|m| bad(format!("--seed-polygon: {m}")))?
+            .into_iter()
+            .map(|p| p.coords.into())
+            .collect()
     } else if text.contains(';') {
         text.split(';')
             .filter(|p| !p.trim().is_empty())
@@ -107,11 +111,15 @@ pub fn run(a: OptimiseArgs) -> Result<(), Failure> {
         (None, Some(p)) => Some(SeedRegion::Polygon { points: polygon(p, s)? }),
         (None, None) => None,
     };
-    let range: Vec<f64> = a.angle_range.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(
-        |_| bad(format!("--angle-range: '{}' is not LO,HI: give two angles in degrees, like -45,45", a.angle_range)),
-    )?;
+    let range: Vec<f64> =
+        a.angle_range.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
+            bad(format!("--angle-range: '{}' is not LO,HI: give two angles in degrees, like -45,45", a.angle_range))
+        })?;
     let [lo, hi] = range[..] else {
-        return Err(bad(format!("--angle-range: '{}' is not LO,HI: give two angles in degrees, like -45,45", a.angle_range)));
+        return Err(bad(format!(
+            "--angle-range: '{}' is not LO,HI: give two angles in degrees, like -45,45",
+            a.angle_range
+        )));
     };
     let opts = opt::Options {
         ply: a.ply.clone(),

@@ -67,7 +67,13 @@ pub fn draw_landscape<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, o: &Opt
     top.draw(&Text::new(
         format!(
             "minimised: {}; best {:.4} at seed ({:.4}, {:.4}, {:.4}) m, angle {angle} (d = {} m; search at {} m)",
-            o.objective_text, o.best.objective, o.best.origin[0], o.best.origin[1], o.best.origin[2], o.best.spacing, o.search_spacing
+            o.objective_text,
+            o.best.objective,
+            o.best.origin[0],
+            o.best.origin[1],
+            o.best.origin[2],
+            o.best.spacing,
+            o.search_spacing
         ),
         (20, 40),
         (FONT, 13).into_font(),

@@ -4,8 +4,8 @@
 use super::optimise::draw_landscape;
 use super::render::{register_fonts, to_png, to_svg, DrawResult};
 use crate::kinematic::fabric_field::FabricImage;
-use crate::study::speed_accuracy::{mm, three_figures, SpeedAccuracy, SpeedPoint};
 use crate::study::optimise::Optimisation;
+use crate::study::speed_accuracy::{mm, three_figures, SpeedAccuracy, SpeedPoint};
 use crate::study::stability::Stability;
 use crate::study::Finished;
 use plotters::coord::Shift;
@@ -368,7 +368,8 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
             );
             found.push(("stability", format!("Where the methods fail, ply {} ({})", s.ply, place.display()), summary));
         }
-        if let Some(o) = read(crate::study::optimise::FILE).and_then(|t| serde_json::from_str::<Optimisation>(&t).ok()) {
+        if let Some(o) = read(crate::study::optimise::FILE).and_then(|t| serde_json::from_str::<Optimisation>(&t).ok())
+        {
             let summary = format!(
                 "Ply {}: {} candidate placements ({} draped) searched at d = {} m, the best {} refined at the ply's d = {} m. Minimised: {}. Best {:.4} at seed ({:.4}, {:.4}, {:.4}) m, angle {}; {} ready for drape run.",
                 o.ply,

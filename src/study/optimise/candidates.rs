@@ -99,11 +99,10 @@ pub fn plan(scene: &Scene, opts: &Options, tool: &ToolSurface) -> Result<Plan, S
         )));
     }
     let region = match (opts.vary_seed, &opts.region) {
-        (true, None) => {
-            return Err(bad(
-                "--vary seed needs a seed region: give --seed-radius R (around the ply's origin) or --seed-polygon FILE".into(),
-            ))
-        }
+        (true, None) => return Err(bad(
+            "--vary seed needs a seed region: give --seed-radius R (around the ply's origin) or --seed-polygon FILE"
+                .into(),
+        )),
         (false, Some(_)) => {
             return Err(bad("a seed region is given but --vary does not name seed: add it, or drop the region".into()))
         }
@@ -132,7 +131,8 @@ pub fn plan(scene: &Scene, opts: &Options, tool: &ToolSurface) -> Result<Plan, S
         (None, Some(SeedRegion::Polygon { points })) => {
             let ab: Vec<[f64; 2]> = points.iter().map(|p| frame.coordinates(&(*p).into())).collect();
             let side = |k: usize| {
-                let (lo, hi) = ab.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[k]), h.max(p[k])));
+                let (lo, hi) =
+                    ab.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[k]), h.max(p[k])));
                 hi - lo
             };
             side(0).max(side(1)) / DEFAULT_SEEDS_ACROSS

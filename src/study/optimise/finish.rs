@@ -56,7 +56,14 @@ impl Evaluator<'_> {
     }
 }
 
-fn placement(x: [f64; 3], v: &Variant, r: &CaseResult, objective: f64, frame_origin: [f64; 3], start: Start) -> Placement {
+fn placement(
+    x: [f64; 3],
+    v: &Variant,
+    r: &CaseResult,
+    objective: f64,
+    frame_origin: [f64; 3],
+    start: Start,
+) -> Placement {
     Placement {
         origin: v.origin.unwrap_or(frame_origin),
         seed_ab: [x[0], x[1]],
@@ -78,7 +85,8 @@ fn placement(x: [f64; 3], v: &Variant, r: &CaseResult, objective: f64, frame_ori
 /// Finish the optimisation planned in `plan` from its cases' records: refine, rank, write
 /// `dir/optimise.json` and `dir/optimal.toml`.
 pub fn finish(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<Optimisation, StudyError> {
-    let search = plan.search.as_ref().ok_or_else(|| StudyError::Input("the plan has no search: not an optimisation".into()))?;
+    let search =
+        plan.search.as_ref().ok_or_else(|| StudyError::Input("the plan has no search: not an optimisation".into()))?;
     let scene = Scene::load(&plan.scene).map_err(|e| StudyError::Input(e.to_string()))?;
     let base = scene
         .layup
@@ -86,7 +94,8 @@ pub fn finish(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<Optimis
         .iter()
         .find(|p| p.settings.name == plan.ply)
         .ok_or_else(|| StudyError::Input(format!("the scene has no ply '{}'", plan.ply)))?;
-    let template = records.first().ok_or_else(|| StudyError::Input("the plan has no candidate".into()))?.case.variant.clone();
+    let template =
+        records.first().ok_or_else(|| StudyError::Input("the plan has no candidate".into()))?.case.variant.clone();
     let tool = crate::io::read_tool(&template.tool, scene.scale).map_err(|e| StudyError::Input(e.to_string()))?;
     let landscape: Vec<Candidate> = records
         .iter()
@@ -151,7 +160,8 @@ pub fn finish(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<Optimis
         });
         let (x, f) = result.best;
         let (v, r) = draped.remove(&key(&x)).expect("the search's best point was draped");
-        let start = Start { candidate: c.index, search_objective, ply_spacing_objective: f0, evaluations: result.trail.len() };
+        let start =
+            Start { candidate: c.index, search_objective, ply_spacing_objective: f0, evaluations: result.trail.len() };
         refined.push(placement(x, &v, &r, f, search.frame.origin, start));
     }
     let refine_s = started.elapsed().as_secs_f64();

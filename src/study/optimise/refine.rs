@@ -64,10 +64,11 @@ pub fn pattern_search(
             seen.insert(key(y), f);
             trail.push((*y, f));
         }
-        let best = polls
-            .iter()
-            .filter_map(|y| Some((*y, (*seen.get(&key(y))?)?)))
-            .reduce(|a, b| if b.1 < a.1 { b } else { a });
+        let best =
+            polls
+                .iter()
+                .filter_map(|y| Some((*y, (*seen.get(&key(y))?)?)))
+                .reduce(|a, b| if b.1 < a.1 { b } else { a });
         match best {
             Some((y, f)) if f < fx - IMPROVEMENT * fx.abs().max(1.0) => (x, fx) = (y, f),
             _ => steps = steps.map(|s| 0.5 * s),

@@ -94,7 +94,13 @@ fn onto_tool(tool: &ToolSurface, q: &Point, n: &Vector) -> Point {
     let ahead = tool.cast_ray(q, n).map(|t| (t, q + n * t));
     let behind = tool.cast_ray(q, &-n).map(|t| (t, q - n * t));
     match (ahead, behind) {
-        (Some(a), Some(b)) => if b.0 < a.0 { b.1 } else { a.1 },
+        (Some(a), Some(b)) => {
+            if b.0 < a.0 {
+                b.1
+            } else {
+                a.1
+            }
+        }
         (Some((_, p)), None) | (None, Some((_, p))) => p,
         (None, None) => tool.closest_point(q).point,
     }
@@ -110,21 +116,21 @@ pub struct Region {
 impl Region {
     /// Check `region` on `tool`; `slack` is how far (m) polygon corners may lie off the tool.
     pub fn new(region: SeedRegion, frame: Frame, tool: &ToolSurface, slack: f64) -> Result<Region, String> {
-        let outline = match &region {
-            SeedRegion::Disc { radius } => {
-                if !(radius.is_finite() && *radius > 0.0) {
-                    return Err(format!("--seed-radius must be a positive length, got {radius}"));
+        let outline =
+            match &region {
+                SeedRegion::Disc { radius } => {
+                    if !(radius.is_finite() && *radius > 0.0) {
+                        return Err(format!("--seed-radius must be a positive length, got {radius}"));
+                    }
+                    None
                 }
-                None
-            }
-            SeedRegion::Polygon { points } => {
-                let pts: Vec<Point> = points.iter().map(|p| Point::from(*p)).collect();
-                Some(
-                    Outline::new(tool, &pts, slack)
-                        .map_err(|e| format!("--seed-polygon: {}", e.to_string().replace("ply outline", "seed polygon")))?,
-                )
-            }
-        };
+                SeedRegion::Polygon { points } => {
+                    let pts: Vec<Point> = points.iter().map(|p| Point::from(*p)).collect();
+                    Some(Outline::new(tool, &pts, slack).map_err(|e| {
+                        format!("--seed-polygon: {}", e.to_string().replace("ply outline", "seed polygon"))
+                    })?)
+                }
+            };
         Ok(Region { region, frame, outline })
     }
 
@@ -148,13 +154,12 @@ impl Region {
         // The region's box in plane coordinates.
         let (lo, hi) = match &self.region {
             SeedRegion::Disc { radius } => ([-radius, -radius], [*radius, *radius]),
-            SeedRegion::Polygon { points } => points.iter().fold(
-                ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-                |(lo, hi), p| {
+            SeedRegion::Polygon { points } => {
+                points.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
                     let c = self.frame.coordinates(&Point::from(*p));
                     ([lo[0].min(c[0]), lo[1].min(c[1])], [hi[0].max(c[0]), hi[1].max(c[1])])
-                },
-            ),
+                })
+            }
         };
         let index = |x: f64, up: bool| {
             let k = x / step;
@@ -189,7 +194,12 @@ mod tests {
 
     /// A flat square of side 2 about the origin in z = 0.
     fn square() -> ToolSurface {
-        let v = vec![Point::new(-1.0, -1.0, 0.0), Point::new(1.0, -1.0, 0.0), Point::new(1.0, 1.0, 0.0), Point::new(-1.0, 1.0, 0.0)];
+        let v = vec![
+            Point::new(-1.0, -1.0, 0.0),
+            Point::new(1.0, -1.0, 0.0),
+            Point::new(1.0, 1.0, 0.0),
+            Point::new(-1.0, 1.0, 0.0),
+        ];
         ToolSurface::from_triangles(v, vec![[0, 1, 2], [0, 2, 3]]).unwrap()
     }
 
@@ -220,7 +230,8 @@ mod tests {
         let ab: Vec<[f64; 2]> = seeds.iter().map(|s| s.ab).collect();
         assert_eq!(ab.len(), 6, "{ab:?}");
         assert!(ab.iter().all(|p| p[0] >= 0.0 && p[1] >= 0.0 && p[0] + p[1] <= 0.6 + 1e-12), "{ab:?}");
-        let bad = Region::new(SeedRegion::Polygon { points: vec![[0.0, 0.0, 0.0], [0.5, 0.0, 0.0]] }, frame, &tool, 0.01);
+        let bad =
+            Region::new(SeedRegion::Polygon { points: vec![[0.0, 0.0, 0.0], [0.5, 0.0, 0.0]] }, frame, &tool, 0.01);
         assert!(bad.err().unwrap().contains("seed polygon"));
         assert!(r.lattice(&tool, 0.0).is_err());
     }
