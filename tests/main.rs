@@ -33,6 +33,7 @@ mod mechanics_shear_tests;
 mod module_layers;
 mod net_properties;
 mod offset_bladelike;
+mod optimise;
 mod report;
 mod sphere_chebyshev;
 mod study;

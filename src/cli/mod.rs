@@ -3,6 +3,7 @@ mod bench;
 mod calibrate;
 mod export;
 mod kinematic;
+mod optimise;
 mod progress;
 mod refine;
 mod report;
@@ -46,6 +47,8 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Studies of one ply: speed against accuracy, where methods fail; sharded, resumable.
     Study(study::StudyArgs),
+    /// The best seed and angle of a ply: a global search of candidate drapes, refined locally.
+    Optimise(optimise::OptimiseArgs),
 }
 
 /// Run a parsed command line.
@@ -60,6 +63,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Export(a) => export::run(a),
         Command::Report(a) => report::run(a),
         Command::Study(a) => study::run(a),
+        Command::Optimise(a) => optimise::run(a),
     }
 }
 

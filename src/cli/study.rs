@@ -187,29 +187,52 @@ pub fn run(a: StudyArgs) -> Result<(), Failure> {
 }
 
 fn execute(plan: &Plan, c: &Common) -> Result<(), Failure> {
-    if let Some(n) = c.slurm {
+    execute_plan(plan, &c.out, c.shard.as_deref(), c.jobs, c.slurm)
+}
+
+/// Run `plan` into `out`: its shard (`K/N`), `jobs` cases at a time, or write its Slurm array of
+/// `slurm` shards; print what it gave when the study is complete.
+pub(super) fn execute_plan(
+    plan: &Plan,
+    out: &Path,
+    shard: Option<&str>,
+    jobs_asked: Option<usize>,
+    slurm: Option<usize>,
+) -> Result<(), Failure> {
+    if let Some(n) = slurm {
         if n == 0 {
             return Err(input(anyhow::anyhow!("--slurm: give the number of shards, at least 1")));
         }
-        st::runner::prepare(plan, &c.out).map_err(study_failure)?;
+        st::runner::prepare(plan, out).map_err(study_failure)?;
         let exe = std::env::current_exe().map_err(compute)?;
-        let path = st::runner::write_sbatch(&c.out, n, &exe, jobs(c.jobs)).map_err(study_failure)?;
+        let path = st::runner::write_sbatch(out, n, &exe, jobs(jobs_asked)).map_err(study_failure)?;
         println!("{} cases in {n} shards; submit with: sbatch {}", plan.cases.len(), path.display());
         return Ok(());
     }
-    let shard = match &c.shard {
+    let shard = match shard {
         Some(s) => Shard::parse(s).map_err(|m| input(anyhow::anyhow!("--shard: {m}")))?,
         None => Shard::ALL,
     };
-    run_shard(plan, &c.out, shard, jobs(c.jobs))
+    run_shard(plan, out, shard, jobs(jobs_asked))
 }
 
 fn run_shard(plan: &Plan, out: &Path, shard: Shard, jobs: usize) -> Result<(), Failure> {
     let mine = plan.cases.iter().filter(|c| shard.holds(c.index)).count();
     let bar = super::progress::bar(mine as u64, plan.kind.name());
-    let (summary, finished) =
-        st::run_plan(plan, out, shard, jobs, |done, _| bar.set_position(done as u64)).map_err(study_failure)?;
+    let started = std::time::Instant::now();
+    st::runner::prepare(plan, out).map_err(study_failure)?;
+    let summary =
+        st::runner::run(plan, out, shard, jobs, |done, _| bar.set_position(done as u64)).map_err(study_failure)?;
+    let ran = summary.cases - summary.resumed;
+    let seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    if ran > 0 {
+        println!(
+            "ran {ran} cases in {seconds:.2} s on {jobs} threads ({:.0} a minute)",
+            60.0 * ran as f64 / seconds.max(f64::MIN_POSITIVE)
+        );
+    }
+    let finished = st::finish(out).map_err(study_failure)?;
     println!(
         "{} {}: {} cases ({} from an earlier run) of ply {} in {}",
         plan.kind.name(),
@@ -311,6 +334,7 @@ fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failu
                 }
             }
         }
+        Finished::Optimise(o) => super::optimise::print(o, dir),
         Finished::Stability(s) => {
             let mut counts = std::collections::BTreeMap::new();
             for c in &s.cases {

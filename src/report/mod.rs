@@ -30,6 +30,7 @@ pub mod calibration;
 pub mod change;
 mod draw_in;
 mod html;
+pub mod optimise;
 mod raster;
 mod render;
 pub mod shade;

@@ -67,16 +67,17 @@ fn bold(size: f64) -> FontDesc<'static> {
     (FONT, size, FontStyle::Bold).into_font()
 }
 
-/// The colour bar in the right column: the diverging map from -limit (or 0, `from_zero`) to
-/// +limit with ticks, a label and marked lines (the locking angle).
-fn draw_colour_bar<DB: DrawingBackend>(
+/// The colour bar in the right column: `colour` from `low` to `limit` (the diverging map of a
+/// shear picture, or of an optimisation's landscape) with ticks, a label and marked lines (the
+/// locking angle, the optimum).
+pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    (limit, from_zero): (f64, bool),
+    (low, limit): (f64, f64),
+    colour: &dyn Fn(f64) -> [u8; 3],
     label: &str,
     marks: &[Mark],
     bottom: u32,
 ) -> DrawResult {
-    let low = if from_zero { 0.0 } else { -limit };
     let (_, column) = root.split_horizontally(WIDTH - BAR_COLUMN_PX);
     let mut chart = ChartBuilder::on(&column)
         .margin_top(TITLE_PX + 10)
@@ -85,7 +86,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .y_label_area_size(58)
         .build_cartesian_2d(0f64..1f64, low..limit)
         .map_err(de)?;
-    let step_label = |v: &f64| if limit >= 5.0 { format!("{v:.0}") } else { format!("{v:.2}") };
+    let step_label = |v: &f64| if limit - low >= 10.0 { format!("{v:.0}") } else { format!("{v:.2}") };
     chart
         .configure_mesh()
         .disable_x_mesh()
@@ -103,7 +104,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
     chart
         .draw_series((0..STEPS).map(|k| {
             let a = low + k as f64 * h;
-            Rectangle::new([(0.0, a), (1.0, a + h)], rgb(shear_colour(a + 0.5 * h, limit)).filled())
+            Rectangle::new([(0.0, a), (1.0, a + h)], rgb(colour(a + 0.5 * h)).filled())
         }))
         .map_err(de)?;
     for m in marks {
@@ -359,7 +360,8 @@ pub fn shaded_png(
         }
         draw_colour_bar(
             &root,
-            (pic.limit, pic.from_zero),
+            (if pic.from_zero { 0.0 } else { -pic.limit }, pic.limit),
+            &|v| shear_colour(v, pic.limit),
             &pic.bar_label,
             &pic.marks,
             HEIGHT - LEGEND_TOP as u32 + 20,

@@ -1,8 +1,10 @@
 //! The pictures of a study: error against time on log-log axes with the Pareto front
 //! (`speed_accuracy.svg/png`), and the outcome map over two swept parameters
 //! (`stability.svg/png`).
+use super::optimise::draw_landscape;
 use super::render::{register_fonts, to_png, to_svg, DrawResult};
 use crate::kinematic::fabric_field::FabricImage;
+use crate::study::optimise::Optimisation;
 use crate::study::speed_accuracy::{mm, three_figures, SpeedAccuracy, SpeedPoint};
 use crate::study::stability::Stability;
 use crate::study::Finished;
@@ -38,6 +40,7 @@ pub fn draw(dir: &Path, finished: &Finished) -> Result<Vec<PathBuf>, String> {
             ("speed_accuracy", to_png(|r| draw_speed_accuracy(r, s))?, to_svg(|r| draw_speed_accuracy(r, s))?)
         }
         Finished::Stability(s) => ("stability", to_png(|r| draw_stability(r, s))?, to_svg(|r| draw_stability(r, s))?),
+        Finished::Optimise(o) => ("optimise", to_png(|r| draw_landscape(r, o))?, to_svg(|r| draw_landscape(r, o))?),
     };
     let mut files = Vec::new();
     for (ext, bytes) in [("png", png), ("svg", svg.into_bytes())] {
@@ -364,6 +367,26 @@ pub fn collect_figures(dir: &Path, out: &Path) -> Result<Vec<StudyFigure>, crate
                 s.axes[1]
             );
             found.push(("stability", format!("Where the methods fail, ply {} ({})", s.ply, place.display()), summary));
+        }
+        if let Some(o) = read(crate::study::optimise::FILE).and_then(|t| serde_json::from_str::<Optimisation>(&t).ok())
+        {
+            let summary = format!(
+                "Ply {}: {} candidate placements ({} draped) searched at d = {} m, the best {} refined at the ply's d = {} m. Minimised: {}. Best {:.4} at seed ({:.4}, {:.4}, {:.4}) m, angle {}; {} ready for drape run.",
+                o.ply,
+                o.landscape.len(),
+                o.feasible,
+                o.search_spacing,
+                o.search.refine_starts,
+                o.best.spacing,
+                o.objective_text,
+                o.best.objective,
+                o.best.origin[0],
+                o.best.origin[1],
+                o.best.origin[2],
+                o.best.angle_deg.map_or("as in the scene".to_string(), |a| format!("{a:.2} deg")),
+                place.join(&o.scene).display()
+            );
+            found.push(("optimise", format!("Best placement, ply {} ({})", o.ply, place.display()), summary));
         }
         for (stem, heading, summary) in found {
             let Ok(bytes) = std::fs::read(place.join(format!("{stem}.png"))) else { continue };

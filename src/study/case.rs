@@ -6,7 +6,7 @@ use crate::kinematic::fabric_field::ShearField;
 use crate::kinematic::MethodChoice;
 use crate::kinematic::{DrapeNet, Extent, GeneratorKind, NodeStatus};
 use crate::layup::auto::DEFAULT_TOLERANCE_DEG;
-use crate::layup::stack::{drape_layup, resolve_warp};
+use crate::layup::stack::{drape_layup, resolve_warp, PlyStats};
 use crate::layup::{AutoModel, Layup, Orientation, Ply, Refinement};
 use crate::material::TensionLaw;
 use crate::mechanics::ContactMode;
@@ -54,6 +54,38 @@ pub struct CaseResult {
     /// The cell shear over fabric coordinates, when the case keeps it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub field: Option<ShearField>,
+    /// The ply's row of the layup table, when it was draped.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stats: Option<CaseStats>,
+}
+
+/// A draped case's layup-table figures ([`crate::layup::stack::PlyStats`]): what an
+/// optimisation's objectives are made of.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CaseStats {
+    /// Largest |shear| over the complete cells, degrees.
+    pub max_abs_shear_deg: f64,
+    /// Mean |shear| over the complete cells, degrees.
+    pub mean_abs_shear_deg: f64,
+    /// Draped area of the cells sheared past the ply's locking angle, m^2.
+    pub area_over_locking_m2: f64,
+    /// The share of the tool (or of the ply's outline) the ply covers, 0 to 1.
+    pub coverage: f64,
+    /// Complete cells.
+    pub cells: usize,
+}
+
+impl CaseStats {
+    /// The figures of a ply's layup-table row.
+    pub fn of(s: &PlyStats) -> CaseStats {
+        CaseStats {
+            max_abs_shear_deg: s.max_abs_shear.to_degrees(),
+            mean_abs_shear_deg: s.mean_abs_shear.to_degrees(),
+            area_over_locking_m2: s.area_over_locking,
+            coverage: s.coverage.share(),
+            cells: s.cells,
+        }
+    }
 }
 
 impl CaseResult {
@@ -73,6 +105,7 @@ impl CaseResult {
             iterations: None,
             choice: None,
             field: None,
+            stats: None,
         }
     }
 }
@@ -93,6 +126,9 @@ pub fn case_ply(base: &Ply, layup: &Layup, v: &Variant, tool: &ToolSurface) -> R
     let mut ply = base.clone();
     ply.settings = base.settings.at_spacing(v.spacing);
     let s = &mut ply.settings;
+    if let Some(o) = v.origin {
+        s.origin = Point::from(o);
+    }
     if let Extent::Grid { nu, nv, .. } = s.extent {
         let cap = if v.method.may_run_mechanics() { MAX_MECHANICAL_NODES } else { MAX_KINEMATIC_NODES };
         if nu.saturating_mul(nv) > cap {
@@ -212,6 +248,7 @@ pub fn run_case(base: &Ply, layup: &Layup, case: &Case, tool: &ToolSurface) -> C
     out.time_s = median(&mut times.clone());
     out.times_s = times;
     out.choice = result.choice.clone();
+    out.stats = Some(CaseStats::of(&result.stats));
     if let Some(rec) = &net.meta.solver {
         out.converged = Some(rec.converged);
         out.iterations = Some(rec.iterations);
@@ -336,5 +373,6 @@ pub fn summarise(net: &DrapeNet, tool: &ToolSurface, keep_field: bool) -> CaseRe
         iterations: None,
         choice: None,
         field: keep_field.then_some(field),
+        stats: None,
     }
 }

@@ -5,8 +5,10 @@
 //! [`runner`] runs them in parallel, each case's result written atomically as it finishes, so an
 //! interrupted study resumes where it stopped; it runs one shard of N, merges shards and writes
 //! a Slurm job array. [`finish`] turns the cases into the study's file once all are in; the
-//! pictures are drawn by [`crate::report::study`].
+//! pictures are drawn by [`crate::report::study`]. An [`optimise`]ation is a study too: its cases
+//! are the global search's candidate placements, and finishing it refines the best of them.
 pub mod case;
+pub mod optimise;
 pub mod plan;
 pub mod runner;
 pub mod speed_accuracy;
@@ -36,6 +38,8 @@ pub enum Finished {
     SpeedAccuracy(Box<speed_accuracy::SpeedAccuracy>),
     /// `stability.json`.
     Stability(stability::Stability),
+    /// `optimise.json` (boxed: it holds every candidate).
+    Optimise(Box<optimise::Optimisation>),
 }
 
 /// If every case of the study in `dir` has its result, compute the study's result, write its
@@ -65,6 +69,12 @@ fn write_result(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<(Fini
             let path = dir.join(stability::FILE);
             write_pretty(&path, &r)?;
             (Finished::Stability(r), path)
+        }
+        StudyKind::Optimise => {
+            let r = optimise::finish(plan, records, dir)?;
+            let path = dir.join(optimise::FILE);
+            write_pretty(&path, &r)?;
+            (Finished::Optimise(Box::new(r)), path)
         }
     })
 }

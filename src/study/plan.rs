@@ -22,6 +22,9 @@ pub enum StudyKind {
     SpeedAccuracy,
     /// Outcomes over the conditions that break drape methods ([`super::stability`]).
     Stability,
+    /// The best seed and angle of a ply: a global search over candidate placements, refined
+    /// locally when the cases are in ([`super::optimise`]).
+    Optimise,
 }
 
 impl StudyKind {
@@ -30,6 +33,7 @@ impl StudyKind {
         match self {
             StudyKind::SpeedAccuracy => "speed-accuracy",
             StudyKind::Stability => "stability",
+            StudyKind::Optimise => "optimise",
         }
     }
 }
@@ -93,6 +97,10 @@ pub struct Variant {
     /// The seed moved along the warp and weft at the seed, as fractions of the ply's half size.
     #[serde(default)]
     pub seed_shift: [f64; 2],
+    /// The seed itself, m, when the case sets it (a point on the tool; an optimisation's
+    /// candidate). The seed shift, if any, moves it further.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<[f64; 3]>,
     /// Pre-shear, degrees, when the case sets it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pre_shear_deg: Option<f64>,
@@ -119,6 +127,7 @@ impl Variant {
             spacing,
             angle_deg: None,
             seed_shift: [0.0, 0.0],
+            origin: None,
             pre_shear_deg: None,
             max_shear_deg: None,
             tension_factor: 1.0,
@@ -191,6 +200,9 @@ pub struct Plan {
     /// The speed-accuracy study's one reference: its tool and the models the ply allows.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<ReferencePlan>,
+    /// An optimisation's search: its objective, region and refinement.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub search: Option<super::optimise::Search>,
     /// The cases, in order.
     pub cases: Vec<Case>,
 }

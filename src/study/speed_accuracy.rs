@@ -279,6 +279,7 @@ pub fn plan(scene: &Scene, opts: &Options) -> Result<Plan, StudyError> {
             tool_triangles: finest_triangles,
             models: reference_models(ply),
         }),
+        search: None,
         cases,
     })
 }
@@ -1128,6 +1129,7 @@ mod tests {
                 tool_triangles: 10,
                 models: models.clone(),
             }),
+            search: None,
             cases: records.iter().map(|r| r.case.clone()).collect(),
         };
         let smooth = |k, d| record(k, geodesic, SurfaceKind::Smooth, "/fine.obj", d, field(d, 3.0, 2.0), None);

@@ -248,6 +248,7 @@ pub fn plan(scene: &Scene, opts: &Options, radius: f64) -> Result<Plan, StudyErr
         axes: Some(axes.map(|a| a.name().to_string())),
         symmetries: Vec::new(),
         reference: None,
+        search: None,
         cases,
     })
 }
