@@ -345,6 +345,23 @@ fn scene_errors_name_the_field_and_the_line() {
     );
     // A reference along the normal at the seed (the pole) has no direction on the tool there.
     scene_refused(&format!("{head}reference = [0.0, 0.0, 1.0]\n{PLY}"), "normal to the tool at the seed");
+    // The blank: only a flat sheet is cut to one; it must hold the origin node and an area.
+    let mech = "warp = [1.0, 0.0, 0.0]\nmaterial = \"CARDS/sze-liu-table1.toml\"\nmethod = \"mechanical\"\n";
+    let diamond = "blank = [[0.03, 0.0], [0.0, 0.03], [-0.03, 0.0], [0.0, -0.03]]\n";
+    scene_refused(
+        &format!("{head}{PLY}{mech}{diamond}"),
+        "field `blank`: the blank is the shape the flat sheet is cut to",
+    );
+    let flat = "mode = \"free\"\nstart = \"flat\"\n";
+    scene_refused(
+        &format!("{head}{PLY}{mech}{flat}blank = [[0.01, 0.01], [0.03, 0.01], [0.02, 0.03]]\n"),
+        "field `blank`: the blank must contain the origin node",
+    );
+    scene_refused(
+        &format!("{head}{PLY}{mech}{flat}blank = [[0.01, 0.0], [-0.01, 0.0]]\n"),
+        "field `blank`: a blank needs at least three corners",
+    );
+    scene_refused(&format!("{head}{PLY}{diamond}"), "field `blank`: only a ply with method = \"mechanical\" uses it");
 }
 
 /// Coverage is the share of the tool, or of the ply's outline, that the ply covers: a ply larger

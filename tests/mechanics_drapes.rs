@@ -5,7 +5,9 @@ use crate::mechanics_refine::max_strain;
 use assert_cmd::Command;
 use drape::geometry::{Point, ToolSurface};
 use drape::io::read_tool;
+use drape::kinematic::NodeStatus;
 use drape::layup::stack::{drape_layup, PlyResult};
+use drape::mechanics::energy::Grid;
 use drape::pipeline::Scene;
 use std::path::{Path, PathBuf};
 
@@ -150,6 +152,47 @@ fn a_flat_sheet_over_the_sphere_drapes_symmetrically_outside_it() {
     let centre = r.net.node(15, 15).unwrap();
     assert!((centre - Point::new(0.0, 0.0, SPHERE_RADIUS)).norm() < 1e-3, "centre at {centre}");
     assert!(r.net.node(0, 0).unwrap().z < -0.2);
+    assert!(mirror_gap(r, true) < 5e-3 && mirror_gap(r, false) < 5e-3);
+}
+
+/// A square blank cut at 45 deg to the fibres (its corners on the fibre axes, 0.7 m out, so the
+/// edge cuts cells across) dropped over the sphere: the nodes of the blank drape and no other,
+/// the fabric weighs the blank's area (the cells the edge cuts carry their share), the drape
+/// keeps the blank's mirror symmetries, and the flat pattern is the blank.
+#[test]
+fn a_blank_cut_at_45_degrees_over_the_sphere_drapes_what_was_cut() {
+    let n = 31;
+    let half = 0.7;
+    let (_, r) = drape_text(&sphere_sheet(
+        n,
+        &format!("blank = [[{half}, 0.0], [0.0, {half}], [-{half}, 0.0], [0.0, -{half}]]"),
+    ));
+    let r = &r[0];
+    assert!(converged(r));
+    let d = r.net.spacing;
+    let blank = [[half, 0.0], [0.0, half], [-half, 0.0], [0.0, -half]];
+    let fractions = drape::mechanics::sheet::blank_fractions(&blank, n, n, d, (15, 15));
+    let keep = drape::mechanics::sheet::blank_nodes(&fractions, n, n);
+    for (k, (&status, keep)) in r.net.status.iter().zip(&keep).enumerate() {
+        let expected = if *keep { NodeStatus::Placed } else { NodeStatus::OutsideOutline };
+        assert_eq!(status, expected, "node {k}");
+    }
+    // The sheet's corners are cut away; the fibre axes reach the blank's corners, 0.7 m out, in
+    // the cells 11 to 12 spacings (0.06 m) from the origin node.
+    assert!(r.net.node(0, 0).is_none() && r.net.node(15, 2).is_none() && r.net.node(28, 15).is_none());
+    assert!(r.net.node(15, 3).is_some() && r.net.node(27, 15).is_some());
+    // Its weight: the areal mass over the blank's area, 2 half^2.
+    let areal_mass = drape::material::MaterialCard::load(&repo("materials/sze-liu-table1.toml")).unwrap().areal_mass;
+    let layout = drape::mechanics::sheet::SheetFeatures { blank: Some(blank.to_vec()), ..Default::default() }
+        .layout(n, n, d, (15, 15))
+        .unwrap();
+    let mass: f64 = Grid::from_net(&r.net).with_sheet(layout).nodal_masses(areal_mass).iter().sum();
+    let exact = areal_mass * 2.0 * half * half;
+    assert!((mass - exact).abs() < 1e-9 * exact, "{mass} kg against {exact} kg");
+    assert!((r.stats.fabric_area - 2.0 * half * half).abs() < 1e-9, "{}", r.stats.fabric_area);
+    for p in &r.net.positions {
+        assert!(p.coords.norm() > SPHERE_RADIUS - SPHERE_FACET_SAGITTA || !p.coords.norm().is_finite());
+    }
     assert!(mirror_gap(r, true) < 5e-3 && mirror_gap(r, false) < 5e-3);
 }
 

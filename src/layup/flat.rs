@@ -114,6 +114,8 @@ pub enum CutLine {
     SmoothNodes,
     /// The complete cells, each grown by the cutting margin.
     GrownCells,
+    /// The blank a flat sheet was cut to (`blank = ...`), as given in fabric coordinates.
+    Blank,
 }
 
 /// Why a pattern is not cut along the line its ply asks for. Recorded in the pattern, printed by
@@ -300,6 +302,25 @@ pub fn flat_pattern_in_outline(net: &DrapeNet, outline: &[Point]) -> Result<Flat
     }
     let regions = vec![Region { loops: vec![poly], cells: nodes.cells, area }];
     Ok(pattern_of(net, regions, nodes.cells, nodes.half_cells, area, CutLine::Outline, nodes.anchor))
+}
+
+/// The pattern of a flat sheet cut to `blank` (fabric coordinates from the origin node, m): the
+/// blank itself, which is what was cut, with a cutting margin offset from it as
+/// [`with_margin`] does. Errors as [`flat_pattern`] (a net without a complete cell).
+pub fn blank_pattern(net: &DrapeNet, blank: &[[f64; 2]], margin: f64) -> Result<FlatPattern, FlatError> {
+    check_margin(net, margin)?;
+    let nodes = flat_pattern(net)?;
+    let n = blank.len();
+    let area =
+        0.5 * (0..n).map(|k| blank[k][0] * blank[(k + 1) % n][1] - blank[(k + 1) % n][0] * blank[k][1]).sum::<f64>();
+    // Loops run counter-clockwise, as the other cut lines give them.
+    let mut poly = blank.to_vec();
+    if area < 0.0 {
+        poly.reverse();
+    }
+    let regions = vec![Region { loops: vec![poly], cells: nodes.cells, area: area.abs() }];
+    let base = pattern_of(net, regions, nodes.cells, nodes.half_cells, area.abs(), CutLine::Blank, nodes.anchor);
+    with_margin(net, base, margin)
 }
 
 /// The pattern of a ply as the run cuts it: along the ply's outline when it has one

@@ -2,7 +2,7 @@
 //! resolved from the ply angle on that surface, refined where the ply asks for it; and the
 //! numbers of the layup table.
 use super::auto::{drape_auto, AutoError};
-use super::flat::ply_pattern;
+use super::flat::{blank_pattern, ply_pattern};
 use super::{Layup, Orientation, Ply, StackSide, Start};
 use crate::geometry::offset::{
     offset_along, offset_directions, offset_vertices, ramp_drops, OffsetReport, PLY_DROP_SLOPE,
@@ -12,10 +12,10 @@ use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
 use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
-use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice};
+use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice, NodeStatus};
 use crate::material::flow::sheared_thickness;
 use crate::mechanics::refine::{RefineError, Refined};
-use crate::mechanics::sheet::{default_origin_node, flat_sheet, SheetError};
+use crate::mechanics::sheet::{blank_fractions, blank_nodes, default_origin_node, flat_sheet, SheetError};
 
 /// A reference direction closer than this (sine of the angle) to the tool normal at a seed has
 /// no usable projection onto the tool there.
@@ -215,9 +215,31 @@ fn flat_start(
     let Extent::Grid { nu, nv, origin_node } = settings.extent else {
         return Err(SheetError("a flat sheet needs a grid".into()));
     };
-    let seam = ply.refinement.as_ref().and_then(|r| r.sheet.seam);
+    let sheet = ply.refinement.as_ref().map(|r| &r.sheet);
+    let seam = sheet.and_then(|s| s.seam);
     let origin = origin_node.unwrap_or_else(|| default_origin_node(nu, nv, seam));
-    flat_sheet(&settings.name, nu, nv, settings.spacing, origin, &settings.origin, &settings.warp, normal, seam, tool)
+    let mut net = flat_sheet(
+        &settings.name,
+        nu,
+        nv,
+        settings.spacing,
+        origin,
+        &settings.origin,
+        &settings.warp,
+        normal,
+        seam,
+        tool,
+    )?;
+    // The nodes the blank cuts away are not part of the ply.
+    if let Some(blank) = sheet.and_then(|s| s.blank.as_ref()) {
+        let keep = blank_nodes(&blank_fractions(blank, nu, nv, settings.spacing, origin), nu, nv);
+        for (status, keep) in net.status.iter_mut().zip(keep) {
+            if !keep {
+                *status = NodeStatus::OutsideOutline;
+            }
+        }
+    }
+    Ok(net)
 }
 
 /// Facets within this distance (times the tool's diagonal) of a seed touch it.
@@ -337,7 +359,14 @@ pub fn drape_layup(
             Extent::Outline(points) => Outline::new(surface, points, net.spacing).ok(),
             Extent::Grid { .. } => None,
         };
-        let stats = ply_stats(&net, surface, outline.as_ref(), ply.locking_angle, areal_mass);
+        let mut stats = ply_stats(&net, surface, outline.as_ref(), ply.locking_angle, areal_mass);
+        // A flat sheet cut to a blank used the blank's fabric.
+        if let Some(blank) = ply.refinement.as_ref().and_then(|r| r.sheet.blank.as_deref()) {
+            if let Ok(p) = blank_pattern(&net, blank, 0.0) {
+                stats.fabric_area = p.area;
+                stats.fabric_mass = areal_mass.map(|m| m * p.area);
+            }
+        }
         results.push(PlyResult { net, refined, kinematic, choice, warp, offset, stats });
     }
     Ok(results)

@@ -1,6 +1,6 @@
 //! Sheet features of seed 000 on the warp/weft grid: reinforced bands, a seam (two sheets
-//! stitched along a weft line), a fold (a weft line with a restoring stiffness) and cuts (fibre
-//! links removed along a polyline).
+//! stitched along a weft line), a fold (a weft line with a restoring stiffness), cuts (fibre
+//! links removed along a polyline) and the blank's shape (a polygon the sheet is cut to).
 //!
 //! [`SheetFeatures`] describes them in the sheet's own terms (fabric coordinates: u along the
 //! warp and v along the weft, metres from the origin node); [`SheetFeatures::layout`] turns them
@@ -96,6 +96,123 @@ pub struct SheetFeatures {
     pub fold: Option<Fold>,
     /// Cuts.
     pub cuts: Vec<Cut>,
+    /// The blank's outline in fabric coordinates (u, v), metres from the origin node: the sheet
+    /// is cut to it ([`blank_fractions`]).
+    pub blank: Option<Vec<[f64; 2]>>,
+}
+
+/// A cell with less of its area inside the blank than this share is left out (a sliver the
+/// blank's edge grazes carries no fabric to speak of, and its nodes would hang by nothing).
+pub const BLANK_SLIVER: f64 = 1e-6;
+
+/// The area of the polygon `p` (either orientation), m^2.
+fn polygon_area(p: &[[f64; 2]]) -> f64 {
+    let n = p.len();
+    0.5 * (0..n).map(|k| p[k][0] * p[(k + 1) % n][1] - p[(k + 1) % n][0] * p[k][1]).sum::<f64>().abs()
+}
+
+/// Check a blank outline: three points or more, finite, enclosing an area, with the origin node
+/// (0, 0) inside. Its area, m^2.
+pub fn check_blank(blank: &[[f64; 2]]) -> Result<f64, SheetError> {
+    if blank.len() < 3 {
+        return Err(SheetError(format!("a blank needs at least three corners (u, v), got {}", blank.len())));
+    }
+    if blank.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(SheetError("the blank's corners must be finite numbers".into()));
+    }
+    let area = polygon_area(blank);
+    if !(area > 0.0) {
+        return Err(SheetError("the blank encloses no area: give its corners in order round it".into()));
+    }
+    if !point_in_polygon((0.0, 0.0), blank) {
+        return Err(SheetError(
+            "the blank must contain the origin node (0, 0): give its corners in fabric coordinates from the origin node".into(),
+        ));
+    }
+    Ok(area)
+}
+
+/// Whether `q` lies inside the polygon `p` (even-odd rule).
+fn point_in_polygon(q: (f64, f64), p: &[[f64; 2]]) -> bool {
+    let mut inside = false;
+    let n = p.len();
+    for k in 0..n {
+        let (a, b) = (p[k], p[(k + 1) % n]);
+        if (a[1] > q.1) != (b[1] > q.1) && q.0 < a[0] + (q.1 - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// The share of the square [u0, u0 + d] x [v0, v0 + d] inside the polygon `blank`: the polygon
+/// clipped by the square (Sutherland-Hodgman against the square's four sides, which holds for
+/// any simple polygon clipped by a convex window), its area over d^2.
+fn square_share(blank: &[[f64; 2]], u0: f64, v0: f64, d: f64) -> f64 {
+    let mut poly: Vec<[f64; 2]> = blank.to_vec();
+    // Each side as (axis, bound, keep the side above the bound).
+    for (axis, bound, above) in [(0, u0, true), (0, u0 + d, false), (1, v0, true), (1, v0 + d, false)] {
+        if poly.is_empty() {
+            break;
+        }
+        let inside = |p: &[f64; 2]| if above { p[axis] >= bound } else { p[axis] <= bound };
+        let mut out = Vec::with_capacity(poly.len() + 4);
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            if inside(&a) {
+                out.push(a);
+            }
+            if inside(&a) != inside(&b) {
+                let t = (bound - a[axis]) / (b[axis] - a[axis]);
+                out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            }
+        }
+        poly = out;
+    }
+    if poly.len() < 3 {
+        return 0.0;
+    }
+    let share = polygon_area(&poly) / (d * d);
+    // A cell inside the blank is whole, not whole to rounding.
+    if share > 1.0 - BLANK_ROUNDING {
+        1.0
+    } else {
+        share.max(0.0)
+    }
+}
+
+/// Shares within this of 1 are a whole cell (the clipped area's rounding).
+const BLANK_ROUNDING: f64 = 1e-9;
+
+/// Per cell of an `nu x nv` grid of spacing `d` with its origin node at `origin` (at
+/// `i * (nv - 1) + j`): the share of its area inside the blank, 0 for a sliver below
+/// [`BLANK_SLIVER`].
+pub fn blank_fractions(blank: &[[f64; 2]], nu: usize, nv: usize, d: f64, origin: (usize, usize)) -> Vec<f64> {
+    let (i0, j0) = (origin.0 as f64, origin.1 as f64);
+    let mut f = Vec::with_capacity(nu.saturating_sub(1) * nv.saturating_sub(1));
+    for i in 0..nu.saturating_sub(1) {
+        for j in 0..nv.saturating_sub(1) {
+            let share = square_share(blank, (i as f64 - i0) * d, (j as f64 - j0) * d, d);
+            f.push(if share < BLANK_SLIVER { 0.0 } else { share });
+        }
+    }
+    f
+}
+
+/// Per node of the grid: whether a cell with fabric of the blank has it as a corner (the nodes
+/// of the blank; the others are cut away).
+pub fn blank_nodes(fractions: &[f64], nu: usize, nv: usize) -> Vec<bool> {
+    let mut keep = vec![false; nu * nv];
+    for i in 0..nu.saturating_sub(1) {
+        for j in 0..nv.saturating_sub(1) {
+            if fractions[i * (nv - 1) + j] > 0.0 {
+                for k in [i * nv + j, i * nv + j + 1, (i + 1) * nv + j, (i + 1) * nv + j + 1] {
+                    keep[k] = true;
+                }
+            }
+        }
+    }
+    keep
 }
 
 /// Why features do not fit a grid.
@@ -138,7 +255,11 @@ pub struct SheetLayout {
 impl SheetFeatures {
     /// Whether there is anything to lay out.
     pub fn is_empty(&self) -> bool {
-        self.reinforcements.is_empty() && self.seam.is_none() && self.fold.is_none() && self.cuts.is_empty()
+        self.reinforcements.is_empty()
+            && self.seam.is_none()
+            && self.fold.is_none()
+            && self.cuts.is_empty()
+            && self.blank.is_none()
     }
 
     /// The features on an `nu x nv` grid of spacing `d` with its origin node at `origin`.
@@ -259,11 +380,50 @@ impl SheetFeatures {
                 }
             }
             // A cell whose links are cut is cut open: it holds no shear.
+            // (The blank's cells are laid out after the cuts, below.)
             for i in 0..nu.saturating_sub(1) {
                 for j in 0..nv.saturating_sub(1) {
                     let k = i * nv + j;
                     if l.warp_cut[k] || l.warp_cut[k + 1] || l.weft_cut[k] || l.weft_cut[k + nv] {
                         l.cell_cut[i * (nv - 1) + j] = true;
+                    }
+                }
+            }
+        }
+        if let Some(blank) = &self.blank {
+            check_blank(blank)?;
+            let fractions = blank_fractions(blank, nu, nv, d, origin);
+            let cv = nv.saturating_sub(1);
+            let share = |i: isize, j: isize| -> Option<f64> {
+                (i >= 0 && j >= 0 && (i as usize) + 1 < nu && (j as usize) + 1 < nv)
+                    .then(|| fractions[i as usize * cv + j as usize])
+            };
+            // An element's tributary width counts the cells about it that are there (a cut
+            // cell is not); of those, the blank holds the mean share.
+            let mean = |cells: &[(isize, isize)]| {
+                let s: Vec<f64> = cells.iter().filter_map(|&(i, j)| share(i, j)).filter(|f| *f > 0.0).collect();
+                // No cell about it: no width either, whatever its factor.
+                if s.is_empty() {
+                    1.0
+                } else {
+                    s.iter().sum::<f64>() / s.len() as f64
+                }
+            };
+            for i in 0..nu {
+                for j in 0..nv {
+                    let (a, b) = (i as isize, j as isize);
+                    let k = i * nv + j;
+                    let node = mean(&[(a - 1, b - 1), (a - 1, b), (a, b - 1), (a, b)]);
+                    l.node_factors[k].bending *= node;
+                    l.warp_link_factors[k].tension *= mean(&[(a, b - 1), (a, b)]);
+                    l.weft_link_factors[k].tension *= mean(&[(a - 1, b), (a, b)]);
+                    if let Some(f) = share(a, b) {
+                        let c = &mut l.cell_factors[i * cv + j];
+                        c.shear *= f;
+                        c.weight *= f;
+                        if f == 0.0 {
+                            l.cell_cut[i * cv + j] = true;
+                        }
                     }
                 }
             }
@@ -425,6 +585,56 @@ pub fn default_origin_node(nu: usize, nv: usize, seam: Option<Seam>) -> (usize, 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cells' shares of blanks of every kind add up to the blank's area: a square at
+    /// 45 deg, a triangle off the grid's lines, an L (not convex), at other spacings and origins.
+    #[test]
+    fn the_cells_share_the_blank_s_area_exactly() {
+        let blanks: [Vec<[f64; 2]>; 3] = [
+            vec![[0.31, 0.0], [0.0, 0.31], [-0.31, 0.0], [0.0, -0.31]],
+            vec![[-0.17, -0.2], [0.33, -0.05], [-0.02, 0.27]],
+            vec![[-0.2, -0.2], [0.25, -0.2], [0.25, -0.05], [0.05, -0.05], [0.05, 0.3], [-0.2, 0.3]],
+        ];
+        for blank in &blanks {
+            let area = check_blank(blank).unwrap();
+            for (n, d, origin) in [(41, 0.02, (20, 20)), (30, 0.027, (13, 16)), (61, 0.0113, (29, 31))] {
+                let f = blank_fractions(blank, n, n, d, origin);
+                let sum: f64 = f.iter().sum::<f64>() * d * d;
+                assert!(
+                    (sum - area).abs() < 1e-12 * area.max(1.0) + BLANK_SLIVER * d * d * f.len() as f64,
+                    "{sum} against {area}"
+                );
+                assert!(f.iter().all(|x| (0.0..=1.0).contains(x)));
+                // The origin node is in the blank.
+                let keep = blank_nodes(&f, n, n);
+                assert!(keep[origin.0 * n + origin.1]);
+            }
+        }
+    }
+
+    #[test]
+    fn a_blank_as_large_as_the_grid_changes_nothing_and_a_bad_one_is_refused() {
+        let (n, d, o) = (11, 0.1, (5, 5));
+        let whole = vec![[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
+        let with = SheetFeatures { blank: Some(whole), ..Default::default() }.layout(n, n, d, o).unwrap();
+        let without = SheetFeatures::default().layout(n, n, d, o).unwrap();
+        assert_eq!(with, without);
+        // Half the grid: the cells beyond it are cut, the cells it halves carry half.
+        let half = vec![[-0.5, -0.5], [0.05, -0.5], [0.05, 0.5], [-0.5, 0.5]];
+        let l = SheetFeatures { blank: Some(half), ..Default::default() }.layout(n, n, d, o).unwrap();
+        assert!((l.cell(5, 3).shear - 0.5).abs() < 1e-12 && (l.cell(5, 3).weight - 0.5).abs() < 1e-12);
+        assert!(l.cell_cut(6, 3) && !l.cell_cut(5, 3) && !l.cell_cut(4, 3));
+        assert_eq!(l.cell(4, 3).weight, 1.0);
+        // The weft link on the cut's side of the halved cells carries their half.
+        assert!((l.weft_link(6, 3).tension - 0.5).abs() < 1e-12);
+        for bad in [
+            vec![[0.1, 0.1], [0.2, 0.1]],
+            vec![[0.1, 0.1], [0.3, 0.1], [0.2, 0.3]],
+            vec![[0.0, 0.0], [0.1, 0.0], [0.2, 0.0]],
+        ] {
+            assert!(check_blank(&bad).is_err(), "{bad:?}");
+        }
+    }
 
     #[test]
     fn a_cut_along_the_warp_opens_the_weft_links_and_cells_it_crosses() {

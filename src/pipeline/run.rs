@@ -23,7 +23,7 @@ use crate::io::{
 };
 use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeError};
 use crate::kinematic::Extent;
-use crate::layup::flat::{ply_pattern, CutWarning, FlatError, FlatPattern};
+use crate::layup::flat::{blank_pattern, ply_pattern, CutWarning, FlatError, FlatPattern};
 use crate::layup::nest::{nest, Nesting, Rotation};
 use crate::layup::stack::{drape_layup, LayupError, PlyResult};
 use crate::layup::table::{ExportPlyRow, ExportRow, LayupRow, LayupTable, NestingRow};
@@ -369,7 +369,13 @@ fn plan_cutting(scene: &Scene, results: &[PlyResult]) -> Result<Cutting, RunErro
             Extent::Outline(points) => Some(points.as_slice()),
             Extent::Grid { .. } => None,
         };
-        match ply_pattern(&r.net, outline, scene.cutting_margin) {
+        // A flat sheet cut to a blank is cut along the blank.
+        let blank = ply.refinement.as_ref().and_then(|f| f.sheet.blank.as_deref());
+        let pattern = match blank {
+            Some(blank) => blank_pattern(&r.net, blank, scene.cutting_margin),
+            None => ply_pattern(&r.net, outline, scene.cutting_margin),
+        };
+        match pattern {
             Ok(p) => {
                 cutting.plies.push(Ok(cutting.patterns.len()));
                 cutting.patterns.push(p);

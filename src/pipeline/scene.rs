@@ -77,6 +77,10 @@
 //! # stiffness = 98.0          #   restoring stiffness, N/m per metre of fold (SI)
 //! # [[ply.cut]]               # fibre links removed along a polyline
 //! # points = [[-0.45, 0.82], [0.45, 0.82]]   # fabric coordinates (u, v) from the origin node
+//! # blank = [[0.3, 0.0], [0.0, 0.3], [-0.3, 0.0], [0.0, -0.3]]  # with start = "flat": the
+//! #                           # shape the sheet is cut to, corners in fabric coordinates (u, v)
+//! #                           # from the origin node (here a square at 45 deg to the fibres);
+//! #                           # cells the edge cuts keep their share of the blank's fabric
 //! ```
 use super::{parse_generators, unit_scale};
 use crate::geometry::{Point, Vector};
@@ -92,7 +96,9 @@ use crate::layup::{
 };
 use crate::material::flow::Cavity;
 use crate::material::MaterialCard;
-use crate::mechanics::sheet::{default_origin_node, Cut, Factors, Fold, Region, Reinforcement, Seam, SheetFeatures};
+use crate::mechanics::sheet::{
+    blank_fractions, check_blank, default_origin_node, Cut, Factors, Fold, Region, Reinforcement, Seam, SheetFeatures,
+};
 use crate::mechanics::ContactMode;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -208,6 +214,7 @@ struct PlyFile {
     fold: Option<FoldFile>,
     #[serde(default)]
     cut: Vec<CutFile>,
+    blank: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Deserialize)]
@@ -385,10 +392,31 @@ fn refinement(
             c.points.iter().map(|q| Ok([length("cut", q[0])?, length("cut", q[1])?])).collect::<Result<Vec<_>, _>>()?;
         sheet.cuts.push(Cut { points });
     }
+    if let Some(blank) = &p.blank {
+        if !matches!(start, Start::Flat { .. }) {
+            return Err((
+                "blank",
+                "the blank is the shape the flat sheet is cut to: give start = \"flat\" (a ply draped from its kinematic net is trimmed on the tool by outline = ...)".into(),
+            ));
+        }
+        let corners = blank
+            .iter()
+            .map(|q| Ok([length("blank", q[0])?, length("blank", q[1])?]))
+            .collect::<Result<Vec<_>, _>>()?;
+        check_blank(&corners).map_err(|e| ("blank", e.0))?;
+        sheet.blank = Some(corners);
+    }
     if let (Extent::Grid { nu, nv, origin_node }, false) = (extent, sheet.is_empty()) {
         // The features must fit the grid now, not after the drape.
         let origin = origin_node.unwrap_or_else(|| default_origin_node(*nu, *nv, sheet.seam));
-        sheet.layout(*nu, *nv, p.spacing * scale, origin).map_err(|e| ("seam", e.0))?;
+        let field = if p.blank.is_some() && sheet.seam.is_none() { "blank" } else { "seam" };
+        sheet.layout(*nu, *nv, p.spacing * scale, origin).map_err(|e| (field, e.0))?;
+        if let Some(blank) = &sheet.blank {
+            let fractions = blank_fractions(blank, *nu, *nv, p.spacing * scale, origin);
+            if !fractions.iter().any(|f| *f > 0.0) {
+                return Err(("blank", "the blank covers no cell of the grid: make the grid reach it".into()));
+            }
+        }
     }
     let seam = sheet.seam;
     Ok(Refinement {
@@ -647,6 +675,7 @@ impl Scene {
                         ("seam", p.seam.is_some()),
                         ("fold", p.fold.is_some()),
                         ("cut", !p.cut.is_empty()),
+                        ("blank", p.blank.is_some()),
                     ];
                     if let Some((field, _)) = mechanical_only.iter().find(|(_, given)| *given) {
                         return Err(at(field, "only a ply with method = \"mechanical\" uses it".into()));
