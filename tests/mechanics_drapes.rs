@@ -116,6 +116,9 @@ fn the_square_table_scene_drapes_the_whole_sheet_and_converges_with_the_mesh() {
     // energy), so the pair is the issue's.
     let (_, coarse) = drape_file(&repo("geometries/square-table/scene.toml"));
     assert!(converged(&coarse[0]));
+    // The seed's restraint (stick = true) is said as such, not as a friction of 0.
+    let contact = coarse[0].refined.as_ref().unwrap().contact.summary();
+    assert!(contact.sticky && contact.describe().starts_with("stick = true"), "{}", contact.describe());
     let text = square_table_text(&[("spacing = 0.005", "spacing = 0.0025"), ("grid = [41, 41]", "grid = [81, 81]")]);
     let (_, fine) = drape_text(&text);
     assert!(converged(&fine[0]));

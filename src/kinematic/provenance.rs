@@ -273,6 +273,10 @@ impl ContactState {
 pub struct ContactRecord {
     /// Coulomb's coefficient between the ply and the tool.
     pub friction: f64,
+    /// Seed 000's restraint (`stick = true`, free drape): the nodes the tool holds up stay where
+    /// they touch until pulled off, friction without limit.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub sticky: bool,
     /// Per node: `stick`, `slip`, `free` or `held`.
     pub state: Vec<Option<ContactState>>,
     /// Per node: how far it slid over the tool over all load steps, m.
@@ -293,6 +297,9 @@ pub struct ContactRecord {
 pub struct ContactSummary {
     /// Coulomb's coefficient between the ply and the tool.
     pub friction: f64,
+    /// Seed 000's restraint instead of friction ([`ContactRecord::sticky`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub sticky: bool,
     /// Nodes that bear on the tool and stick.
     pub stick: usize,
     /// Nodes that bear on the tool and slipped in the last load step.
@@ -318,6 +325,7 @@ impl ContactRecord {
         let largest = |v: &[Option<f64>]| v.iter().flatten().copied().fold(0.0, f64::max);
         ContactSummary {
             friction: self.friction,
+            sticky: self.sticky,
             stick: count(ContactState::Stick),
             slip: count(ContactState::Slip),
             free: count(ContactState::Free),
@@ -332,8 +340,12 @@ impl ContactRecord {
 impl ContactSummary {
     /// One line for people: friction, how many nodes stick and slip, the largest slip.
     pub fn describe(&self) -> String {
-        let mut s =
-            format!("friction {}: {} nodes stick, {} slip, {} free", self.friction, self.stick, self.slip, self.free);
+        let grip = if self.sticky {
+            "stick = true (nodes the tool holds up stay where they touch)".to_string()
+        } else {
+            format!("friction {}", self.friction)
+        };
+        let mut s = format!("{grip}: {} nodes stick, {} slip, {} free", self.stick, self.slip, self.free);
         if self.held > 0 {
             s += &format!(", {} held", self.held);
         }

@@ -722,6 +722,7 @@ fn contact_record(
     }
     ContactRecord {
         friction: settings.friction,
+        sticky: settings.stick,
         state,
         slip_m,
         pressure_pa,
