@@ -391,3 +391,34 @@ fn export_vtu_binary_option_reads_in_vtk_as_the_ascii() {
         assert_eq!(*c == 0.0, v.is_nan(), "NaN exactly on the uncovered elements");
     }
 }
+
+/// Lengths on the command line in millimetres (`--units mm`) export the same file as the same
+/// lengths in metres; an unknown unit is refused before anything is written.
+#[test]
+fn export_lengths_in_millimetres_are_the_same_lengths_in_metres() {
+    let case = drape_ply();
+    let metres =
+        export(&case, "csv", "m.csv", &["--permeability", "--thickness", "0.00031", "--fibre-radius", "3.5e-6"]);
+    let mm = export(
+        &case,
+        "csv",
+        "mm.csv",
+        &["--permeability", "--units", "mm", "--thickness", "0.31", "--fibre-radius", "0.0035"],
+    );
+    let (a, b) = (std::fs::read_to_string(&metres).unwrap(), std::fs::read_to_string(&mm).unwrap());
+    assert_eq!(a, b);
+    // And the thickness is the one given, not the card's.
+    let card = export(&case, "csv", "card.csv", &["--permeability", "--fibre-radius", "3.5e-6"]);
+    assert_ne!(std::fs::read_to_string(&card).unwrap(), a);
+    let refused = Command::cargo_bin("drape")
+        .unwrap()
+        .args(["export", "--net", case.dir.join("p45.drape.json").to_str().unwrap()])
+        .args(["--mesh", root().join("geometries/hemisphere/hemisphere-2k.obj").to_str().unwrap()])
+        .args(["--format", "csv", "--out", case.dir.join("x.csv").to_str().unwrap(), "--units", "inch"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--units"), "{stderr}");
+    assert!(!case.dir.join("x.csv").exists());
+}

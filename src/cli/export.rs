@@ -39,9 +39,13 @@ pub struct ExportArgs {
     /// and OptiStruct decks (default: the card the net records, if any).
     #[arg(long)]
     pub material: Option<PathBuf>,
-    /// Ply thickness as laid flat, m (overrides the card's).
+    /// Ply thickness as laid flat, in --units (overrides the card's).
     #[arg(long)]
     pub thickness: Option<f64>,
+    /// Units of the lengths given here (--thickness, --fibre-radius): m or mm. The flow mesh's
+    /// are --mesh-units.
+    #[arg(long, default_value = "m")]
+    pub units: String,
     /// What shear does to thickness and fibre volume fraction.
     #[arg(long, value_enum, default_value = "fixed")]
     pub cavity: CavityArg,
@@ -49,7 +53,7 @@ pub struct ExportArgs {
     /// radius from the card's [flow] section or --fibre-radius).
     #[arg(long)]
     pub permeability: bool,
-    /// Fibre radius, m, for --permeability.
+    /// Fibre radius, in --units, for --permeability.
     #[arg(long)]
     pub fibre_radius: Option<f64>,
     /// The material the CalculiX deck's shell sections refer to (you define it).
@@ -62,16 +66,17 @@ pub struct ExportArgs {
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Failure> {
+    let scale = crate::pipeline::unit_scale(&a.units).map_err(|m| input(anyhow::anyhow!("--units: {m}")))?;
     let options = ExportOptions {
         mesh_units: a.mesh_units,
         material: a.material,
-        thickness: a.thickness,
+        thickness: a.thickness.map(|t| t * scale),
         cavity: match a.cavity {
             CavityArg::Fixed => Cavity::Fixed,
             CavityArg::Free => Cavity::Free,
         },
         permeability: a.permeability,
-        fibre_radius: a.fibre_radius,
+        fibre_radius: a.fibre_radius.map(|r| r * scale),
         material_name: a.material_name,
         vtu: a.vtu,
     };
