@@ -1,6 +1,7 @@
 """The Python package against the command line: the same numbers from the same input, the same
 refusals, nets from numpy arrays equal to nets from files, and the JSON contract round trip."""
 import json
+import sys
 import threading
 import time
 import warnings
@@ -294,24 +295,32 @@ def test_export_matches_cli(cli, tmp_path):
 
 
 def test_the_gil_is_released_while_draping():
-    # A drape long enough to see: another Python thread must run while it works.
-    finished = {}
+    # With a switch interval far longer than the test, a thread gives the GIL up only when it
+    # waits (the main thread's sleep(0)) or when the extension releases it. The main thread
+    # counts while another drapes: released, the count goes on during the drape; held, it
+    # stands still from the call to its return.
+    count = [0]
+    seen = {}
+    done = threading.Event()
 
     def work():
-        start = time.perf_counter()
+        seen["before"] = count[0]
         drape.kinematic(HEMISPHERE, (0, 0, 0.1), (1, 0, 0), 0.0008, (301, 301), surface="smooth")
-        finished["seconds"] = time.perf_counter() - start
+        seen["after"] = count[0]
+        done.set()
 
-    thread = threading.Thread(target=work)
-    ticks = 0
-    thread.start()
-    while thread.is_alive():
-        ticks += 1
-        time.sleep(0.002)
-    thread.join()
-    assert finished["seconds"] > 0.1, "the drape was too short to tell"
-    # With the GIL held the main thread would wait out the whole drape after its first tick.
-    assert ticks >= 10, (ticks, finished["seconds"])
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(100.0)
+    try:
+        thread = threading.Thread(target=work)
+        thread.start()
+        while not done.is_set():
+            count[0] += 1
+            time.sleep(0)
+        thread.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert seen["after"] - seen["before"] >= 10, seen
 
 
 def test_example_script_runs(tmp_path, monkeypatch):

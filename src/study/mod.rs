@@ -85,8 +85,8 @@ fn write_result(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<(Fini
 /// again.
 pub fn shear_range_warning(dir: &Path) -> Option<String> {
     let plan = runner::read_plan(dir).ok()?;
-    let scene = crate::pipeline::Scene::load(&plan.scene).ok()?;
-    let ply = scene.layup.plies.iter().find(|p| p.settings.name == plan.ply)?;
+    let (scene, k) = plan.scene_and_ply().ok()?;
+    let ply = &scene.layup.plies[k];
     let card = ply.refinement.as_ref().map(|r| &r.material).or(ply.material.as_ref().map(|m| &m.card))?;
     let records = collect(&plan, dir).ok()?;
     let shears: Vec<f64> = records.iter().filter_map(|r| r.result.max_shear_deg).collect();

@@ -207,6 +207,20 @@ pub struct Plan {
     pub cases: Vec<Case>,
 }
 
+impl Plan {
+    /// The plan's scene, read again, and its ply's place in the layup.
+    pub fn scene_and_ply(&self) -> Result<(Scene, usize), StudyError> {
+        let scene = Scene::load(&self.scene).map_err(|e| StudyError::Input(e.to_string()))?;
+        let k = scene
+            .layup
+            .plies
+            .iter()
+            .position(|p| p.settings.name == self.ply)
+            .ok_or_else(|| StudyError::Input(format!("the scene has no ply '{}'", self.ply)))?;
+        Ok((scene, k))
+    }
+}
+
 /// The part of a study one process runs: shard `k` (from 1) of `n` takes the cases whose index
 /// is `k - 1` modulo `n`, so the shards are disjoint and together hold every case.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

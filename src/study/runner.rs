@@ -7,7 +7,6 @@ use super::StudyError;
 use crate::geometry::ToolSurface;
 use crate::io::read_tool;
 use crate::io::write_atomic;
-use crate::pipeline::Scene;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -96,13 +95,8 @@ pub fn run(
     jobs: usize,
     on_done: impl Fn(usize, usize) + Sync,
 ) -> Result<RunSummary, StudyError> {
-    let scene = Scene::load(&plan.scene).map_err(|e| StudyError::Input(e.to_string()))?;
-    let base = scene
-        .layup
-        .plies
-        .iter()
-        .find(|p| p.settings.name == plan.ply)
-        .ok_or_else(|| StudyError::Input(format!("the scene has no ply '{}'", plan.ply)))?;
+    let (scene, k) = plan.scene_and_ply()?;
+    let base = &scene.layup.plies[k];
     let mine: Vec<&Case> = plan.cases.iter().filter(|c| shard.holds(c.index)).collect();
     let pending: Vec<&Case> = mine.iter().copied().filter(|c| finished(dir, c).is_none()).collect();
     let resumed = mine.len() - pending.len();

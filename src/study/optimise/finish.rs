@@ -8,7 +8,6 @@ use super::scene_file::optimal_scene;
 use super::{Candidate, Optimisation, Placement, Search, Start, REFINE_BUDGET, REFINE_SHRINK, SCENE_FILE};
 use crate::geometry::ToolSurface;
 use crate::layup::Layup;
-use crate::pipeline::Scene;
 use crate::study::case::{run_case, CaseResult, CaseStats};
 use crate::study::plan::{Case, Plan, Variant};
 use crate::study::runner::CaseRecord;
@@ -87,13 +86,8 @@ fn placement(
 pub fn finish(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<Optimisation, StudyError> {
     let search =
         plan.search.as_ref().ok_or_else(|| StudyError::Input("the plan has no search: not an optimisation".into()))?;
-    let scene = Scene::load(&plan.scene).map_err(|e| StudyError::Input(e.to_string()))?;
-    let base = scene
-        .layup
-        .plies
-        .iter()
-        .find(|p| p.settings.name == plan.ply)
-        .ok_or_else(|| StudyError::Input(format!("the scene has no ply '{}'", plan.ply)))?;
+    let (scene, k) = plan.scene_and_ply()?;
+    let base = &scene.layup.plies[k];
     let template =
         records.first().ok_or_else(|| StudyError::Input("the plan has no candidate".into()))?.case.variant.clone();
     let tool = crate::io::read_tool(&template.tool, scene.scale).map_err(|e| StudyError::Input(e.to_string()))?;
