@@ -214,6 +214,11 @@ fn half_cylinder_scene(dir: &Path, r: f64, ply: &str) -> std::path::PathBuf {
     path
 }
 
+/// `drape run SCENE --out OUT`, to be asserted on.
+fn drape_run(scene: &Path, out: &Path) -> assert_cmd::assert::Assert {
+    assert_cmd::Command::cargo_bin("drape").unwrap().arg("run").arg(scene).arg("--out").arg(out).assert()
+}
+
 fn read_json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
@@ -231,14 +236,7 @@ fn a_ply_on_a_half_cylinder_with_friction_stays_on_its_kinematic_net_and_auto_ke
             r,
             &format!("angle_deg = {angle}\nfriction = 0.3\nmethod = \"mechanical\""),
         );
-        assert_cmd::Command::cargo_bin("drape")
-            .unwrap()
-            .arg("run")
-            .arg(&scene)
-            .arg("--out")
-            .arg(&out)
-            .assert()
-            .success();
+        drape_run(&scene, &out).success();
         let net = read_json(&out.join("p.drape.json"));
         assert_eq!(net["meta"]["solver"]["outcome"], "converged", "R {r}, {angle} deg");
         let change = net["meta"]["change_from_kinematic"]["shear_deg"].as_array().unwrap();
@@ -249,14 +247,7 @@ fn a_ply_on_a_half_cylinder_with_friction_stays_on_its_kinematic_net_and_auto_ke
         let out = tmp.path().join("auto");
         let scene =
             half_cylinder_scene(tmp.path(), r, &format!("angle_deg = {angle}\nfriction = 0.3\nmethod = \"auto\""));
-        assert_cmd::Command::cargo_bin("drape")
-            .unwrap()
-            .arg("run")
-            .arg(&scene)
-            .arg("--out")
-            .arg(&out)
-            .assert()
-            .success();
+        drape_run(&scene, &out).success();
         let row = &read_json(&out.join("layup.json"))["plies"][0];
         assert_eq!(row["method"], "kinematic", "R {r}, {angle} deg: {}", row["method_choice"]["reason"]);
 
@@ -266,14 +257,7 @@ fn a_ply_on_a_half_cylinder_with_friction_stays_on_its_kinematic_net_and_auto_ke
             r,
             &format!("angle_deg = {angle}\nfriction = 0.0\nmethod = \"mechanical\""),
         );
-        let run = assert_cmd::Command::cargo_bin("drape")
-            .unwrap()
-            .arg("run")
-            .arg(&scene)
-            .arg("--out")
-            .arg(&out)
-            .assert()
-            .code(1);
+        let run = drape_run(&scene, &out).code(1);
         let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
         assert!(stdout.contains("SLIDES: ply 'p'"), "{stdout}");
         let row = &read_json(&out.join("layup.json"))["plies"][0];

@@ -10,10 +10,10 @@ use super::net::{DrapeNet, NodeStatus};
 pub use super::provenance::{DrawIn, DrawInLine, EdgeDrawIn};
 use crate::geometry::Vector;
 
-/// The ply's unit normal at the origin node of `net`, from the fibres through it (central
-/// differences where both neighbours are placed); None where the origin node or the fibres
-/// through it are missing.
-pub fn seed_normal(net: &DrapeNet) -> Option<Vector> {
+/// The warp and weft tangents of `net` at its origin node (central differences where both
+/// neighbours are placed, else one-sided); None where the origin node or a fibre through it is
+/// missing.
+pub fn origin_tangents(net: &DrapeNet) -> Option<(Vector, Vector)> {
     let (i0, j0) = net.origin_node;
     let placed = |i: usize, j: usize| net.status[net.index(i, j)] == NodeStatus::Placed;
     if !placed(i0, j0) {
@@ -32,7 +32,14 @@ pub fn seed_normal(net: &DrapeNet) -> Option<Vector> {
             (None, None) => None,
         }
     };
-    tangent(1, 0)?.cross(&tangent(0, 1)?).try_normalize(0.0)
+    Some((tangent(1, 0)?, tangent(0, 1)?))
+}
+
+/// The ply's unit normal at the origin node of `net`, from the fibres through it
+/// ([`origin_tangents`]).
+pub fn seed_normal(net: &DrapeNet) -> Option<Vector> {
+    let (warp, weft) = origin_tangents(net)?;
+    warp.cross(&weft).try_normalize(0.0)
 }
 
 /// The draw-in of `net` in the plan normal to `plan_normal` (`plan_from`: `sheet` or `seed`);

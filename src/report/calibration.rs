@@ -3,12 +3,11 @@
 //! shear force against the shear angle (the energy normalisation that puts samples of every size
 //! on one curve) with the law's, the fitted range marked; below, each point's relative force
 //! error against its angle, where a misfit at small angles shows as plainly as one at large.
-use super::render::{register_fonts, to_png, DrawResult};
+use super::render::{de, register_fonts, to_png, DrawResult, FONT};
 use crate::material::calibrate::{normalised_shear_force, rig_force, ShearFit, ShearSample};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-const FONT: &str = "sans-serif";
 /// One colour per sample.
 const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
@@ -20,10 +19,6 @@ const PALETTE: [RGBColor; 6] = [
 ];
 /// Points of each drawn law curve.
 const CURVE_POINTS: usize = 200;
-
-fn de<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
 
 /// The fit's picture as PNG bytes.
 pub fn fit_png(fit: &ShearFit, samples: &[ShearSample]) -> Result<Vec<u8>, String> {

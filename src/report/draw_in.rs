@@ -2,41 +2,27 @@
 //! draped, both seen in the plan its draw-in is measured in ([`crate::kinematic::draw_in`]),
 //! every k-th fibre of each, with the edge points of the fibre and diagonal lines through the
 //! seed and how far each moved in.
-use super::render::DrawResult;
+use super::render::{de, DrawResult, FONT};
 use crate::geometry::Vector;
+use crate::kinematic::draw_in::origin_tangents;
 use crate::kinematic::provenance::DrawIn;
 use crate::kinematic::{DrapeNet, NodeStatus};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-const FONT: &str = "sans-serif";
 /// Fibres drawn across the larger side of the grid, about.
 const FIBRES_DRAWN: usize = 24;
 const FLAT_COLOUR: RGBColor = RGBColor(175, 175, 175);
 const DRAPED_COLOUR: RGBColor = RGBColor(49, 130, 189);
 const EDGE_COLOUR: RGBColor = RGBColor(215, 48, 39);
 
-fn de<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
-
 /// The plan's axes: the warp at the seed in plan, and the normal across it turned so the weft at
-/// the seed points along the second. None where the net has no fibre from its origin node.
+/// the seed points along the second. None where the net has no fibres through its origin node.
 fn plan_axes(net: &DrapeNet, normal: &Vector) -> Option<(Vector, Vector)> {
-    let (i0, j0) = net.origin_node;
-    let at = |i: usize, j: usize| {
-        (net.status[net.index(i, j)] == NodeStatus::Placed).then(|| net.positions[net.index(i, j)])
-    };
-    let o = at(i0, j0)?;
-    let plan = |v: Vector| v - normal * normal.dot(&v);
-    let warp = if i0 + 1 < net.nu { at(i0 + 1, j0).map(|p| p - o) } else { at(i0 - 1, j0).map(|p| o - p) }?;
-    let e1 = plan(warp).try_normalize(1e-12)?;
-    let mut e2 = normal.cross(&e1);
-    let weft = if j0 + 1 < net.nv { at(i0, j0 + 1).map(|p| p - o) } else { at(i0, j0 - 1).map(|p| o - p) };
-    if weft.is_some_and(|w| w.dot(&e2) < 0.0) {
-        e2 = -e2;
-    }
-    Some((e1, e2))
+    let (warp, weft) = origin_tangents(net)?;
+    let e1 = (warp - normal * normal.dot(&warp)).try_normalize(1e-12)?;
+    let e2 = normal.cross(&e1);
+    Some((e1, if weft.dot(&e2) < 0.0 { -e2 } else { e2 }))
 }
 
 /// Draw the picture of `net`'s draw-in `d`.
@@ -48,7 +34,8 @@ pub fn draw_plan<DB: DrawingBackend>(
 ) -> DrawResult {
     root.fill(&WHITE).map_err(de)?;
     let normal = Vector::from(d.plan_normal);
-    let (e1, e2) = plan_axes(net, &normal).ok_or("the net has no fibre from its origin node to draw the plan by")?;
+    let (e1, e2) =
+        plan_axes(net, &normal).ok_or("the net has no fibres through its origin node to draw the plan by")?;
     let (i0, j0) = net.origin_node;
     let o = net.positions[net.index(i0, j0)];
     let placed = |i: usize, j: usize| net.status[net.index(i, j)] == NodeStatus::Placed;

@@ -2,27 +2,18 @@
 //! region (at each seed the best over the angles tried) and against the ply angle (the best
 //! over the seeds, and at the best candidate's seed), the optimum and the runners-up marked.
 //! Colours are the report's diverging map, blue for the best and red for the worst.
-use super::render::{draw_colour_bar, DrawResult, Mark, HEIGHT, WIDTH};
+use super::render::{de, draw_colour_bar, DrawResult, Mark, BAR_COLUMN_PX, FONT, HEIGHT, TITLE_PX, WIDTH};
 use super::view::shear_colour;
 use crate::study::optimise::{Candidate, Optimisation};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 
-const FONT: &str = "sans-serif";
-/// Height of the title band, pixels.
-const TITLE_BAND: u32 = 64;
-/// Width of the colour-bar column (the report's pictures keep it on the right), pixels.
-const BAR_COLUMN: u32 = 240;
 /// Cells drawn for seeds without a complete cell at any angle.
 const NO_DRAPE: RGBColor = RGBColor(200, 200, 200);
 /// The angle chart's two lines.
 const BEST_OVER_SEEDS: RGBColor = RGBColor(31, 119, 180);
 const AT_BEST_SEED: RGBColor = RGBColor(255, 127, 14);
-
-fn de<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
 
 /// The landscape's colour of objective `f` between the best `lo` and the worst `hi` found.
 fn landscape_colour(f: f64, lo: f64, hi: f64) -> [u8; 3] {
@@ -56,7 +47,7 @@ pub fn draw_landscape<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, o: &Opt
     let values: Vec<f64> = o.landscape.iter().filter_map(|c| c.objective).collect();
     let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
     let (lo, hi) = (lo.min(o.best.objective), hi.max(o.best.objective));
-    let (top, body) = root.split_vertically(TITLE_BAND);
+    let (top, body) = root.split_vertically(TITLE_PX);
     top.draw(&Text::new(
         format!("Ply {}: the objective over the seed region and the ply angle", o.ply),
         (20, 10),
@@ -79,12 +70,12 @@ pub fn draw_landscape<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, o: &Opt
         (FONT, 13).into_font(),
     ))
     .map_err(de)?;
-    let (plots, _) = body.split_horizontally(WIDTH - BAR_COLUMN);
+    let (plots, _) = body.split_horizontally(WIDTH - BAR_COLUMN_PX);
     let seeds_varied = o.search.region.is_some();
     let angles_varied = o.search.angles.is_some();
     match (seeds_varied, angles_varied) {
         (true, true) => {
-            let (left, right) = plots.split_horizontally((WIDTH - BAR_COLUMN) / 2);
+            let (left, right) = plots.split_horizontally((WIDTH - BAR_COLUMN_PX) / 2);
             draw_seed_map(&left, o, lo, hi)?;
             draw_angle_chart(&right, o)?;
         }

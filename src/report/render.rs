@@ -12,13 +12,14 @@ pub const WIDTH: u32 = 1200;
 /// Picture height, see [`WIDTH`].
 pub const HEIGHT: u32 = 800;
 
-/// Font family every text of the pictures uses; registered from the embedded DejaVu Sans.
-const FONT: &str = "sans-serif";
+/// Font family every text of the pictures uses; registered from the embedded DejaVu Sans (the
+/// other pictures' modules name it through this, so their text is drawn in the font registered).
+pub(super) const FONT: &str = "sans-serif";
 
-/// Width of the colour-bar column, pixels.
-const BAR_COLUMN_PX: u32 = 240;
+/// Width of the colour-bar column (kept on the right of the pictures that have one), pixels.
+pub(super) const BAR_COLUMN_PX: u32 = 240;
 /// Height of the title band, pixels.
-const TITLE_PX: u32 = 64;
+pub(super) const TITLE_PX: u32 = 64;
 
 static FONTS: Once = Once::new();
 
@@ -36,7 +37,8 @@ pub fn register_fonts() {
 /// One picture error: what plotters said.
 pub type DrawResult = Result<(), String>;
 
-fn de<E: std::fmt::Display>(e: E) -> String {
+/// A plotters error as the picture's error text.
+pub(super) fn de<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 

@@ -2,7 +2,7 @@
 //! (`speed_accuracy.svg/png`), and the outcome map over two swept parameters
 //! (`stability.svg/png`).
 use super::optimise::draw_landscape;
-use super::render::{register_fonts, to_png, to_svg, DrawResult};
+use super::render::{de, register_fonts, to_png, to_svg, DrawResult, FONT, TITLE_PX};
 use crate::kinematic::fabric_field::FabricImage;
 use crate::study::optimise::Optimisation;
 use crate::study::speed_accuracy::{mm, three_figures, SpeedAccuracy, SpeedPoint};
@@ -13,7 +13,6 @@ use plotters::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-const FONT: &str = "sans-serif";
 /// Errors below this (degrees) are drawn at it (the estimate's rounding floor).
 const ERROR_FLOOR_DEG: f64 = 1e-4;
 /// Series colours, one per method.
@@ -27,10 +26,6 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(227, 119, 194),
     RGBColor(127, 127, 127),
 ];
-
-fn de<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
 
 /// Draw a finished study's pictures into `dir`; returns the files written.
 pub fn draw(dir: &Path, finished: &Finished) -> Result<Vec<PathBuf>, String> {
@@ -74,9 +69,6 @@ fn series_name(p: &SpeedPoint, several_tools: bool) -> String {
     name
 }
 
-/// Height of the title band above the chart, pixels.
-const TITLE_BAND: u32 = 64;
-
 /// Error (max over the compared points, against the study's one reference) against time, one
 /// series per method, on log axes labelled at each decade and at 2 and 5, each point marked
 /// with its spacing.
@@ -96,7 +88,7 @@ pub fn draw_speed_accuracy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, s:
             (p.time_s > 0.0).then(|| (series_name(p, several_tools), p.time_s, e, p.pareto, p.spacing))
         })
         .collect();
-    let (top, body) = root.split_vertically(TITLE_BAND);
+    let (top, body) = root.split_vertically(TITLE_PX);
     top.draw(&Text::new(
         format!("Ply {}: largest cell-shear error against time, every run against one reference", s.ply),
         (20, 10),
