@@ -24,6 +24,9 @@ fn card() -> &'static MaterialCard {
     })
 }
 
+/// Coulomb's coefficient between the sheet and the cap (the bundled sphere scenes' 0.3).
+const FRICTION: f64 = 0.3;
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(8))]
     #[test]
@@ -34,7 +37,16 @@ proptest! {
         let warp = Vector::new(angle.cos(), angle.sin(), 0.0);
         let net = drape(tool(), &KinematicSettings::grid("p", origin, warp, 0.012, 9, 9)).unwrap();
         let mode = if free { ContactMode::Free } else { ContactMode::Pressed };
-        let settings = RefineSettings { mode, load_steps: 2, solver: SolverSettings::default().max_iterations(15), ..RefineSettings::default() };
+        // Friction holds the ply on the cap, as the bundled scenes' does: frictionless and held
+        // by nothing it has no equilibrium there and slides off (the outcome `slides`, tested in
+        // mechanics_friction), its last state hanging past the cap's open rim.
+        let settings = RefineSettings {
+            mode,
+            load_steps: 2,
+            friction: FRICTION,
+            solver: SolverSettings::default().max_iterations(15),
+            ..RefineSettings::default()
+        };
         let r = refine(&net, tool(), card(), &settings).unwrap();
         prop_assert!(r.energy_final <= r.energy_kinematic);
         for step in &r.steps {
