@@ -20,6 +20,7 @@ mod flat_patterns;
 mod flow_export;
 mod flow_writers;
 mod flowmesh_readers;
+mod forming;
 mod fuzz_readers;
 mod layup;
 mod material_cli;

@@ -20,6 +20,8 @@
 //! | `square-table/square-table.obj`       | closed 0.1 x 0.1 x 0.1 m box, top at z = 0 (seed 000)    |
 //! | `round-table/round-table.obj`         | closed drum R = 0.8 m, 0.75 m high, top at z = 0 (seed 000) |
 //! | `sphere/sphere.obj`                   | sphere R = 0.4 m at the origin, 20 480 triangles (seed 000) |
+//! | `punch-and-die/punch.obj`             | hemispherical punch R = 75 mm, 48 subdivisions (9 216)  |
+//! | `punch-and-die/die.obj`               | die face at z = 25 mm, opening R = 80 mm, 10 mm fillet, 70 mm deep |
 //!
 //! With `--large` it also writes `generated/hemisphere-200k.obj` (224 subdivisions, 200 704
 //! triangles) and `generated/hemisphere-800k.obj` (448 subdivisions, 802 816 triangles) for
@@ -39,6 +41,16 @@ type Committed = (&'static str, fn() -> TriangleMesh);
 
 /// Hemisphere radius of the bundled hemisphere meshes (m).
 const HEMISPHERE_RADIUS: f64 = 0.1;
+/// The punch-and-die set-up (issue 33): a hemispherical punch of R 75 mm (its rim at z = 0 where
+/// its 50 mm stroke ends) into a die opening of R 80 mm with a 10 mm entry fillet, the die's face
+/// at z = 25 mm (the punch's top where its stroke begins), m.
+const PUNCH_RADIUS: f64 = 0.075;
+/// See [`PUNCH_RADIUS`].
+const DIE_OPENING: f64 = 0.08;
+/// See [`PUNCH_RADIUS`].
+const DIE_FILLET: f64 = 0.01;
+/// See [`PUNCH_RADIUS`].
+const DIE_FACE_Z: f64 = 0.025;
 
 fn main() -> anyhow::Result<()> {
     let mut large = false;
@@ -58,7 +70,7 @@ fn main() -> anyhow::Result<()> {
         }
     }
 
-    let small: [Committed; 11] = [
+    let small: [Committed; 13] = [
         ("hemisphere/hemisphere-2k.obj", || hemisphere(HEMISPHERE_RADIUS, 23)),
         ("hemisphere/hemisphere-20k.obj", || hemisphere(HEMISPHERE_RADIUS, 71)),
         ("plate/plate.obj", || plate(0.4, 0.3, 80, 60)),
@@ -70,6 +82,12 @@ fn main() -> anyhow::Result<()> {
         ("square-table/square-table.obj", || table_box(0.1, 0.1, 0.1, 10)),
         ("round-table/round-table.obj", || round_table(0.8, 0.75, 256, 8, 6)),
         ("sphere/sphere.obj", || icosphere(0.4, drape::geometry::Point::origin(), 5)),
+        ("punch-and-die/punch.obj", || hemisphere(PUNCH_RADIUS, 48)),
+        ("punch-and-die/die.obj", || {
+            let mut die = die_ring(DIE_OPENING, DIE_FILLET, 0.22, 0.07, 192, [8, 8, 12]);
+            die.vertices.iter_mut().for_each(|v| v.z += DIE_FACE_Z);
+            die
+        }),
     ];
     for (name, make) in &small {
         write(&out, name, &make())?;

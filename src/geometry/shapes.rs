@@ -675,6 +675,44 @@ pub fn round_table(radius: f64, height: f64, n_around: usize, n_rings: usize, n_
     welded(tris)
 }
 
+/// A forming die's face about the z axis: a flat annulus in `z = 0` from `outer` in to the
+/// entry radius, a quarter-circle fillet of radius `fillet` rising from `r = opening + fillet`
+/// to the wall, and the opening's wall `r = opening` up to `z = depth`. `n_around` segments
+/// around; the flange in `n_flange` bands, the fillet in `n_fillet`, the wall in `n_wall`.
+/// Normals point away from the die's solid: down on the face, in towards the axis on the wall
+/// (the side a blank between punch and die meets).
+///
+/// # Panics
+/// If a size is not positive, the fillet and wall do not fit, or a count is too small.
+pub fn die_ring(
+    opening: f64,
+    fillet: f64,
+    outer: f64,
+    depth: f64,
+    n_around: usize,
+    [n_flange, n_fillet, n_wall]: [usize; 3],
+) -> TriangleMesh {
+    assert!(opening > 0.0 && fillet > 0.0, "die sizes must be positive");
+    assert!(outer > opening + fillet && depth > fillet, "the flange and wall must extend past the fillet");
+    assert!(n_around >= 3 && n_flange >= 1 && n_fillet >= 1 && n_wall >= 1, "die needs 3 segments and a band each");
+    // The profile (r, z) from the outer edge inwards and up.
+    let mut profile: Vec<(f64, f64)> =
+        linspace(outer, opening + fillet, n_flange).into_iter().map(|r| (r, 0.0)).collect();
+    for a in linspace(0.0, std::f64::consts::FRAC_PI_2, n_fillet).into_iter().skip(1) {
+        profile.push((opening + fillet * (1.0 - a.sin()), fillet * (1.0 - a.cos())));
+    }
+    profile.extend(linspace(fillet, depth, n_wall).into_iter().skip(1).map(|z| (opening, z)));
+    // Wound down the wall and out along the face, the normals (around x along the profile) face
+    // away from the solid.
+    profile.reverse();
+    let bands = profile.len() - 1;
+    grid_mesh(n_around, bands, true, |i, j| {
+        let t = TAU * i as f64 / n_around as f64;
+        let (r, z) = profile[j];
+        Point::new(r * t.cos(), r * t.sin(), z)
+    })
+}
+
 /// A sphere of `radius` centred at `centre`: an icosahedron subdivided `levels` times (20 x 4^levels
 /// triangles), its vertices pushed onto the sphere, wound outwards.
 ///
@@ -1037,6 +1075,23 @@ mod tests {
         assert!(ax.windows(2).all(|w| w[1] > w[0]));
         assert!(ax.iter().zip(ax.iter().rev()).all(|(a, b)| *a == -*b));
         assert!(ax.windows(2).all(|w| w[1] - w[0] <= 4.0 * 0.0025 + 1e-12));
+    }
+
+    #[test]
+    fn die_ring_faces_away_from_its_solid() {
+        let mesh = die_ring(0.08, 0.01, 0.15, 0.06, 64, [6, 8, 10]);
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|k| mesh.vertices[k as usize]);
+            let n = (b - a).cross(&(c - a)).normalize();
+            let m = Point::from((a.coords + b.coords + c.coords) / 3.0);
+            let r = (m.x * m.x + m.y * m.y).sqrt();
+            if m.z < 1e-9 {
+                assert!(n.z < -0.99, "the face looks down: {n:?}");
+            } else if m.z > 0.01 + 1e-9 {
+                assert!(r < 0.08 + 1e-9 && (n.x * m.x + n.y * m.y) / r < -0.99, "the wall looks in: {n:?}");
+            }
+        }
+        assert_clean_surface(mesh);
     }
 
     #[test]

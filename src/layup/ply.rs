@@ -5,6 +5,7 @@ use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::{Point, ToolSurface, Vector};
 use crate::kinematic::{DrapeNet, KinematicSettings};
 use crate::material::MaterialCard;
+use crate::mechanics::forming::Forming;
 use crate::mechanics::refine::{annotate, refine_draped, refine_from, RefineError, RefineSettings, Refined};
 use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::{ContactMode, SolverSettings};
@@ -139,6 +140,8 @@ pub struct Refinement {
     pub holds: Vec<[f64; 2]>,
     /// Move off saddles the solver's stability check finds ([`SolverSettings::escape_saddles`]).
     pub escape_saddles: bool,
+    /// A flat blank formed by tools in motion (`start = "flat"` with `mode = "pressed"`).
+    pub forming: Option<Forming>,
 }
 
 impl Refinement {
@@ -157,6 +160,7 @@ impl Refinement {
             sheet: SheetFeatures::default(),
             stick: false,
             escape_saddles: false,
+            forming: None,
         }
     }
 
@@ -170,6 +174,7 @@ impl Refinement {
             stick: self.stick,
             friction: self.friction,
             holds: self.holds.clone(),
+            forming: self.forming.clone(),
             ..RefineSettings::default()
         }
     }

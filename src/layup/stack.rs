@@ -230,6 +230,10 @@ fn flat_start(
         seam,
         tool,
     )?;
+    // A blank formed by the tools is laid on the punch where its stroke begins.
+    if let Some(forming) = ply.refinement.as_ref().and_then(|r| r.forming.as_ref()) {
+        net.positions.iter_mut().for_each(|p| *p -= forming.stroke);
+    }
     // The nodes the blank cuts away are not part of the ply.
     if let Some(blank) = sheet.and_then(|s| s.blank.as_ref()) {
         let keep = blank_nodes(&blank_fractions(blank, nu, nv, settings.spacing, origin), nu, nv);

@@ -3,6 +3,7 @@
 //! solved with Clarabel.
 pub mod contact;
 pub mod energy;
+pub mod forming;
 pub mod friction;
 pub mod qp;
 pub mod refine;

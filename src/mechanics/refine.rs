@@ -2,6 +2,7 @@
 //! kinematic state with the tool as contact, under load steps of gravity.
 use super::contact::{ContactMode, ContactSurface, Freedom};
 use super::energy::{Gravity, Grid, HessianKind, Laws, Model};
+use super::forming::{Forming, PlanView, ToolsAt};
 use super::friction::{
     bearings, friction_needed, tangent_rigid_motions, Bearing, FrictionLag, Frictional, LAG_TOLERANCE, MAX_LAGS,
     RELAG_SHARE, RELAG_TRAVEL_SPACINGS, SLIDE_MIN_SPACINGS, SLIDE_SHARE, STICK_SPACINGS,
@@ -138,6 +139,10 @@ pub struct RefineSettings {
     /// spacing (a ply draped again at another spacing holds the same fabric points). Nothing
     /// else holds a ply but the tool and friction.
     pub holds: Vec<[f64; 2]>,
+    /// A forming process: the tool is a punch moving along its stroke over the increments
+    /// (`load_steps` at least as many as [`Forming::increments`] asks), a die and a binder
+    /// beside it; the ply meets them with one-sided contact (the mode is then free).
+    pub forming: Option<Forming>,
 }
 
 impl Default for RefineSettings {
@@ -152,6 +157,7 @@ impl Default for RefineSettings {
             stick: false,
             friction: 0.0,
             holds: Vec::new(),
+            forming: None,
         }
     }
 }
@@ -495,7 +501,8 @@ fn refine_among<L: Laws + ?Sized>(
     };
     let placed = |start: &[Point]| {
         let mut x = start.to_vec();
-        if let (Some(smooth), ContactMode::Pressed) = (smooth, settings.mode) {
+        // (A blank to be formed starts as it was laid.)
+        if let (Some(smooth), ContactMode::Pressed, None) = (smooth, settings.mode, &settings.forming) {
             use rayon::prelude::*;
             x.par_iter_mut().zip(&active).filter(|(_, a)| **a).for_each(|(p, _)| *p = smooth.project(p).point);
         }
@@ -517,29 +524,36 @@ fn refine_among<L: Laws + ?Sized>(
             _ => return Err(RefineError::Hold { at: [u, v], node: [i, j], nu: kinematic.nu, nv: kinematic.nv }),
         }
     }
+    // A forming process meets its tools with one-sided contact, in as many increments as its
+    // stroke needs.
+    let forming = settings.forming.as_ref();
+    let mode = if forming.is_some() { ContactMode::Free } else { settings.mode };
+    let load_steps = forming.map_or(settings.load_steps, |f| f.increments(kinematic.spacing, settings.load_steps));
     let freedom: Vec<Freedom> = (0..active.len())
-        .map(|k| match (active[k] && !held[k], settings.mode) {
+        .map(|k| match (active[k] && !held[k], mode) {
             (false, _) => Freedom::Fixed,
             (true, ContactMode::Pressed) => Freedom::OnTool,
             (true, _) => Freedom::Free,
         })
         .collect();
-    let cons = Constraints {
-        freedom,
-        mode: settings.mode,
-        tool: Some(surface),
-        spacing: kinematic.spacing,
-        stitched,
-        stick: settings.stick,
-    };
+    // The blank's plane (the binder grips in it), from where the flat blank was laid.
+    let origin_index = kinematic.index(kinematic.origin_node.0, kinematic.origin_node.1);
+    let blank_plane = forming.map(|_| {
+        let normal = crate::kinematic::draw_in::seed_normal(kinematic).unwrap_or_else(Vector::z);
+        (starts[0][origin_index], normal)
+    });
+    let die: Option<&dyn ContactSurface> = forming.and_then(|f| f.die.as_deref()).map(|d| d as &dyn ContactSurface);
+    let plan_view = forming.map(|f| PlanView::across(&f.stroke));
     let mut steps = Vec::new();
     let mut increments = Vec::new();
-    let mut objective = NetObjective::new(grid, laws, settings.gravity / settings.load_steps as f64);
+    let mut objective = NetObjective::new(grid, laws, settings.gravity / load_steps as f64);
+    // Each node's share of the fabric, m^2: what the binder's pressure acts on.
+    let areas = objective.grid().nodal_masses(1.0);
     let solver_settings = settings.solver.clone();
     // Energies under the full load, for comparison with the result. The first step carries 1/S
     // of the load, so the full load does (S - 1) times more work.
     let full_load = |objective: &NetObjective, x: &[Point]| {
-        objective.evaluate(x, false).energy - (settings.load_steps - 1) as f64 * objective.work(x)
+        objective.evaluate(x, false).energy - (load_steps - 1) as f64 * objective.work(x)
     };
     let energy_kinematic = full_load(&objective, &kinematic.positions);
     let (mut x, energy_start) = starts
@@ -556,10 +570,49 @@ fn refine_among<L: Laws + ?Sized>(
     let mut slid = vec![0.0; x.len()];
     let mut lag = FrictionLag::new(settings.friction, stick_distance, &x, vec![None; x.len()]);
     let mut slide = None;
-    for step in 1..=settings.load_steps {
+    for step in 1..=load_steps {
         if step > 1 {
             objective.scale_loads(step as f64 / (step - 1) as f64);
         }
+        // The tools where this increment leaves them, and the nodes the binder grips as it
+        // begins: they slide in the blank's plane, friction on both faces.
+        let tools_at = forming.map(|f| ToolsAt {
+            punch: surface,
+            punch_facets: tool.num_triangles() as u32,
+            offset: f.punch_offset(step, load_steps),
+            die,
+        });
+        let binder = forming.and_then(|f| f.binder.as_ref());
+        let gripped = match (binder, plan_view, blank_plane) {
+            (Some(b), Some(view), Some((point, normal))) => {
+                let body: Vec<bool> = (0..x.len()).map(|k| active[k] && !held[k]).collect();
+                b.gripped(&view, &x, &body, &point, &normal, kinematic.spacing)
+            }
+            _ => vec![false; x.len()],
+        };
+        let cons = Constraints {
+            freedom: (freedom.iter().zip(&gripped))
+                .map(|(&f, &g)| match (g, blank_plane) {
+                    (true, Some((_, normal))) => Freedom::InPlane(normal),
+                    _ => f,
+                })
+                .collect(),
+            mode,
+            tool: Some(tools_at.as_ref().map_or(surface, |t| t as &dyn ContactSurface)),
+            spacing: kinematic.spacing,
+            stitched: stitched.clone(),
+            stick: settings.stick,
+        };
+        // Where the nodes bear: on the tools, and the gripped ones on the binder.
+        let bear = |x: &[Point], eval: &Evaluation| {
+            let mut b = bearings(&cons, x, eval);
+            if let (Some(binder), Some((_, normal))) = (binder, blank_plane) {
+                for (k, _) in gripped.iter().enumerate().filter(|(_, g)| **g) {
+                    b[k] = Some(binder.bearing(&normal, areas[k]));
+                }
+            }
+            b
+        };
         // The increment's friction: normal forces of this state under this increment's load,
         // slips from here; then the normal forces of each solution, until they agree, slips
         // still from here (a node slid under the first normal forces, too weak, is pulled back by
@@ -571,10 +624,9 @@ fn refine_among<L: Laws + ?Sized>(
         if step == 1 {
             eval.internal.iter_mut().for_each(|f| *f = Vector::zeros());
         }
-        lag = FrictionLag::new(settings.friction, stick_distance, &x, bearings(&cons, &x, &eval));
+        lag = FrictionLag::new(settings.friction, stick_distance, &x, bear(&x, &eval));
         let limit = slide_limit(&lag, kinematic.spacing);
-        let mut increment =
-            Increment { load_factor: step as f64 / settings.load_steps as f64, solves: 0, lag_change: 0.0 };
+        let mut increment = Increment { load_factor: step as f64 / load_steps as f64, solves: 0, lag_change: 0.0 };
         // The iterations of a load step, shared by its solves.
         let mut budget = solver_settings.max_iterations;
         let ok = loop {
@@ -584,11 +636,16 @@ fn refine_among<L: Laws + ?Sized>(
                 (settings.friction > 0.0).then_some((before.as_slice(), RELAG_TRAVEL_SPACINGS * kinematic.spacing));
             let step_limit = lag.mean_slip(&x) + RELAG_SHARE * limit;
             let frictional = Frictional { inner: &objective, lag: &lag, slide_limit: step_limit, travel };
-            let report = solve(&frictional, &mut x, &cons, &solver_settings.clone().max_iterations(budget));
+            let mut this_solve = solver_settings.clone().max_iterations(budget);
+            if forming.is_some() {
+                // Forming is driven by the tools: their forces set the scale of balance.
+                this_solve.reaction_scale = Some(reaction_scale(&lag, &gripped));
+            }
+            let report = solve(&frictional, &mut x, &cons, &this_solve);
             budget = budget.saturating_sub(report.iterations.len());
             let outcome = report.outcome;
             steps.push(report);
-            let now = bearings(&cons, &x, &objective.evaluate(&x, false));
+            let now = bear(&x, &objective.evaluate(&x, false));
             increment.lag_change = lag_change(&lag.bearing, &now);
             // How far the ply slid over the tool in this increment (normal-force weighted mean).
             let sliding = lag.mean_slip(&x);
@@ -679,6 +736,20 @@ fn refine_among<L: Laws + ?Sized>(
 /// the tool, and at least [`SLIDE_MIN_SPACINGS`] spacings.
 fn slide_limit(lag: &FrictionLag, spacing: f64) -> f64 {
     (SLIDE_SHARE * lag.extent()).max(SLIDE_MIN_SPACINGS * spacing)
+}
+
+/// The forces the tools exert on a formed ply, as the lag has them (N, their norm over the
+/// nodes): the punch's and the die's normal forces, and the binder's grip in its plane (its
+/// friction capacity: the binder's normal force only clamps).
+fn reaction_scale(lag: &FrictionLag, gripped: &[bool]) -> f64 {
+    (lag.bearing.iter().zip(gripped))
+        .filter_map(|(b, &g)| {
+            let f = b.as_ref()?.force.max(0.0);
+            Some(if g { lag.mu * f } else { f })
+        })
+        .map(|f| f * f)
+        .sum::<f64>()
+        .sqrt()
 }
 
 /// How much the normal forces changed from `before` to `after`: the sum of the changes over the

@@ -106,7 +106,7 @@ pub struct SheetFeatures {
 pub const BLANK_SLIVER: f64 = 1e-6;
 
 /// The area of the polygon `p` (either orientation), m^2.
-fn polygon_area(p: &[[f64; 2]]) -> f64 {
+pub(crate) fn polygon_area(p: &[[f64; 2]]) -> f64 {
     let n = p.len();
     0.5 * (0..n).map(|k| p[k][0] * p[(k + 1) % n][1] - p[(k + 1) % n][0] * p[k][1]).sum::<f64>().abs()
 }
@@ -133,7 +133,7 @@ pub fn check_blank(blank: &[[f64; 2]]) -> Result<f64, SheetError> {
 }
 
 /// Whether `q` lies inside the polygon `p` (even-odd rule).
-fn point_in_polygon(q: (f64, f64), p: &[[f64; 2]]) -> bool {
+pub(crate) fn point_in_polygon(q: (f64, f64), p: &[[f64; 2]]) -> bool {
     let mut inside = false;
     let n = p.len();
     for k in 0..n {

@@ -94,6 +94,9 @@ pub struct SolverSettings {
     /// The force |F - P| is measured against when there are no loads (|P| = 0), in N; default:
     /// the internal forces over the free directions at the start.
     pub force_scale: Option<f64>,
+    /// The forces the tools exert on the ply (N, their norm over the nodes), where they dwarf its
+    /// weight (a punch, a binder): |F - P| is measured against the larger of them and |P|.
+    pub reaction_scale: Option<f64>,
     /// Initial pseudo-transient shift, relative to the model's mean stiffness over the mean
     /// nodal mass (0 starts with Newton's step).
     pub initial_shift: f64,
@@ -123,6 +126,7 @@ impl Default for SolverSettings {
             max_iterations: 100,
             tolerance: 1e-4,
             force_scale: None,
+            reaction_scale: None,
             initial_shift: 1e-6,
             second_order_correction: true,
             stability_check: true,
@@ -458,8 +462,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let dofs0 = dofs_of(&state.bases, &rep);
     let cap0 = full.iter().zip(&dofs0).map(|(&f, &d)| if d > 0 { f.max(d) } else { 0 }).collect();
     let mut red = Reduction::new(cap0, dofs0, rep.clone(), &pairs);
-    let force_scale = if load > 0.0 {
-        load
+    let force_scale = if load > 0.0 || settings.reaction_scale.is_some() {
+        load.max(settings.reaction_scale.unwrap_or(0.0))
     } else {
         settings
             .force_scale

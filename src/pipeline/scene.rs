@@ -81,11 +81,22 @@
 //! #                           # shape the sheet is cut to, corners in fabric coordinates (u, v)
 //! #                           # from the origin node (here a square at 45 deg to the fibres);
 //! #                           # cells the edge cuts keep their share of the blank's fabric
+//! # stroke = [0.0, 0.0, 0.05] # with start = "flat" and mode = "pressed": the blank is formed by
+//! #                           # the tool (the punch) moving this far over the increments (at most
+//! #                           # half a spacing each); the tool file has it where the stroke ends,
+//! #                           # the blank lies flat on it where the stroke begins
+//! # die = "die.obj"           # optional: the female tool, still; the ply stays on the side of it
+//! #                           # that faces the punch
+//! # [ply.binder]              # optional: a blank holder clamping the blank in its plane outside
+//! # outline = [[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]  # its opening in plan view
+//! #                           # across the stroke ([x, y] for a stroke along z)
+//! # pressure = 1.0e4          # Pa; friction (the ply's) on both faces
 //! ```
 use super::{parse_generators, unit_scale};
 use crate::geometry::{Point, Vector};
 use crate::io::flow::FlowFormat;
 use crate::io::points::read_points;
+use crate::io::read_tool;
 use crate::io::vtk::VtuEncoding;
 use crate::kinematic::fishnet::check_memory;
 use crate::kinematic::{Extent, KinematicSettings, SurfaceKind, DEFAULT_MAX_SHEAR_DEG};
@@ -96,6 +107,7 @@ use crate::layup::{
 };
 use crate::material::flow::Cavity;
 use crate::material::MaterialCard;
+use crate::mechanics::forming::{die_facing, Binder, Forming};
 use crate::mechanics::sheet::{
     blank_fractions, check_blank, default_origin_node, Cut, Factors, Fold, Region, Reinforcement, Seam, SheetFeatures,
 };
@@ -103,6 +115,7 @@ use crate::mechanics::ContactMode;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Why a scene could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -215,6 +228,16 @@ struct PlyFile {
     #[serde(default)]
     cut: Vec<CutFile>,
     blank: Option<Vec<[f64; 2]>>,
+    stroke: Option<[f64; 3]>,
+    die: Option<String>,
+    binder: Option<BinderFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BinderFile {
+    outline: Vec<[f64; 2]>,
+    pressure: f64,
 }
 
 #[derive(Deserialize)]
@@ -292,6 +315,7 @@ fn refinement(
     extent: &Extent,
     scale: f64,
     scene_friction: Option<f64>,
+    base: &Path,
 ) -> Result<Refinement, (&'static str, String)> {
     let m = material.ok_or((
         "material",
@@ -317,8 +341,11 @@ fn refinement(
             if !matches!(extent, Extent::Grid { .. }) {
                 return Err(("start", "a flat sheet needs a grid (not an outline)".into()));
             }
-            if mode != ContactMode::Free {
-                return Err(("start", "a flat sheet hangs under gravity: give mode = \"free\"".into()));
+            if mode == ContactMode::Pressed && p.stroke.is_none() {
+                return Err((
+                    "stroke",
+                    "a flat blank pressed onto the tool is formed by the tool's stroke: give stroke = [dx, dy, dz], the punch's travel (the tool file has it where the stroke ends), or mode = \"free\" to let the sheet hang under gravity".into(),
+                ));
             }
             Start::Flat { normal: n.normalize() }
         }
@@ -418,6 +445,7 @@ fn refinement(
             }
         }
     }
+    let forming = forming(p, start, mode, base, scale)?;
     let seam = sheet.seam;
     Ok(Refinement {
         material: m.card.clone(),
@@ -463,7 +491,52 @@ fn refinement(
             }
         },
         escape_saddles: p.escape_saddles.unwrap_or(false),
+        forming,
     })
+}
+
+/// The forming process of a flat blank pressed onto the tool: the punch's stroke, the die, the
+/// binder (errors name the field).
+fn forming(
+    p: &PlyFile,
+    start: Start,
+    mode: ContactMode,
+    base: &Path,
+    scale: f64,
+) -> Result<Option<Forming>, (&'static str, String)> {
+    let formed = matches!(start, Start::Flat { .. }) && mode == ContactMode::Pressed;
+    if !formed {
+        for (field, given) in [("stroke", p.stroke.is_some()), ("die", p.die.is_some()), ("binder", p.binder.is_some())]
+        {
+            if given {
+                return Err((
+                    field,
+                    "only a flat blank formed by the tools uses it: give start = \"flat\" and mode = \"pressed\""
+                        .into(),
+                ));
+            }
+        }
+        return Ok(None);
+    }
+    let stroke = p.stroke.expect("a formed blank has its stroke (checked with start)");
+    let stroke = Vector::new(stroke[0], stroke[1], stroke[2]) * scale;
+    let origin = Point::new(p.origin[0], p.origin[1], p.origin[2]) * scale;
+    let die = match &p.die {
+        None => None,
+        Some(file) => {
+            let path = base.join(file);
+            let die = read_tool(&path, scale).map_err(|e| ("die", format!("{e}")))?;
+            let die = die_facing(die, &origin, &stroke).map_err(|e| ("die", format!("{e}")))?;
+            Some(Arc::new(die))
+        }
+    };
+    let binder = p.binder.as_ref().map(|b| Binder {
+        outline: b.outline.iter().map(|q| [q[0] * scale, q[1] * scale]).collect(),
+        pressure: b.pressure,
+    });
+    let forming = Forming { stroke, die, binder };
+    forming.check(&origin).map_err(|e| (e.field, e.message))?;
+    Ok(Some(forming))
 }
 
 /// Gap between nested flat patterns when the scene gives none, metres.
@@ -676,15 +749,18 @@ impl Scene {
                         ("fold", p.fold.is_some()),
                         ("cut", !p.cut.is_empty()),
                         ("blank", p.blank.is_some()),
+                        ("stroke", p.stroke.is_some()),
+                        ("die", p.die.is_some()),
+                        ("binder", p.binder.is_some()),
                     ];
                     if let Some((field, _)) = mechanical_only.iter().find(|(_, given)| *given) {
                         return Err(at(field, "only a ply with method = \"mechanical\" uses it".into()));
                     }
                     None
                 }
-                "mechanical" => {
-                    Some(refinement(p, material.as_ref(), &extent, scale, file.friction).map_err(|(f, m)| at(f, m))?)
-                }
+                "mechanical" => Some(
+                    refinement(p, material.as_ref(), &extent, scale, file.friction, base).map_err(|(f, m)| at(f, m))?,
+                ),
                 "auto" => {
                     if material.is_none() {
                         return Err(at(
@@ -692,8 +768,8 @@ impl Scene {
                             "method = \"auto\" weighs the kinematic net under the ply's material card: give material = \"card.toml\" or a name from [materials]".into(),
                         ));
                     }
-                    let r =
-                        refinement(p, material.as_ref(), &extent, scale, file.friction).map_err(|(f, m)| at(f, m))?;
+                    let r = refinement(p, material.as_ref(), &extent, scale, file.friction, base)
+                        .map_err(|(f, m)| at(f, m))?;
                     if r.mode != ContactMode::Pressed {
                         return Err(at(
                             "mode",
