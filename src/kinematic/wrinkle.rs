@@ -1,0 +1,375 @@
+//! Wrinkles: per cell of a draped net, how far the ply stands off the surface it was draped on
+//! (the tool gap) and how much it undulates about its own smoothed surface (the waviness); a
+//! cell wavier than a threshold is wrinkled, and the wrinkled cells' draped area is the ply's
+//! wrinkled area. (The bending energy density beside them comes from the mechanics' bending
+//! term, `mechanics::energy::bending_energy_density`, which this layer cannot call: the caller
+//! hands it in.)
+//!
+//! **The smoothed surface.** At each node the placed nodes about it, weighted by a Gaussian of
+//! their distance in the fabric (standard deviation σ = [`SMOOTHING_SPACINGS`] fibre spacings,
+//! cut at [`WINDOW_SIGMAS`] σ), are fitted by weighted least squares with a quadric height
+//! `z = a0 + a1 x + a2 y + a3 x² + a4 x y + a5 y²` over the plane normal to the ply's smoothed
+//! normal there (the same Gaussian's mean of the cells' unit normals). The node's *deviation* is
+//! its height above that quadric, `-a0`.
+//!
+//! **Waviness** of a cell: √2 times the standard deviation of the nodes' deviations, weighted by
+//! the same Gaussian about the cell's centre: the amplitude of the sinusoid of that spread, in
+//! metres. A spread, not a mean, so a deviation that is the same at every node (the fit's own
+//! error on a sphere, below) is no waviness.
+//!
+//! What it reads, derived for the continuous fit (the grid's weighted sums are those integrals
+//! up to the window's cut, whose weight is e^(-3.5²/2) = 0.2 % of the whole):
+//! - A ripple `A sin(k u)` of the ply along its normal, of wavelength λ = 2π/k, reads `A T(k)`
+//!   with `T = 1 - (1 + q) e^(-q)`, `q = (k σ)² / 2`: the weighted local quadratic fit is a
+//!   smoothing whose equivalent kernel has the Fourier transform `(1 + q) e^(-q)`; the weighted
+//!   mean the spread removes and the sampled `sin²` change it by factors `1 ± e^(-2q)`. With
+//!   σ = 2 spacings: T = 0.9985, 0.957, 0.823, 0.644, 0.350 for λ = 3, 4, 5, 6, 8 spacings: an
+//!   undulation up to 4 spacings long is read in full, longer ones increasingly as the ply's
+//!   shape. (The net cannot show one shorter than 2 spacings.)
+//! - A smooth surface is fitted up to its fourth-order terms: on a sphere of radius R every node
+//!   lies σ⁴/R³ above its quadric, on a cylinder 3σ⁴/(8R³) (the Gaussian's moments
+//!   E x⁴ = 3σ⁴, E x⁶ = 15σ⁶). That is the same at every node whose window is whole, so there the
+//!   waviness is ~0; where the window is cut by the ply's edge the deviations differ and the
+//!   waviness stays below √2 times the largest of them. A tool radius R thus reads at most about
+//!   √2 σ⁴/R³ near the ply's edges: 0.11 mm for R = 50 mm at 5 mm spacing. A tool whose
+//!   curvature jumps (a fillet meeting a flat) within a few σ reads more there: a drape on such
+//!   a tool should be judged with a spacing fine against its radii.
+//!
+//! **The threshold** ([`threshold`]): the ply's thickness ([`THICKNESS_FRACTION`] of it), else
+//! [`DEFAULT_THRESHOLD_M`]. A ply that undulates about its own smoothed surface by more than its
+//! thickness no longer lies within the layer it takes up when the laminate is consolidated: the
+//! undulation cannot be pressed out within the ply's own thickness, so its fibres stay wavy
+//! (out-of-plane fibre waviness, the wrinkle defect whose amplitude against the ply thickness
+//! governs the loss of compressive strength). Without a thickness, 0.5 mm: the thickness of a
+//! heavy woven or non-crimp ply, so a thinner ply is judged leniently rather than flagged
+//! everywhere.
+//!
+//! **Tool gap** of a cell: the largest distance of its four corners from the surface the ply
+//! was draped on (the tool, or the tool offset by the plies below), measured to its facets. On
+//! a kinematic drape on the facets it is zero up to rounding; a ply on the smooth surface over
+//! them (`surface = "smooth"`, or pressed by the mechanics) lies up to their sagitta off them; a
+//! free drape that hangs off the tool has large gaps there by design.
+//!
+//! Cells that are not complete get no value (`None`), as their shear. Each value is a function
+//! of the net alone (and of the surface), computed in parallel: the same for any thread count.
+use super::net::{DrapeNet, NodeStatus};
+use super::provenance::{WrinkleRecord, WrinkleSummary, WrinkleThresholdFrom};
+use crate::geometry::{ToolSurface, Vector};
+use nalgebra::{Matrix6, Vector6};
+use rayon::prelude::*;
+
+/// The standard deviation of the Gaussian weights of the smoothed surface and of the waviness,
+/// in fibre spacings: ripples up to 4 spacings long are read in full (see the module's notes),
+/// tool radii above about 10 σ read as smooth.
+pub const SMOOTHING_SPACINGS: f64 = 2.0;
+
+/// The windows end this many σ from their centre: the weight beyond is e^(-3.5²/2) = 0.2 % of
+/// the whole (a Gaussian in the plane), and a window holds about 150 nodes.
+pub const WINDOW_SIGMAS: f64 = 3.5;
+
+/// The waviness threshold of a ply without a thickness, m: a heavy woven or non-crimp ply's
+/// thickness (see the module's notes).
+pub const DEFAULT_THRESHOLD_M: f64 = 0.5e-3;
+
+/// The waviness threshold of a ply with a thickness, as a share of it: a ply undulating by more
+/// than its thickness cannot be consolidated flat within its own layer.
+pub const THICKNESS_FRACTION: f64 = 1.0;
+
+/// A weighted fit's normal equations are solved by Cholesky unless a pivot falls below this
+/// share of their largest diagonal entry (nodes nearly on a line or a conic: too few to fix a
+/// quadric); then by the pseudo-inverse, whose singular values below this share count as zero.
+/// The fit's coordinates are in units of σ, so a well-spread window has pivots of order 1.
+const SINGULAR: f64 = 1e-12;
+
+/// The waviness above which a ply's cell is wrinkled, m, for a ply of `thickness` (m), and where
+/// it comes from.
+pub fn threshold(thickness: Option<f64>) -> (f64, WrinkleThresholdFrom) {
+    match thickness.filter(|t| t.is_finite() && *t > 0.0) {
+        Some(t) => (THICKNESS_FRACTION * t, WrinkleThresholdFrom::Thickness),
+        None => (DEFAULT_THRESHOLD_M, WrinkleThresholdFrom::Default),
+    }
+}
+
+/// Grid offsets (a, b) and Gaussian weights of a window about a point `shift` spacings past a
+/// node in both directions: the offsets whose distance `|(a + shift, b + shift)|` is within
+/// [`WINDOW_SIGMAS`] σ. Nodes about a node: shift 0; nodes about a cell's centre: -0.5.
+fn window(shift: f64) -> Vec<(isize, isize, f64)> {
+    let s = SMOOTHING_SPACINGS;
+    let reach = s * WINDOW_SIGMAS;
+    let n = reach.ceil() as isize + 1;
+    let mut out = Vec::new();
+    for a in -n..=n {
+        for b in -n..=n {
+            let r2 = (a as f64 + shift).powi(2) + (b as f64 + shift).powi(2);
+            if r2 <= reach * reach {
+                out.push((a, b, (-r2 / (2.0 * s * s)).exp()));
+            }
+        }
+    }
+    out
+}
+
+/// Node (i + a, j + b) of an `nu x nv` grid, if inside it.
+#[inline]
+fn offset(i: usize, j: usize, a: isize, b: isize, nu: usize, nv: usize) -> Option<(usize, usize)> {
+    let (p, q) = (i as isize + a, j as isize + b);
+    (p >= 0 && q >= 0 && (p as usize) < nu && (q as usize) < nv).then_some((p as usize, q as usize))
+}
+
+/// Each node's deviation from the ply's smoothed surface there (m, signed along the smoothed
+/// normal), in node order; `None` for a node that is not a corner of a complete cell.
+pub fn node_deviations(net: &DrapeNet) -> Vec<Option<f64>> {
+    let (nu, nv) = (net.nu, net.nv);
+    if nu < 2 || nv < 2 {
+        return vec![None; nu * nv];
+    }
+    let cv = nv - 1;
+    let normals: Vec<Option<Vector>> = (0..net.num_cells())
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .map(|c| net.cell_frame(c / cv, c % cv).map(|f| f.normal))
+        .collect();
+    let smoothed = smoothed_normals(&normals, nu, nv);
+    let nodes_about = window(0.0);
+    let h = SMOOTHING_SPACINGS * net.spacing;
+    (0..nu * nv)
+        .into_par_iter()
+        .with_min_len(1 << 8)
+        .map(|k| {
+            let (i, j) = (k / nv, k % nv);
+            let c = net.node(i, j)?;
+            // The node's own cells: it must be a corner of one; their normal is the fallback.
+            let own = [(-1, -1), (-1, 0), (0, -1), (0, 0)]
+                .into_iter()
+                .filter_map(|(a, b)| offset(i, j, a, b, nu - 1, nv - 1))
+                .filter_map(|(p, q)| normals[p * cv + q])
+                .fold(None, |acc: Option<Vector>, n| Some(acc.unwrap_or_else(Vector::zeros) + n))?;
+            let smoothed = smoothed[k];
+            let n = smoothed.try_normalize(0.0).or_else(|| own.try_normalize(0.0))?;
+            // Any tangent basis: the quadrics are the same whatever its turn about n.
+            let axis = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
+                Vector::x()
+            } else if n.y.abs() <= n.z.abs() {
+                Vector::y()
+            } else {
+                Vector::z()
+            };
+            let e1 = n.cross(&axis).normalize();
+            let e2 = n.cross(&e1);
+            // The weighted moments of the monomials up to degree four (the normal equations'
+            // entries: 15 distinct) and of the heights times those up to degree two.
+            let (e1, e2) = (e1 / h, e2 / h);
+            let mut mo = [0.0f64; 15];
+            let mut rz = [0.0f64; 6];
+            for &(a, b, w) in &nodes_about {
+                let Some((p, q)) = offset(i, j, a, b, nu, nv) else { continue };
+                let k = p * nv + q;
+                if net.status[k] != NodeStatus::Placed {
+                    continue;
+                }
+                let d = net.positions[k] - c;
+                let (x, y, z) = (d.dot(&e1), d.dot(&e2), d.dot(&n));
+                let (wx, wy) = (w * x, w * y);
+                let (wxx, wxy, wyy) = (wx * x, wx * y, wy * y);
+                let (xx, xy, yy) = (x * x, x * y, y * y);
+                let m = [
+                    w,
+                    wx,
+                    wy,
+                    wxx,
+                    wxy,
+                    wyy,
+                    wxx * x,
+                    wxx * y,
+                    wxy * y,
+                    wyy * y,
+                    wxx * xx,
+                    wxx * xy,
+                    wxx * yy,
+                    wxy * yy,
+                    wyy * yy,
+                ];
+                for (acc, v) in mo.iter_mut().zip(m) {
+                    *acc += v;
+                }
+                let wz = w * z;
+                for (acc, v) in rz.iter_mut().zip([wz, wz * x, wz * y, wz * xx, wz * xy, wz * yy]) {
+                    *acc += v;
+                }
+            }
+            // Moments by (power of x, power of y): index in `mo`.
+            let [m00, m10, m01, m20, m11, m02, m30, m21, m12, m03, m40, m31, m22, m13, m04] = mo;
+            #[rustfmt::skip]
+            let m = Matrix6::new(
+                m00, m10, m01, m20, m11, m02,
+                m10, m20, m11, m30, m21, m12,
+                m01, m11, m02, m21, m12, m03,
+                m20, m30, m21, m40, m31, m22,
+                m11, m21, m12, m31, m22, m13,
+                m02, m12, m03, m22, m13, m04,
+            );
+            let r = Vector6::from(rz);
+            Some(-solve(m, r)[0])
+        })
+        .collect()
+}
+
+/// At each node, the sum of the complete cells' unit normals (`normals`, `None` where a cell is
+/// not complete) weighted by the Gaussian of their centres' fabric distance from the node, out
+/// to [`WINDOW_SIGMAS`] σ along each fibre: the Gaussian factors, so the sum is taken along the
+/// weft and then along the warp.
+fn smoothed_normals(normals: &[Option<Vector>], nu: usize, nv: usize) -> Vec<Vector> {
+    let (cu, cv) = (nu - 1, nv - 1);
+    let s = SMOOTHING_SPACINGS;
+    let reach = s * WINDOW_SIGMAS;
+    // Cells (by their lower corner) at offsets b from a node: centres at b + 1/2.
+    let n = reach.ceil() as isize;
+    let taps: Vec<(isize, f64)> = (-n - 1..=n)
+        .map(|b| (b, (b as f64 + 0.5)))
+        .filter(|(_, x)| x.abs() <= reach)
+        .map(|(b, x)| (b, (-x * x / (2.0 * s * s)).exp()))
+        .collect();
+    let tap = |len: usize, at: usize, value: &dyn Fn(usize) -> Vector| {
+        taps.iter()
+            .filter_map(|&(b, w)| {
+                let q = at as isize + b;
+                (q >= 0 && (q as usize) < len).then(|| value(q as usize) * w)
+            })
+            .fold(Vector::zeros(), |acc, v| acc + v)
+    };
+    // Along the weft: per cell row, at each node column.
+    let rows: Vec<Vector> = (0..cu * nv)
+        .into_par_iter()
+        .with_min_len(1 << 10)
+        .map(|k| {
+            let (i, j) = (k / nv, k % nv);
+            tap(cv, j, &|q| normals[i * cv + q].unwrap_or_else(Vector::zeros))
+        })
+        .collect();
+    // Along the warp: at each node.
+    (0..nu * nv)
+        .into_par_iter()
+        .with_min_len(1 << 10)
+        .map(|k| {
+            let (i, j) = (k / nv, k % nv);
+            tap(cu, i, &|p| rows[p * nv + j])
+        })
+        .collect()
+}
+
+/// The weighted least-squares coefficients from the normal equations `m a = r` (see
+/// [`SINGULAR`]).
+fn solve(m: Matrix6<f64>, r: Vector6<f64>) -> Vector6<f64> {
+    let scale = m.diagonal().max();
+    if !(scale > 0.0) {
+        return Vector6::zeros();
+    }
+    if let Some(ch) = m.cholesky() {
+        let l = ch.l_dirty();
+        if (0..6).all(|k| l[(k, k)] * l[(k, k)] > SINGULAR * scale) {
+            return ch.solve(&r);
+        }
+    }
+    let svd = m.svd(true, true);
+    let eps = SINGULAR * svd.singular_values.max();
+    svd.solve(&r, eps).unwrap_or_else(|_| Vector6::zeros())
+}
+
+/// Each cell's waviness (m) from the nodes' deviations ([`node_deviations`]), in cell order;
+/// `None` for a cell that is not complete.
+pub fn cell_waviness(net: &DrapeNet, deviations: &[Option<f64>]) -> Vec<Option<f64>> {
+    let (nu, nv) = (net.nu, net.nv);
+    assert_eq!(deviations.len(), nu * nv, "one deviation per node");
+    let cv = nv.saturating_sub(1);
+    let nodes_about = window(-0.5);
+    (0..net.num_cells())
+        .into_par_iter()
+        .with_min_len(1 << 10)
+        .map(|c| {
+            let (i, j) = (c / cv, c % cv);
+            net.cell_corners(i, j)?;
+            // One pass, the deviations taken from the cell's first corner's (a value among them,
+            // so the sums do not cancel when the deviations share a large common part).
+            let shift = deviations[i * nv + j]?;
+            let (mut total, mut sum, mut squares) = (0.0, 0.0, 0.0);
+            for &(a, b, w) in &nodes_about {
+                let Some((p, q)) = offset(i, j, a, b, nu, nv) else { continue };
+                if let Some(d) = deviations[p * nv + q] {
+                    let e = d - shift;
+                    total += w;
+                    sum += w * e;
+                    squares += w * e * e;
+                }
+            }
+            let mean = sum / total;
+            let var = (squares / total - mean * mean).max(0.0);
+            Some((2.0 * var).sqrt())
+        })
+        .collect()
+}
+
+/// Each cell's tool gap (m): the largest distance of its corners from `surface`, in cell order;
+/// `None` for a cell that is not complete.
+pub fn cell_tool_gaps(net: &DrapeNet, surface: &ToolSurface) -> Vec<Option<f64>> {
+    let triangles = surface.triangles().len();
+    let gaps: Vec<Option<f64>> = (0..net.positions.len())
+        .into_par_iter()
+        .with_min_len(1 << 8)
+        .map(|k| {
+            (net.status[k] == NodeStatus::Placed).then(|| {
+                let hint = Some(net.triangles[k]).filter(|t| (*t as usize) < triangles);
+                surface.closest_point_from(&net.positions[k], hint).distance
+            })
+        })
+        .collect();
+    let (nv, cv) = (net.nv, net.nv.saturating_sub(1));
+    (0..net.num_cells())
+        .map(|c| {
+            let k = (c / cv) * nv + c % cv;
+            [k, k + 1, k + nv, k + nv + 1].into_iter().map(|n| gaps[n]).try_fold(0.0f64, |m, g| Some(m.max(g?)))
+        })
+        .collect()
+}
+
+/// The wrinkles of `net`, draped on `surface`, for a ply of `thickness` (m; the threshold, see
+/// [`threshold`]), with each cell's bending energy density (J/m^2, in cell order) when the ply
+/// has a material card.
+///
+/// # Panics
+/// If `bending` is given with other than one entry per cell.
+pub fn measure(
+    net: &DrapeNet,
+    surface: &ToolSurface,
+    thickness: Option<f64>,
+    bending: Option<Vec<Option<f64>>>,
+) -> WrinkleRecord {
+    let waviness = cell_waviness(net, &node_deviations(net));
+    let tool_gap = cell_tool_gaps(net, surface);
+    let bending = bending.unwrap_or_default();
+    assert!(bending.is_empty() || bending.len() == net.num_cells(), "one bending energy density per cell");
+    let (threshold_m, threshold_from) = threshold(thickness);
+    let cv = net.nv.saturating_sub(1);
+    let (mut wrinkled_cells, mut wrinkled_area_m2) = (0, 0.0);
+    for (c, w) in waviness.iter().enumerate() {
+        if w.is_some_and(|w| w > threshold_m) {
+            wrinkled_cells += 1;
+            wrinkled_area_m2 += net.cell_area(c / cv, c % cv).unwrap_or(0.0);
+        }
+    }
+    let largest = |v: &[Option<f64>]| v.iter().flatten().copied().reduce(f64::max);
+    WrinkleRecord {
+        summary: WrinkleSummary {
+            threshold_m,
+            threshold_from,
+            smoothing_spacings: SMOOTHING_SPACINGS,
+            wrinkled_cells,
+            wrinkled_area_m2,
+            max_waviness_m: largest(&waviness),
+            max_tool_gap_m: largest(&tool_gap),
+            max_bending_energy_density_j_m2: largest(&bending),
+        },
+        waviness_m: waviness,
+        tool_gap_m: tool_gap,
+        bending_energy_density_j_m2: bending,
+    }
+}
