@@ -610,7 +610,8 @@ pub struct WrinkleRecord {
     /// The figures of the whole ply.
     #[serde(flatten)]
     pub summary: WrinkleSummary,
-    /// Waviness: the amplitude of the ply's undulation about its own smoothed surface, m.
+    /// Waviness: the amplitude of the ply's undulation about its own smoothed surface and about
+    /// the tool, the smaller of the two, m.
     pub waviness_m: Vec<Option<f64>>,
     /// The largest distance of the cell's corners from the surface the ply was draped on (the
     /// tool, or the tool offset by the plies below), m: large by design where a ply hangs off

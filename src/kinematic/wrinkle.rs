@@ -10,12 +10,23 @@
 //! cut at [`WINDOW_SIGMAS`] σ), are fitted by weighted least squares with a quadric height
 //! `z = a0 + a1 x + a2 y + a3 x² + a4 x y + a5 y²` over the plane normal to the ply's smoothed
 //! normal there (the same Gaussian's mean of the cells' unit normals). The node's *deviation* is
-//! its height above that quadric, `-a0`.
+//! its height above that quadric, `-a0` ([`node_deviations`]).
 //!
 //! **Waviness** of a cell: √2 times the standard deviation of the nodes' deviations, weighted by
 //! the same Gaussian about the cell's centre: the amplitude of the sinusoid of that spread, in
-//! metres. A spread, not a mean, so a deviation that is the same at every node (the fit's own
-//! error on a sphere, below) is no waviness.
+//! metres ([`cell_waviness`]). A spread, not a mean, so a deviation that is the same at every
+//! node (the fit's own error on a sphere, below) is no waviness. It is read twice, and the
+//! smaller reading counts:
+//! - about the ply's own smoothed surface, as above;
+//! - about the tool: the same fit and spread of the nodes' signed gaps to the surface they were
+//!   draped on, over the nodes' fabric coordinates ([`gap_deviations`]).
+//!
+//! Either alone mistakes a shape for a wrinkle, the other not: the fit cannot follow a tool
+//! radius of the order of σ (the double dome's 15 mm fillets at 5 mm spacing read 0.7 mm about
+//! the ply's own surface), but a ply lying on its tool has no gap to undulate; and a ply that
+//! hangs or bridges smoothly off the tool has gaps whose curvature jumps where the closest
+//! feature of the tool changes (a table's top to its edge), but a smooth own surface. A wrinkle
+//! undulates about both, and reads its amplitude in each.
 //!
 //! What it reads, derived for the continuous fit (the grid's weighted sums are those integrals
 //! up to the window's cut, whose weight is e^(-3.5²/2) = 0.2 % of the whole):
@@ -25,15 +36,15 @@
 //!   mean the spread removes and the sampled `sin²` change it by factors `1 ± e^(-2q)`. With
 //!   σ = 2 spacings: T = 0.9985, 0.957, 0.823, 0.644, 0.350 for λ = 3, 4, 5, 6, 8 spacings: an
 //!   undulation up to 4 spacings long is read in full, longer ones increasingly as the ply's
-//!   shape. (The net cannot show one shorter than 2 spacings.)
+//!   shape. (The net cannot show one shorter than 2 spacings.) The same holds of a ripple of
+//!   the gap to a tool.
 //! - A smooth surface is fitted up to its fourth-order terms: on a sphere of radius R every node
 //!   lies σ⁴/R³ above its quadric, on a cylinder 3σ⁴/(8R³) (the Gaussian's moments
 //!   E x⁴ = 3σ⁴, E x⁶ = 15σ⁶). That is the same at every node whose window is whole, so there the
-//!   waviness is ~0; where the window is cut by the ply's edge the deviations differ and the
-//!   waviness stays below √2 times the largest of them. A tool radius R thus reads at most about
-//!   √2 σ⁴/R³ near the ply's edges: 0.11 mm for R = 50 mm at 5 mm spacing. A tool whose
-//!   curvature jumps (a fillet meeting a flat) within a few σ reads more there: a drape on such
-//!   a tool should be judged with a spacing fine against its radii.
+//!   own reading is ~0; where the window is cut by the ply's edge the deviations differ and it
+//!   stays below √2 times the largest of them: about √2 σ⁴/R³ near the ply's edges, 0.11 mm for
+//!   R = 50 mm at 5 mm spacing. A tool whose curvature jumps (a fillet meeting a flat) within a
+//!   few σ reads more there; the reading about the tool does not, where the ply lies on it.
 //!
 //! **The threshold** ([`threshold`]): the ply's thickness ([`THICKNESS_FRACTION`] of it), else
 //! [`DEFAULT_THRESHOLD_M`]. A ply that undulates about its own smoothed surface by more than its
@@ -156,62 +167,114 @@ pub fn node_deviations(net: &DrapeNet) -> Vec<Option<f64>> {
             };
             let e1 = n.cross(&axis).normalize();
             let e2 = n.cross(&e1);
-            // The weighted moments of the monomials up to degree four (the normal equations'
-            // entries: 15 distinct) and of the heights times those up to degree two.
             let (e1, e2) = (e1 / h, e2 / h);
-            let mut mo = [0.0f64; 15];
-            let mut rz = [0.0f64; 6];
-            for &(a, b, w) in &nodes_about {
-                let Some((p, q)) = offset(i, j, a, b, nu, nv) else { continue };
-                let k = p * nv + q;
-                if net.status[k] != NodeStatus::Placed {
-                    continue;
-                }
-                let d = net.positions[k] - c;
-                let (x, y, z) = (d.dot(&e1), d.dot(&e2), d.dot(&n));
-                let (wx, wy) = (w * x, w * y);
-                let (wxx, wxy, wyy) = (wx * x, wx * y, wy * y);
-                let (xx, xy, yy) = (x * x, x * y, y * y);
-                let m = [
-                    w,
-                    wx,
-                    wy,
-                    wxx,
-                    wxy,
-                    wyy,
-                    wxx * x,
-                    wxx * y,
-                    wxy * y,
-                    wyy * y,
-                    wxx * xx,
-                    wxx * xy,
-                    wxx * yy,
-                    wxy * yy,
-                    wyy * yy,
-                ];
-                for (acc, v) in mo.iter_mut().zip(m) {
-                    *acc += v;
-                }
-                let wz = w * z;
-                for (acc, v) in rz.iter_mut().zip([wz, wz * x, wz * y, wz * xx, wz * xy, wz * yy]) {
-                    *acc += v;
-                }
-            }
-            // Moments by (power of x, power of y): index in `mo`.
-            let [m00, m10, m01, m20, m11, m02, m30, m21, m12, m03, m40, m31, m22, m13, m04] = mo;
-            #[rustfmt::skip]
-            let m = Matrix6::new(
-                m00, m10, m01, m20, m11, m02,
-                m10, m20, m11, m30, m21, m12,
-                m01, m11, m02, m21, m12, m03,
-                m20, m30, m21, m40, m31, m22,
-                m11, m21, m12, m31, m22, m13,
-                m02, m12, m03, m22, m13, m04,
-            );
-            let r = Vector6::from(rz);
-            Some(-solve(m, r)[0])
+            let samples = nodes_about.iter().filter_map(|&(a, b, w)| {
+                let (p, q) = offset(i, j, a, b, nu, nv)?;
+                let d = net.node(p, q)? - c;
+                Some((w, d.dot(&e1), d.dot(&e2), d.dot(&n)))
+            });
+            // The node lies at height 0 of its frame.
+            Some(-quadric_at_origin(samples))
         })
         .collect()
+}
+
+/// Each placed node's signed distance from `surface` (m): its distance from the closest point,
+/// negative where it lies behind the facet there (against the facet's normal); `None` for a
+/// node that is not placed.
+pub fn node_gaps(net: &DrapeNet, surface: &ToolSurface) -> Vec<Option<f64>> {
+    let triangles = surface.triangles().len();
+    (0..net.positions.len())
+        .into_par_iter()
+        .with_min_len(1 << 8)
+        .map(|k| {
+            (net.status[k] == NodeStatus::Placed).then(|| {
+                let p = net.positions[k];
+                let hint = Some(net.triangles[k]).filter(|t| (*t as usize) < triangles);
+                let foot = surface.closest_point_from(&p, hint);
+                foot.distance.copysign((p - foot.point).dot(&foot.normal))
+            })
+        })
+        .collect()
+}
+
+/// Each node's deviation of its gap to the tool (`gaps`, [`node_gaps`]) from the gaps smoothed
+/// about it (m): the same Gaussian-weighted quadric fit as [`node_deviations`], over the fabric
+/// coordinates of the nodes, in node order; `None` for a node that is not a corner of a
+/// complete cell. Where the ply lies on its tool the gaps are nil and so are these, whatever
+/// the tool's shape.
+pub fn gap_deviations(net: &DrapeNet, gaps: &[Option<f64>]) -> Vec<Option<f64>> {
+    let (nu, nv) = (net.nu, net.nv);
+    assert_eq!(gaps.len(), nu * nv, "one gap per node");
+    let nodes_about = window(0.0);
+    let s = SMOOTHING_SPACINGS;
+    (0..nu * nv)
+        .into_par_iter()
+        .with_min_len(1 << 8)
+        .map(|k| {
+            let (i, j) = (k / nv, k % nv);
+            let own = [(-1, -1), (-1, 0), (0, -1), (0, 0)]
+                .into_iter()
+                .filter_map(|(a, b)| offset(i, j, a, b, nu - 1, nv - 1))
+                .any(|(p, q)| net.cell_corners(p, q).is_some());
+            let g = gaps[k].filter(|_| own)?;
+            let samples = nodes_about.iter().filter_map(|&(a, b, w)| {
+                let (p, q) = offset(i, j, a, b, nu, nv)?;
+                Some((w, a as f64 / s, b as f64 / s, gaps[p * nv + q]? - g))
+            });
+            Some(-quadric_at_origin(samples))
+        })
+        .collect()
+}
+
+/// The value at the origin of the quadric `a0 + a1 x + a2 y + a3 x² + a4 x y + a5 y²` fitted by
+/// weighted least squares to the samples `(w, x, y, z)` (x, y in units of σ): from the weighted
+/// moments of the monomials up to degree four (the normal equations' 15 distinct entries) and
+/// of the heights times those up to degree two.
+fn quadric_at_origin(samples: impl Iterator<Item = (f64, f64, f64, f64)>) -> f64 {
+    let mut mo = [0.0f64; 15];
+    let mut rz = [0.0f64; 6];
+    for (w, x, y, z) in samples {
+        let (wx, wy) = (w * x, w * y);
+        let (wxx, wxy, wyy) = (wx * x, wx * y, wy * y);
+        let (xx, xy, yy) = (x * x, x * y, y * y);
+        let m = [
+            w,
+            wx,
+            wy,
+            wxx,
+            wxy,
+            wyy,
+            wxx * x,
+            wxx * y,
+            wxy * y,
+            wyy * y,
+            wxx * xx,
+            wxx * xy,
+            wxx * yy,
+            wxy * yy,
+            wyy * yy,
+        ];
+        for (acc, v) in mo.iter_mut().zip(m) {
+            *acc += v;
+        }
+        let wz = w * z;
+        for (acc, v) in rz.iter_mut().zip([wz, wz * x, wz * y, wz * xx, wz * xy, wz * yy]) {
+            *acc += v;
+        }
+    }
+    // Moments by (power of x, power of y).
+    let [m00, m10, m01, m20, m11, m02, m30, m21, m12, m03, m40, m31, m22, m13, m04] = mo;
+    #[rustfmt::skip]
+    let m = Matrix6::new(
+        m00, m10, m01, m20, m11, m02,
+        m10, m20, m11, m30, m21, m12,
+        m01, m11, m02, m21, m12, m03,
+        m20, m30, m21, m40, m31, m22,
+        m11, m21, m12, m31, m22, m13,
+        m02, m12, m03, m22, m13, m04,
+    );
+    solve(m, Vector6::from(rz))[0]
 }
 
 /// At each node, the sum of the complete cells' unit normals (`normals`, `None` where a cell is
@@ -308,25 +371,16 @@ pub fn cell_waviness(net: &DrapeNet, deviations: &[Option<f64>]) -> Vec<Option<f
         .collect()
 }
 
-/// Each cell's tool gap (m): the largest distance of its corners from `surface`, in cell order;
-/// `None` for a cell that is not complete.
-pub fn cell_tool_gaps(net: &DrapeNet, surface: &ToolSurface) -> Vec<Option<f64>> {
-    let triangles = surface.triangles().len();
-    let gaps: Vec<Option<f64>> = (0..net.positions.len())
-        .into_par_iter()
-        .with_min_len(1 << 8)
-        .map(|k| {
-            (net.status[k] == NodeStatus::Placed).then(|| {
-                let hint = Some(net.triangles[k]).filter(|t| (*t as usize) < triangles);
-                surface.closest_point_from(&net.positions[k], hint).distance
-            })
-        })
-        .collect();
+/// Each cell's tool gap (m): the largest distance of its corners from the surface (`gaps`,
+/// [`node_gaps`]), in cell order; `None` for a cell that is not complete.
+pub fn cell_tool_gaps(net: &DrapeNet, gaps: &[Option<f64>]) -> Vec<Option<f64>> {
+    assert_eq!(gaps.len(), net.nu * net.nv, "one gap per node");
     let (nv, cv) = (net.nv, net.nv.saturating_sub(1));
     (0..net.num_cells())
         .map(|c| {
             let k = (c / cv) * nv + c % cv;
-            [k, k + 1, k + nv, k + nv + 1].into_iter().map(|n| gaps[n]).try_fold(0.0f64, |m, g| Some(m.max(g?)))
+            net.cell_corners(c / cv, c % cv)?;
+            [k, k + 1, k + nv, k + nv + 1].into_iter().try_fold(0.0f64, |m, n| Some(m.max(gaps[n]?.abs())))
         })
         .collect()
 }
@@ -343,8 +397,20 @@ pub fn measure(
     thickness: Option<f64>,
     bending: Option<Vec<Option<f64>>>,
 ) -> WrinkleRecord {
-    let waviness = cell_waviness(net, &node_deviations(net));
-    let tool_gap = cell_tool_gaps(net, surface);
+    let gaps = node_gaps(net, surface);
+    let own = cell_waviness(net, &node_deviations(net));
+    let about_tool = cell_waviness(net, &gap_deviations(net, &gaps));
+    // The smaller reading: an undulation the tool has, or a smooth ply's gap that the tool's
+    // shape bends, is no wrinkle (see the module's notes).
+    let waviness: Vec<Option<f64>> = own
+        .into_iter()
+        .zip(about_tool)
+        .map(|(a, b)| match (a, b) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        })
+        .collect();
+    let tool_gap = cell_tool_gaps(net, &gaps);
     let bending = bending.unwrap_or_default();
     assert!(bending.is_empty() || bending.len() == net.num_cells(), "one bending energy density per cell");
     let (threshold_m, threshold_from) = threshold(thickness);

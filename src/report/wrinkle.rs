@@ -1,7 +1,7 @@
 //! The wrinkle map of a ply (`<ply>-wrinkles.png`): each cell by its waviness (the amplitude of
-//! its undulation about the ply's smoothed surface, `meta.wrinkles`, see
-//! `kinematic::wrinkle`), on the shear map's views and colours from zero, the cells wavier than
-//! the ply's threshold hatched and the threshold marked on the bar.
+//! its undulation about the ply's own smoothed surface and about the tool, the smaller,
+//! `meta.wrinkles`, see `kinematic::wrinkle`), on the shear map's views and colours from zero,
+//! the cells wavier than the ply's threshold hatched and the threshold marked on the bar.
 use super::render::{LegendItem, Mark, ShadedPicture, Swatch};
 use super::shade::{self, CellPaint, PlyScene, ToolMesh};
 use super::view::{nice_ceil, shear_colour};
@@ -33,11 +33,11 @@ pub(super) fn wrinkle_picture<'a>(
     let scene = PlyScene::new(net, tool, paint, false);
     let gap = s.max_tool_gap_m.map_or("-".to_string(), |g| format!("{:.2} mm", g * 1e3));
     let from = match s.threshold_from {
-        WrinkleThresholdFrom::Thickness => "the ply's thickness",
-        WrinkleThresholdFrom::Default => "default, no thickness given",
+        WrinkleThresholdFrom::Thickness => "ply thickness",
+        WrinkleThresholdFrom::Default => "default, no thickness",
     };
     let subtitle = format!(
-        "amplitude about the ply's surface smoothed over {} spacings: largest {largest_mm:.3} mm, threshold {threshold_mm:.3} mm ({from}); largest gap to the tool {gap}",
+        "about the ply's own surface and the tool (the smaller), σ = {} spacings: largest {largest_mm:.3} mm, threshold {threshold_mm:.3} mm ({from}); largest tool gap {gap}",
         s.smoothing_spacings
     );
     let pic = ShadedPicture {
