@@ -38,3 +38,4 @@ mod report;
 mod sphere_chebyshev;
 mod study;
 mod symmetric_reference;
+mod wrinkles;
