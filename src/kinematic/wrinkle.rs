@@ -5,12 +5,17 @@
 //! term, `mechanics::energy::bending_energy_density`, which this layer cannot call: the caller
 //! hands it in.)
 //!
-//! **The smoothed surface.** At each node the placed nodes about it, weighted by a Gaussian of
-//! their distance in the fabric (standard deviation σ = [`SMOOTHING_SPACINGS`] fibre spacings,
-//! cut at [`WINDOW_SIGMAS`] σ), are fitted by weighted least squares with a quadric height
-//! `z = a0 + a1 x + a2 y + a3 x² + a4 x y + a5 y²` over the plane normal to the ply's smoothed
-//! normal there (the same Gaussian's mean of the cells' unit normals). The node's *deviation* is
-//! its height above that quadric, `-a0` ([`node_deviations`]).
+//! **The smoothed surface.** The net's positions, smoothed over its fabric coordinates: at each
+//! node, each coordinate of the placed nodes about it, weighted by a Gaussian of their distance
+//! in the fabric (standard deviation σ = [`SMOOTHING_SPACINGS`] fibre spacings, cut at
+//! [`WINDOW_SIGMAS`] σ), is fitted by weighted least squares with a quadric
+//! `a0 + a1 a + a2 b + a3 a² + a4 a b + a5 b²` of the fabric coordinates (a, b), and `a0` is the
+//! smoothed position. The node's *deviation* is its offset from its smoothed position along the
+//! normal smoothed by the same Gaussian (the weighted sum of the cells' unit normals)
+//! ([`node_deviations`]). The fit's weights depend only on which nodes about a node are placed,
+//! so a node whose whole window is placed takes weights computed once. Being a function of the
+//! fabric coordinates, the smoothed surface needs no height over a plane: a ply folded over
+//! itself is smoothed as well.
 //!
 //! **Waviness** of a cell: √2 times the standard deviation of the nodes' deviations, weighted by
 //! the same Gaussian about the cell's centre: the amplitude of the sinusoid of that spread, in
@@ -18,8 +23,8 @@
 //! node (the fit's own error on a sphere, below) is no waviness. It is read twice, and the
 //! smaller reading counts:
 //! - about the ply's own smoothed surface, as above;
-//! - about the tool: the same fit and spread of the nodes' signed gaps to the surface they were
-//!   draped on, over the nodes' fabric coordinates ([`gap_deviations`]).
+//! - about the tool: the same smoothing and spread of the nodes' signed gaps to the surface they
+//!   were draped on ([`gap_deviations`]).
 //!
 //! Either alone mistakes a shape for a wrinkle, the other not: the fit cannot follow a tool
 //! radius of the order of σ (the double dome's 15 mm fillets at 5 mm spacing read 0.7 mm about
@@ -38,13 +43,16 @@
 //!   undulation up to 4 spacings long is read in full, longer ones increasingly as the ply's
 //!   shape. (The net cannot show one shorter than 2 spacings.) The same holds of a ripple of
 //!   the gap to a tool.
-//! - A smooth surface is fitted up to its fourth-order terms: on a sphere of radius R every node
-//!   lies σ⁴/R³ above its quadric, on a cylinder 3σ⁴/(8R³) (the Gaussian's moments
-//!   E x⁴ = 3σ⁴, E x⁶ = 15σ⁶). That is the same at every node whose window is whole, so there the
-//!   own reading is ~0; where the window is cut by the ply's edge the deviations differ and it
-//!   stays below √2 times the largest of them: about √2 σ⁴/R³ near the ply's edges, 0.11 mm for
-//!   R = 50 mm at 5 mm spacing. A tool whose curvature jumps (a fillet meeting a flat) within a
-//!   few σ reads more there; the reading about the tool does not, where the ply lies on it.
+//! - A smooth surface is fitted up to its fourth-order terms: the fit leaves `8 c σ⁴` of a term
+//!   `c (a² + b²)²` and `3 c σ⁴` of `c a⁴` (the Gaussian's moments E a⁴ = 3σ⁴, E a⁶ = 15σ⁶). A
+//!   fibre of arc length u round a circle of radius R falls `u²/(2R) - u⁴/(24R³)` below its
+//!   tangent, so on a cylinder each node lies σ⁴/(8R³) off its smoothed position along the
+//!   normal, and on a sphere (geodesic polar coordinates) σ⁴/(3R³). That is the same at every
+//!   node whose window is whole, so there the own reading is ~0; where the window is cut by the
+//!   ply's edge the deviations differ and it stays below √2 times the largest of them: of order
+//!   √2 σ⁴/R³ near the ply's edges, 0.11 mm for R = 50 mm at 5 mm spacing. A tool whose
+//!   curvature jumps (a fillet meeting a flat) within a few σ reads more there; the reading about
+//!   the tool does not, where the ply lies on it.
 //!
 //! **The threshold** ([`threshold`]): the ply's thickness ([`THICKNESS_FRACTION`] of it), else
 //! [`DEFAULT_THRESHOLD_M`]. A ply that undulates about its own smoothed surface by more than its
@@ -130,53 +138,7 @@ fn offset(i: usize, j: usize, a: isize, b: isize, nu: usize, nv: usize) -> Optio
 /// Each node's deviation from the ply's smoothed surface there (m, signed along the smoothed
 /// normal), in node order; `None` for a node that is not a corner of a complete cell.
 pub fn node_deviations(net: &DrapeNet) -> Vec<Option<f64>> {
-    let (nu, nv) = (net.nu, net.nv);
-    if nu < 2 || nv < 2 {
-        return vec![None; nu * nv];
-    }
-    let cv = nv - 1;
-    let normals: Vec<Option<Vector>> = (0..net.num_cells())
-        .into_par_iter()
-        .with_min_len(1 << 12)
-        .map(|c| net.cell_frame(c / cv, c % cv).map(|f| f.normal))
-        .collect();
-    let smoothed = smoothed_normals(&normals, nu, nv);
-    let nodes_about = window(0.0);
-    let h = SMOOTHING_SPACINGS * net.spacing;
-    (0..nu * nv)
-        .into_par_iter()
-        .with_min_len(1 << 8)
-        .map(|k| {
-            let (i, j) = (k / nv, k % nv);
-            let c = net.node(i, j)?;
-            // The node's own cells: it must be a corner of one; their normal is the fallback.
-            let own = [(-1, -1), (-1, 0), (0, -1), (0, 0)]
-                .into_iter()
-                .filter_map(|(a, b)| offset(i, j, a, b, nu - 1, nv - 1))
-                .filter_map(|(p, q)| normals[p * cv + q])
-                .fold(None, |acc: Option<Vector>, n| Some(acc.unwrap_or_else(Vector::zeros) + n))?;
-            let smoothed = smoothed[k];
-            let n = smoothed.try_normalize(0.0).or_else(|| own.try_normalize(0.0))?;
-            // Any tangent basis: the quadrics are the same whatever its turn about n.
-            let axis = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
-                Vector::x()
-            } else if n.y.abs() <= n.z.abs() {
-                Vector::y()
-            } else {
-                Vector::z()
-            };
-            let e1 = n.cross(&axis).normalize();
-            let e2 = n.cross(&e1);
-            let (e1, e2) = (e1 / h, e2 / h);
-            let samples = nodes_about.iter().filter_map(|&(a, b, w)| {
-                let (p, q) = offset(i, j, a, b, nu, nv)?;
-                let d = net.node(p, q)? - c;
-                Some((w, d.dot(&e1), d.dot(&e2), d.dot(&n)))
-            });
-            // The node lies at height 0 of its frame.
-            Some(-quadric_at_origin(samples))
-        })
-        .collect()
+    deviations(net, None).0
 }
 
 /// Each placed node's signed distance from `surface` (m): its distance from the closest point,
@@ -199,46 +161,34 @@ pub fn node_gaps(net: &DrapeNet, surface: &ToolSurface) -> Vec<Option<f64>> {
 }
 
 /// Each node's deviation of its gap to the tool (`gaps`, [`node_gaps`]) from the gaps smoothed
-/// about it (m): the same Gaussian-weighted quadric fit as [`node_deviations`], over the fabric
-/// coordinates of the nodes, in node order; `None` for a node that is not a corner of a
-/// complete cell. Where the ply lies on its tool the gaps are nil and so are these, whatever
-/// the tool's shape.
+/// about it (m): the same smoothing as [`node_deviations`], in node order; `None` for a node
+/// that is not a corner of a complete cell. Where the ply lies on its tool the gaps are nil and
+/// so are these, whatever the tool's shape.
 pub fn gap_deviations(net: &DrapeNet, gaps: &[Option<f64>]) -> Vec<Option<f64>> {
-    let (nu, nv) = (net.nu, net.nv);
-    assert_eq!(gaps.len(), nu * nv, "one gap per node");
-    let nodes_about = window(0.0);
-    let s = SMOOTHING_SPACINGS;
-    (0..nu * nv)
-        .into_par_iter()
-        .with_min_len(1 << 8)
-        .map(|k| {
-            let (i, j) = (k / nv, k % nv);
-            let own = [(-1, -1), (-1, 0), (0, -1), (0, 0)]
-                .into_iter()
-                .filter_map(|(a, b)| offset(i, j, a, b, nu - 1, nv - 1))
-                .any(|(p, q)| net.cell_corners(p, q).is_some());
-            let g = gaps[k].filter(|_| own)?;
-            let samples = nodes_about.iter().filter_map(|&(a, b, w)| {
-                let (p, q) = offset(i, j, a, b, nu, nv)?;
-                Some((w, a as f64 / s, b as f64 / s, gaps[p * nv + q]? - g))
-            });
-            Some(-quadric_at_origin(samples))
-        })
-        .collect()
+    deviations(net, Some(gaps)).1
 }
 
-/// The value at the origin of the quadric `a0 + a1 x + a2 y + a3 x² + a4 x y + a5 y²` fitted by
-/// weighted least squares to the samples `(w, x, y, z)` (x, y in units of σ): from the weighted
-/// moments of the monomials up to degree four (the normal equations' 15 distinct entries) and
-/// of the heights times those up to degree two.
-fn quadric_at_origin(samples: impl Iterator<Item = (f64, f64, f64, f64)>) -> f64 {
+/// The node's smoothing weights over the window `nodes_about` (its offsets and Gaussian
+/// weights), for the nodes `present` there: the smoothed value at the node is the sum of the
+/// weights times the nodes' values, the value at the origin of the quadric
+/// `a0 + a1 a + a2 b + a3 a² + a4 a b + a5 b²` fitted to them by weighted least squares over
+/// their fabric coordinates (a, b, in units of σ). From the weighted moments of the monomials up
+/// to degree four (the normal equations' 15 distinct entries): weight `w φ · c`, `M c = e0`.
+fn smoothing_weights(nodes_about: &[(isize, isize, f64)], present: impl Fn(usize) -> bool) -> Vec<f64> {
+    let s = SMOOTHING_SPACINGS;
+    let phi = |a: isize, b: isize| {
+        let (x, y) = (a as f64 / s, b as f64 / s);
+        [1.0, x, y, x * x, x * y, y * y]
+    };
     let mut mo = [0.0f64; 15];
-    let mut rz = [0.0f64; 6];
-    for (w, x, y, z) in samples {
+    for (n, &(a, b, w)) in nodes_about.iter().enumerate() {
+        if !present(n) {
+            continue;
+        }
+        let (x, y) = (a as f64 / s, b as f64 / s);
         let (wx, wy) = (w * x, w * y);
         let (wxx, wxy, wyy) = (wx * x, wx * y, wy * y);
-        let (xx, xy, yy) = (x * x, x * y, y * y);
-        let m = [
+        let terms = [
             w,
             wx,
             wy,
@@ -249,21 +199,17 @@ fn quadric_at_origin(samples: impl Iterator<Item = (f64, f64, f64, f64)>) -> f64
             wxx * y,
             wxy * y,
             wyy * y,
-            wxx * xx,
-            wxx * xy,
-            wxx * yy,
-            wxy * yy,
-            wyy * yy,
+            wxx * x * x,
+            wxx * x * y,
+            wxx * y * y,
+            wxy * y * y,
+            wyy * y * y,
         ];
-        for (acc, v) in mo.iter_mut().zip(m) {
-            *acc += v;
-        }
-        let wz = w * z;
-        for (acc, v) in rz.iter_mut().zip([wz, wz * x, wz * y, wz * xx, wz * xy, wz * yy]) {
+        for (acc, v) in mo.iter_mut().zip(terms) {
             *acc += v;
         }
     }
-    // Moments by (power of x, power of y).
+    // Moments by (power of a, power of b).
     let [m00, m10, m01, m20, m11, m02, m30, m21, m12, m03, m40, m31, m22, m13, m04] = mo;
     #[rustfmt::skip]
     let m = Matrix6::new(
@@ -274,7 +220,80 @@ fn quadric_at_origin(samples: impl Iterator<Item = (f64, f64, f64, f64)>) -> f64
         m11, m21, m12, m31, m22, m13,
         m02, m12, m03, m22, m13, m04,
     );
-    solve(m, Vector6::from(rz))[0]
+    let c = solve(m, Vector6::x());
+    nodes_about
+        .iter()
+        .enumerate()
+        .map(|(n, &(a, b, w))| if present(n) { w * Vector6::from(phi(a, b)).dot(&c) } else { 0.0 })
+        .collect()
+}
+
+/// Each node's deviation from the ply's smoothed surface (m, along the smoothed normal) and,
+/// with `gaps`, of its gap from the gaps smoothed alike; `None` for a node that is not a corner
+/// of a complete cell (and, for the gaps, without `gaps`).
+///
+/// The smoothed surface: the net's positions smoothed over its fabric coordinates by the
+/// Gaussian-weighted local quadratic fit ([`smoothing_weights`]); a node's deviation is its
+/// offset from its smoothed position along the normal smoothed by the same Gaussian. A node
+/// whose whole window is placed takes the weights of the whole window, computed once.
+fn deviations(net: &DrapeNet, gaps: Option<&[Option<f64>]>) -> (Vec<Option<f64>>, Vec<Option<f64>>) {
+    let (nu, nv) = (net.nu, net.nv);
+    if nu < 2 || nv < 2 {
+        return (vec![None; nu * nv], vec![None; nu * nv]);
+    }
+    if let Some(g) = gaps {
+        assert_eq!(g.len(), nu * nv, "one gap per node");
+    }
+    let cv = nv - 1;
+    let normals: Vec<Option<Vector>> = (0..net.num_cells())
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .map(|c| net.cell_frame(c / cv, c % cv).map(|f| f.normal))
+        .collect();
+    let smoothed = smoothed_normals(&normals, nu, nv);
+    let nodes_about = window(0.0);
+    let whole = smoothing_weights(&nodes_about, |_| true);
+    (0..nu * nv)
+        .into_par_iter()
+        .with_min_len(1 << 8)
+        .map(|k| {
+            let (i, j) = (k / nv, k % nv);
+            let Some(c) = net.node(i, j) else { return (None, None) };
+            // The node's own cells: it must be a corner of one; their normal is the fallback.
+            let own = [(-1, -1), (-1, 0), (0, -1), (0, 0)]
+                .into_iter()
+                .filter_map(|(a, b)| offset(i, j, a, b, nu - 1, nv - 1))
+                .filter_map(|(p, q)| normals[p * cv + q])
+                .fold(None, |acc: Option<Vector>, n| Some(acc.unwrap_or_else(Vector::zeros) + n));
+            let Some(n) = own.and_then(|own| smoothed[k].try_normalize(0.0).or_else(|| own.try_normalize(0.0))) else {
+                return (None, None);
+            };
+            let at = |n: usize| {
+                let (a, b, _) = nodes_about[n];
+                offset(i, j, a, b, nu, nv).map(|(p, q)| p * nv + q).filter(|&m| net.status[m] == NodeStatus::Placed)
+            };
+            let partial;
+            let weights = if (0..nodes_about.len()).all(|n| at(n).is_some()) {
+                &whole
+            } else {
+                partial = smoothing_weights(&nodes_about, |n| at(n).is_some());
+                &partial
+            };
+            let (mut position, mut gap) = (Vector::zeros(), 0.0);
+            for (n, w) in weights.iter().enumerate() {
+                if let Some(m) = at(n).filter(|_| *w != 0.0) {
+                    position += (net.positions[m] - c) * *w;
+                    if let Some(g) = gaps {
+                        gap += w * g[m].unwrap_or(0.0);
+                    }
+                }
+            }
+            // The node's offset from its smoothed position: minus the smoothed offset from it.
+            let own = -position.dot(&n);
+            let about_tool = gaps.and_then(|g| g[k]).map(|g| g - gap);
+            (Some(own), about_tool)
+        })
+        .unzip()
 }
 
 /// At each node, the sum of the complete cells' unit normals (`normals`, `None` where a cell is
@@ -398,8 +417,8 @@ pub fn measure(
     bending: Option<Vec<Option<f64>>>,
 ) -> WrinkleRecord {
     let gaps = node_gaps(net, surface);
-    let own = cell_waviness(net, &node_deviations(net));
-    let about_tool = cell_waviness(net, &gap_deviations(net, &gaps));
+    let (own, about_tool) = deviations(net, Some(&gaps));
+    let (own, about_tool) = (cell_waviness(net, &own), cell_waviness(net, &about_tool));
     // The smaller reading: an undulation the tool has, or a smooth ply's gap that the tool's
     // shape bends, is no wrinkle (see the module's notes).
     let waviness: Vec<Option<f64>> = own
