@@ -39,3 +39,4 @@ mod report;
 mod sphere_chebyshev;
 mod study;
 mod symmetric_reference;
+mod wrinkles;

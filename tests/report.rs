@@ -707,10 +707,11 @@ fn a_four_ply_run_reports_side_by_side_and_the_flow_mesh() {
     let images = seen["images"].as_array().unwrap();
     assert!(images.len() >= 9 && images.iter().all(|i| i["loaded"] == true), "{images:?}");
     // Four plies with their pictures, the side by side, the flow mesh, the patterns and the 3D
-    // view: a page, not a scroll of 13,000 px.
+    // view: a page, not a scroll of 13,000 px (6,250 px when this was written; each kinematic
+    // ply's wrinkle map beside its shear map moves its histogram to a row of its own: 8,184 px).
     let height = seen["height"].as_u64().unwrap();
     eprintln!("four-ply page: {height} px");
-    assert!(height < 7000, "the four-ply page is {height} px long");
+    assert!(height < 9000, "the four-ply page is {height} px long");
 }
 
 /// Copy the files of folder `from` into a new folder `to`.

@@ -35,7 +35,7 @@ fn kinematic_net(layup: &Layup, tool: &ToolSurface, ply: &Ply, spacing: f64, n: 
     ply.settings.extent = drape::kinematic::Extent::Grid { nu: n, nv: n, origin_node: None };
     ply.refinement = None;
     ply.auto = None;
-    let one = Layup { reference: layup.reference, stack_side: layup.stack_side, plies: vec![ply] };
+    let one = Layup { reference: layup.reference, stack_side: layup.stack_side, plies: vec![ply], wrinkles: false };
     drape_layup(&one, tool, |_, _| {}).unwrap().pop().unwrap().net
 }
 

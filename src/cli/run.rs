@@ -135,7 +135,7 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
 /// The layup table: one row per ply in stacking order.
 fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
     let mut out = format!(
-        "layup: {} plies on {}\n{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10} {:>9}\n",
+        "layup: {} plies on {}\n{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10} {:>9} {:>11}\n",
         scene.layup.plies.len(),
         scene.tool.display(),
         "ply",
@@ -150,16 +150,17 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         "fabric",
         "mass",
         "offset",
-        "draw-in"
+        "draw-in",
+        "wrinkled"
     );
     out += &format!(
-        "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10} {:>9}\n",
-        "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm", "mm"
+        "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9} {:>9} {:>12} {:>12} {:>11} {:>9} {:>10} {:>9} {:>11}\n",
+        "", "deg", "", "", "deg", "deg", "deg", "m^2", "% of", "m^2", "kg", "mm", "mm", "m^2"
     );
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         let s = &r.stats;
         out += &format!(
-            "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3} {:>9}\n",
+            "{:<12} {:>7} {:<20} {:<20} {:>7} {:>9.2} {:>9.2} {:>12.3e} {:>12} {:>11.4} {:>9} {:>10.3} {:>9} {:>11}\n",
             ply.settings.name,
             ply.angle_deg().map_or("warp".to_string(), |a| format!("{a:.1}")),
             format!(
@@ -193,7 +194,13 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
                 .as_ref()
                 .and_then(|d| d.largest_overall())
                 .map_or("-".to_string(), |e| format!("{:.2}", e.draw_in_m * 1e3)),
+            r.net.meta.wrinkles.as_ref().map_or("-".to_string(), |w| format!("{:.3e}", w.summary.wrinkled_area_m2)),
         );
+    }
+    for (ply, r) in scene.layup.plies.iter().zip(results) {
+        if let Some(w) = &r.net.meta.wrinkles {
+            out += &format!("wrinkles: ply '{}': {}\n", ply.settings.name, w.summary.describe());
+        }
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {
         if let Some(d) = &r.net.meta.draw_in {

@@ -68,6 +68,34 @@ pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Optio
             return bad(format!("meta.contact holds a slip or pressure of {v}"));
         }
     }
+    if let Some(w) = &net.meta.wrinkles {
+        let cells = cell_count(net);
+        let lists = [
+            ("waviness_m", &w.waviness_m),
+            ("tool_gap_m", &w.tool_gap_m),
+            ("bending_energy_density_j_m2", &w.bending_energy_density_j_m2),
+        ];
+        for (what, list) in lists {
+            // Without a material card the bending list is empty.
+            if list.len() != cells && !(what.starts_with("bending") && list.is_empty()) {
+                return bad(format!(
+                    "meta.wrinkles.{what} has {} entries for a {} x {} grid ({cells} cells)",
+                    list.len(),
+                    net.nu,
+                    net.nv
+                ));
+            }
+            if let Some(v) = list.iter().flatten().find(|v| !v.is_finite()) {
+                return bad(format!("meta.wrinkles.{what} holds {v}"));
+            }
+        }
+        let s = &w.summary;
+        let figures = [Some(s.threshold_m), Some(s.wrinkled_area_m2), s.max_waviness_m, s.max_tool_gap_m];
+        if let Some(v) = figures.into_iter().flatten().chain(s.max_bending_energy_density_j_m2).find(|v| !v.is_finite())
+        {
+            return bad(format!("meta.wrinkles holds a figure of {v}"));
+        }
+    }
     let (i0, j0) = net.origin_node;
     if i0 >= net.nu || j0 >= net.nv {
         return bad(format!("the origin node ({i0}, {j0}) lies outside the {} x {} grid", net.nu, net.nv));
@@ -111,6 +139,20 @@ fn cell_problem(net: &DrapeNet, i: usize, j: usize, shear: Option<f64>, frames: 
     let g = shear?;
     if !g.to_degrees().is_finite() {
         return Some(format!("cell ({i}, {j}) has a shear angle of {g} rad"));
+    }
+    // A complete cell has every wrinkle measure the net records (the lengths were checked).
+    if let Some(w) = &net.meta.wrinkles {
+        let k = i * (net.nv - 1) + j;
+        let missing = [("waviness_m", &w.waviness_m), ("tool_gap_m", &w.tool_gap_m)]
+            .into_iter()
+            .chain(
+                (!w.bending_energy_density_j_m2.is_empty())
+                    .then_some(("bending_energy_density_j_m2", &w.bending_energy_density_j_m2)),
+            )
+            .find(|(_, list)| list[k].is_none());
+        if let Some((what, _)) = missing {
+            return Some(format!("cell ({i}, {j}) is complete but meta.wrinkles.{what} has no value for it"));
+        }
     }
     if frames {
         match net.cell_frame(i, j) {

@@ -7,7 +7,10 @@
 //! (i, j), (i+1, j), (i+1, j+1), (i, j+1) (counter-clockwise seen from the normal warp x weft).
 //!
 //! CellData: `shear_deg` (Float64), `warp`, `weft`, `normal` (Float64 x 3, unit), `cell_i`,
-//! `cell_j` (Int32). PointData: `node_i`, `node_j` (Int32); for a refined net also how each node
+//! `cell_j` (Int32); for a net that records its wrinkles (`meta.wrinkles`, a ply of `drape
+//! run`) also `waviness_m` (Float64, m), `wrinkled` (Int32: 1 where the waviness exceeds the
+//! ply's threshold), `tool_gap_m` (Float64, m) and, for a ply with a material card,
+//! `bending_energy_density_j_m2` (Float64, J/m^2). PointData: `node_i`, `node_j` (Int32); for a refined net also how each node
 //! meets the tool (`meta.contact`): `contact_state` (Int32: 0 free, 1 stick, 2 slip, 3 held;
 //! [`ContactState::code`]), `slip` (Float64, m, over all load steps) and `contact_pressure`
 //! (Float64, Pa). Floats are written with `{:?}`, the shortest text that parses back to the same
@@ -244,6 +247,19 @@ fn write_vtu_to<W: Write>(net: &DrapeNet, w: &mut W, encoding: VtuEncoding) -> i
     }
     arrays.array(w, "Int32", "cell_i", 1, 1, complete().map(|(i, _)| i))?;
     arrays.array(w, "Int32", "cell_j", 1, 1, complete().map(|(_, j)| j))?;
+    if let Some(wr) = &net.meta.wrinkles {
+        // The net check made sure every complete cell has each measure the record holds.
+        let cv = net.nv - 1;
+        let at = |list: &[Option<f64>], (i, j): (usize, usize)| list[i * cv + j].expect("checked: complete cell");
+        arrays.array(w, "Float64", "waviness_m", 1, 1, complete().map(|c| at(&wr.waviness_m, c)))?;
+        let threshold = wr.summary.threshold_m;
+        arrays.array(w, "Int32", "wrinkled", 1, 1, complete().map(|c| (at(&wr.waviness_m, c) > threshold) as i32))?;
+        arrays.array(w, "Float64", "tool_gap_m", 1, 1, complete().map(|c| at(&wr.tool_gap_m, c)))?;
+        if !wr.bending_energy_density_j_m2.is_empty() {
+            let values = complete().map(|c| at(&wr.bending_energy_density_j_m2, c));
+            arrays.array(w, "Float64", "bending_energy_density_j_m2", 1, 1, values)?;
+        }
+    }
     w.write_all(b"</CellData>\n")?;
 
     w.write_all(b"<Points>\n")?;

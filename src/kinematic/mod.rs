@@ -11,6 +11,7 @@ pub mod outline;
 pub mod provenance;
 pub mod sampler;
 pub mod surface;
+pub mod wrinkle;
 
 pub use fishnet::{drape, drape_on, drape_smooth, DrapeError};
 pub use net::{DrapeNet, Method, NodeStatus};

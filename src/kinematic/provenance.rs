@@ -63,6 +63,11 @@ pub struct Provenance {
     /// For a ply draped with `method = "auto"`: what was chosen and why.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method_choice: Option<MethodChoice>,
+    /// Per cell, how far the ply stands off the surface it was draped on, how much it undulates
+    /// about its own smoothed surface and the bending energy there; the wrinkled area
+    /// ([`super::wrinkle`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrinkles: Option<WrinkleRecord>,
     /// Keys other tools wrote, kept on a round trip.
     #[serde(flatten)]
     pub other: Map<String, Value>,
@@ -527,4 +532,92 @@ impl DrawIn {
             "the ply at its seed"
         }
     }
+}
+
+/// Where the waviness threshold of a ply comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WrinkleThresholdFrom {
+    /// The ply's thickness as laid flat.
+    Thickness,
+    /// No thickness given: the default, 0.5 mm.
+    Default,
+}
+
+impl WrinkleThresholdFrom {
+    /// Its name in files and tables: `thickness` or `default`.
+    pub fn name(self) -> &'static str {
+        match self {
+            WrinkleThresholdFrom::Thickness => "thickness",
+            WrinkleThresholdFrom::Default => "default",
+        }
+    }
+}
+
+/// A ply's wrinkles in a few numbers (`layup.json`'s `wrinkles`, and the head of the net's
+/// `meta.wrinkles`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WrinkleSummary {
+    /// A cell whose waviness exceeds this is wrinkled, m.
+    pub threshold_m: f64,
+    /// Where the threshold comes from: `thickness` or `default`.
+    pub threshold_from: WrinkleThresholdFrom,
+    /// The standard deviation of the Gaussian weights of the smoothed surface and of the
+    /// waviness, in fibre spacings.
+    pub smoothing_spacings: f64,
+    /// Cells whose waviness exceeds the threshold.
+    pub wrinkled_cells: usize,
+    /// Their draped area, m^2.
+    pub wrinkled_area_m2: f64,
+    /// The largest waviness of a cell, m (absent without a complete cell).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_waviness_m: Option<f64>,
+    /// The largest distance of a cell's corner from the surface the ply was draped on, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_tool_gap_m: Option<f64>,
+    /// The largest bending energy density of a cell, J/m^2 (absent without a material card).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_bending_energy_density_j_m2: Option<f64>,
+}
+
+impl WrinkleSummary {
+    /// The wrinkles in a few words, millimetres.
+    pub fn describe(&self) -> String {
+        let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.3} mm", v * 1e3));
+        let mut s = format!(
+            "{} cells ({:.4} m^2) wavier than {:.3} mm (the {}); largest waviness {}, largest gap to the tool {}",
+            self.wrinkled_cells,
+            self.wrinkled_area_m2,
+            self.threshold_m * 1e3,
+            match self.threshold_from {
+                WrinkleThresholdFrom::Thickness => "ply's thickness",
+                WrinkleThresholdFrom::Default => "default, no thickness given",
+            },
+            mm(self.max_waviness_m),
+            mm(self.max_tool_gap_m)
+        );
+        if let Some(b) = self.max_bending_energy_density_j_m2 {
+            s += &format!(", largest bending energy {b:.4e} J/m^2");
+        }
+        s
+    }
+}
+
+/// Per cell (index `i * (nv - 1) + j`, `None` where a cell is not complete): the wrinkle
+/// measures of [`super::wrinkle`] (`"wrinkles"` in the net's meta).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WrinkleRecord {
+    /// The figures of the whole ply.
+    #[serde(flatten)]
+    pub summary: WrinkleSummary,
+    /// Waviness: the amplitude of the ply's undulation about its own smoothed surface and about
+    /// the tool, the smaller of the two, m.
+    pub waviness_m: Vec<Option<f64>>,
+    /// The largest distance of the cell's corners from the surface the ply was draped on (the
+    /// tool, or the tool offset by the plies below), m: large by design where a ply hangs off
+    /// the tool.
+    pub tool_gap_m: Vec<Option<f64>>,
+    /// Bending energy per unit area, J/m^2 (empty when the ply has no material card).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bending_energy_density_j_m2: Vec<Option<f64>>,
 }

@@ -3,8 +3,10 @@
 //! make them.
 use crate::geometry::smooth::SmoothSurface;
 use crate::geometry::{Point, ToolSurface, Vector};
-use crate::kinematic::{DrapeNet, KinematicSettings};
+use crate::kinematic::provenance::WrinkleRecord;
+use crate::kinematic::{wrinkle, DrapeNet, KinematicSettings};
 use crate::material::MaterialCard;
+use crate::mechanics::energy::bending_energy_density;
 use crate::mechanics::forming::Forming;
 use crate::mechanics::refine::{annotate, refine_draped, refine_from, RefineError, RefineSettings, Refined};
 use crate::mechanics::sheet::SheetFeatures;
@@ -103,6 +105,26 @@ impl Ply {
             Orientation::Angle(a) => Some(a.to_degrees()),
             Orientation::Warp(_) => None,
         }
+    }
+
+    /// The material card the ply's mechanics uses: its refinement's card, else its own.
+    pub fn card(&self) -> Option<&MaterialCard> {
+        self.refinement.as_ref().map(|r| &r.material).or(self.material.as_ref().map(|m| &m.card))
+    }
+
+    /// The wrinkles of `net`, this ply draped on `surface` (the tool or the tool offset by the
+    /// plies below): waviness and tool gap per cell ([`crate::kinematic::wrinkle`]) against the
+    /// ply's thickness, and with a card ([`Ply::card`]) the bending energy density of its
+    /// bending term ([`bending_energy_density`], with the sheet's features the refinement used).
+    pub fn wrinkles(&self, net: &DrapeNet, surface: &ToolSurface) -> WrinkleRecord {
+        let sheet = self.refinement.as_ref().map(|r| &r.sheet);
+        // The sheet's features were laid out on this grid by the refinement; if they no longer
+        // fit, its bending is measured without them.
+        let bending = self.card().map(|card| {
+            bending_energy_density(net, card, sheet)
+                .unwrap_or_else(|_| bending_energy_density(net, card, None).expect("no sheet features: nothing to fit"))
+        });
+        wrinkle::measure(net, surface, self.thickness, bending)
     }
 }
 
@@ -275,4 +297,8 @@ pub struct Layup {
     pub stack_side: StackSide,
     /// The plies in stacking order.
     pub plies: Vec<Ply>,
+    /// Measure each ply's wrinkles ([`Ply::wrinkles`], the net's `meta.wrinkles`): `drape run`
+    /// does; the studies, which need only the table's shear and coverage figures and time the
+    /// drape, do not.
+    pub wrinkles: bool,
 }

@@ -345,6 +345,7 @@ pub fn drape_layup(
             Start::Kinematic => crate::kinematic::draw_in::seed_normal(&net).map(|n| (n, "seed")),
         };
         net.meta.draw_in = plan.and_then(|(n, from)| crate::kinematic::draw_in::draw_in(&net, &n, from));
+        net.meta.wrinkles = layup.wrinkles.then(|| ply.wrinkles(&net, surface));
         // What later stages (exports, reports) need to know about the ply.
         net.meta.stack_offset_max_m = Some(offset.max_distance);
         net.meta.angle_deg = ply.angle_deg();

@@ -6,7 +6,7 @@ use super::nest::Nesting;
 use super::stack::PlyResult;
 use super::{LockingSource, Ply};
 use crate::kinematic::coverage::SurfaceCoverage;
-use crate::kinematic::provenance::{ContactSummary, DrawIn, Stability};
+use crate::kinematic::provenance::{ContactSummary, DrawIn, Stability, WrinkleSummary};
 use crate::kinematic::MethodChoice;
 use serde::{Deserialize, Serialize};
 
@@ -185,13 +185,18 @@ pub struct LayupRow {
     /// the warning ([`shear_range_warning`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shear_range_warning: Option<String>,
+    /// Its wrinkles: the wrinkled area (cells wavier than the threshold), the threshold and
+    /// where it comes from, the largest waviness, tool gap and bending energy density
+    /// ([`crate::kinematic::wrinkle`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrinkles: Option<WrinkleSummary>,
 }
 
 /// A warning when a ply's largest shear is past the angle its material card's shear law was
 /// calibrated to (the card it is refined with, else its own); `None` within it, without a card,
 /// or for a card that records no range.
 pub fn shear_range_warning(ply: &Ply, result: &PlyResult) -> Option<String> {
-    let card = ply.refinement.as_ref().map(|r| &r.material).or(ply.material.as_ref().map(|m| &m.card))?;
+    let card = ply.card()?;
     card.shear_range_warning(result.stats.max_abs_shear.to_degrees())
 }
 
@@ -285,6 +290,7 @@ impl LayupRow {
             offset_bridged_vertices: Some(result.offset.relaxed),
             shear_range_warning: shear_range_warning(ply, result),
             draw_in: result.net.meta.draw_in.clone(),
+            wrinkles: result.net.meta.wrinkles.as_ref().map(|w| w.summary.clone()),
             // Filled in by the run from the ply's pattern.
             pattern_cut: None,
             pattern_margin_m: None,

@@ -858,7 +858,7 @@ impl Scene {
             path: path.into(),
             scale,
             tool: base.join(&file.tool),
-            layup: Layup { reference, stack_side, plies },
+            layup: Layup { reference, stack_side, plies, wrinkles: true },
             roll_width,
             nesting_gap,
             cutting_margin,

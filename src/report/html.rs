@@ -267,7 +267,7 @@ fn export_section(h: &mut String, e: &crate::layup::table::ExportRow) {
 fn layup_table(h: &mut String, rows: &[LayupRow]) {
     let _ = writeln!(
         h,
-        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage (share of the tool or outline covered)</th><th>draped area (m²)</th><th>offset (mm)</th><th>draw-in (mm, fibres / diagonals)</th></tr>"
+        "<table id=\"layup-table\">\n<tr><th class=\"t\">ply</th><th class=\"t\">material</th><th>angle (°)</th><th class=\"t\">method</th><th>locking (°)</th><th>max |γ| (°)</th><th>mean |γ| (°)</th><th>area over locking (m²)</th><th>coverage (share of the tool or outline covered)</th><th>draped area (m²)</th><th>offset (mm)</th><th>draw-in (mm, fibres / diagonals)</th><th>wrinkled area (m², waviness over the threshold)</th></tr>"
     );
     for r in rows {
         let material = r
@@ -276,7 +276,7 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             .map(|m| std::path::Path::new(m).file_stem().map_or(m.to_string(), |s| s.to_string_lossy().into_owned()));
         let _ = writeln!(
             h,
-            "<tr class=\"ply\"><td class=\"t\"><a href=\"#ply-{0}\">{0}</a></td><td class=\"t\">{1}</td><td>{2}</td><td class=\"t\">{3}</td><td>{4}</td><td>{5}</td><td>{6}</td><td>{7}</td><td>{8}</td><td>{9}</td><td>{10}</td><td>{11}</td></tr>",
+            "<tr class=\"ply\"><td class=\"t\"><a href=\"#ply-{0}\">{0}</a></td><td class=\"t\">{1}</td><td>{2}</td><td class=\"t\">{3}</td><td>{4}</td><td>{5}</td><td>{6}</td><td>{7}</td><td>{8}</td><td>{9}</td><td>{10}</td><td>{11}</td><td>{12}</td></tr>",
             escape(&r.name),
             escape(material.as_deref().unwrap_or("—")),
             num(r.angle_deg, 1),
@@ -298,6 +298,13 @@ fn layup_table(h: &mut String, rows: &[LayupRow]) {
             r.draw_in.as_ref().map_or("—".to_string(), |d| {
                 let largest = |fibres: bool| num(d.largest(fibres).map(|e| e.draw_in_m * 1e3), 1);
                 format!("{} / {}", largest(true), largest(false))
+            }),
+            r.wrinkles.as_ref().map_or("—".to_string(), |w| {
+                format!(
+                    "{} <span class=\"small\">(over {} mm)</span>",
+                    num(Some(w.wrinkled_area_m2), 4),
+                    num(Some(w.threshold_m * 1e3), 2)
+                )
             }),
         );
     }
@@ -416,10 +423,18 @@ fn ply_section(h: &mut String, ply: &PlyReport, facts: &[(String, String)]) {
                 let _ = writeln!(h, "</div>");
             }
             let _ = writeln!(h, "</section>");
-            rows.push(png("histogram").into_iter().map(|p| (p, "")).collect());
+            // The wrinkle map beside the mechanical net's shear histogram.
+            rows.push(png("wrinkles").into_iter().chain(png("histogram")).map(|p| (p, "")).collect());
         }
         (_, shear) => {
-            rows.push(shear.into_iter().chain(png("histogram")).map(|p| (p, "")).collect());
+            // The wrinkle map beside the shear map, then the histogram.
+            match png("wrinkles") {
+                Some(w) => {
+                    rows.push(shear.into_iter().map(|p| (p, "")).chain([(w, "wrinkles · ")]).collect());
+                    rows.push(png("histogram").into_iter().map(|p| (p, "")).collect());
+                }
+                None => rows.push(shear.into_iter().chain(png("histogram")).map(|p| (p, "")).collect()),
+            }
             rows.push(["change", "change-histogram"].iter().filter_map(|s| png(s)).map(|p| (p, "")).collect());
         }
     }

@@ -19,6 +19,10 @@
 //!   and, when the net records its draw-in (`meta.draw_in`), `<ply>-draw-in.png/.svg`: the blank
 //!   flat and the ply draped, in plan, with how far the edge moved in along the fibres and the
 //!   diagonals through the seed;
+//! - when the net records its wrinkles (`meta.wrinkles`, every ply of `drape run`),
+//!   `<ply>-wrinkles.png`: the wrinkle map, each cell by its waviness about the ply's smoothed
+//!   surface on the shear map's views, the cells past the ply's threshold hatched, shown beside
+//!   the shear map;
 //! - `index.html`: the layup table (from `layup.json` when present, else computed from the
 //!   nets), laminate totals, the flow-mesh export as `layup.json` records it, what each node status means, the interactive 3D view (the
 //!   project's own script, data embedded: nothing is fetched), every picture, the flat patterns
@@ -37,6 +41,7 @@ pub mod shade;
 pub mod study;
 mod view;
 pub mod viewer;
+mod wrinkle;
 
 pub use render::{bin_shares, bin_width, register_fonts, HEIGHT, WIDTH};
 pub use view::{change_limit, colour_limit, shear_colour, View};
@@ -642,6 +647,7 @@ fn row_of_net(input: &PlyInput, tool: Option<&RawTool>) -> LayupRow {
         outcome: net.meta.solver.as_ref().map(|s| s.outcome.clone()),
         contact: net.meta.contact.as_ref().map(|c| c.summary()),
         method_choice: net.meta.method_choice.clone(),
+        wrinkles: net.meta.wrinkles.as_ref().map(|w| w.summary.clone()),
         ..LayupRow::default()
     }
 }
@@ -949,6 +955,13 @@ fn draw_ply(
             |r| draw_in::draw_plan(r, net, d, &input.stem),
             &mut files,
         )?;
+    }
+    if let Some(record) = &net.meta.wrinkles {
+        let p = name("wrinkles.png");
+        let (scene, pic) = wrinkle::wrinkle_picture(net, record, tool_mesh(), &input.stem);
+        let (bytes, _) = render::shaded_png(&scene, &views, &pic).map_err(draw_err(&p))?;
+        write_atomic(&p, |w| w.write_all(&bytes))?;
+        files.push(p);
     }
     if let Some(contact) = &net.meta.contact {
         let p = name("contact.png");

@@ -224,7 +224,8 @@ pub fn run_case(base: &Ply, layup: &Layup, case: &Case, tool: &ToolSurface) -> C
         Ok(p) => p,
         Err(reason) => return CaseResult::refused(reason, triangles),
     };
-    let one = Layup { reference: layup.reference, stack_side: layup.stack_side, plies: vec![ply] };
+    // A case's figures need no wrinkles, and its time is the drape's.
+    let one = Layup { reference: layup.reference, stack_side: layup.stack_side, plies: vec![ply], wrinkles: false };
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..case.repeats.max(1) {

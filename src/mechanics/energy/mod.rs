@@ -27,7 +27,7 @@
 use crate::geometry::{Point, Vector};
 use crate::kinematic::net::{DrapeNet, NodeStatus};
 use crate::material::{Fibre, MaterialCard};
-use crate::mechanics::sheet::{Factors, SheetLayout};
+use crate::mechanics::sheet::{Factors, SheetError, SheetFeatures, SheetLayout};
 use crate::mechanics::sparse::{SymmetricMatrix, SymmetricPattern};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -250,6 +250,26 @@ impl Grid {
         let d = self.spacing;
         (0..self.num_nodes()).map(|k| Point::new((k / self.nv) as f64 * d, (k % self.nv) as f64 * d, 0.0)).collect()
     }
+}
+
+/// Each cell's bending energy per unit of its reference area d^2 (J/m^2) as the net lies: the
+/// bending term's share of each complete cell ([`Bending::cell_energies`], the term the
+/// mechanics minimises, on the placed nodes, with the sheet's features when it has any: its
+/// reinforcements' bending factors, hinges and cuts), over d^2. `None` for a cell that is not
+/// complete. A cell the blank cuts counts per unit of the whole cell. Fails only when `sheet`
+/// does not fit the net's grid.
+pub fn bending_energy_density<L: Laws + ?Sized>(
+    net: &DrapeNet,
+    laws: &L,
+    sheet: Option<&SheetFeatures>,
+) -> Result<Vec<Option<f64>>, SheetError> {
+    let mut grid = Grid::from_net(net);
+    if let Some(s) = sheet.filter(|s| !s.is_empty()) {
+        grid = grid.with_sheet(s.layout(net.nu, net.nv, net.spacing, net.origin_node)?);
+    }
+    let area = net.spacing * net.spacing;
+    let energies = Bending::new(laws).cell_energies(&grid, &net.positions);
+    Ok(energies.into_iter().map(|e| e.map(|e| e / area)).collect())
 }
 
 /// Where a term puts its contributions: one strip of node rows of the grid. A term reports the

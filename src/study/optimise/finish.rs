@@ -116,7 +116,12 @@ pub fn finish(plan: &Plan, records: &[CaseRecord], dir: &Path) -> Result<Optimis
     }
     // Best first; equal objectives in plan order, so the ranking is the same on any machine.
     ranked.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
-    let one = Layup { reference: scene.layup.reference, stack_side: scene.layup.stack_side, plies: Vec::new() };
+    let one = Layup {
+        reference: scene.layup.reference,
+        stack_side: scene.layup.stack_side,
+        plies: Vec::new(),
+        wrinkles: false,
+    };
     let eval = Evaluator {
         search,
         region: region_of(search, &tool).map_err(StudyError::Input)?,
