@@ -176,65 +176,48 @@ fn optimise_on_a_cylinder_finds_the_0_90_ply_of_zero_shear() {
     }
 }
 
-/// A part symmetric about the plane x = 0 (two bumps, triangulated symmetrically) with
-/// bump height `h`: `n` cells across each way.
-fn two_bumps(h: f64, n: usize) -> TriangleMesh {
-    let z = |x: f64, y: f64| {
-        let bump = |c: f64| (-((x - c) * (x - c) + y * y) / 0.08).exp();
-        h * (bump(0.4) + bump(-0.4))
-    };
-    let at = |i: usize, j: usize| {
-        let (x, y) = (-1.0 + 2.0 * i as f64 / n as f64, -0.8 + 1.6 * j as f64 / n as f64);
-        Point::new(x, y, z(x, y))
-    };
-    let vertices: Vec<Point> = (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| at(i, j)).collect();
-    let id = |i: usize, j: usize| (i * (n + 1) + j) as u32;
-    let mut triangles = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b, c, e) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            // The diagonal mirrors with the quad: one way left of the plane, the other right.
-            if 2 * i < n {
-                triangles.extend([[a, b, c], [a, c, e]]);
-            } else {
-                triangles.extend([[a, b, e], [b, c, e]]);
-            }
-        }
-    }
-    TriangleMesh { vertices, triangles }
-}
-
 /// On a part symmetric about a plane, the objective of every candidate equals its mirror
 /// image's (seed mirrored, angle negated), and the optimum lies on the plane (at 0 deg, its own
 /// mirror image in the range searched) or its mirror image is as good. Two bump heights, two
-/// objectives.
+/// objectives, on the facets and on the smooth surface, with the +-45 deg plies whose fibres
+/// from the seed run along the facets' diagonals.
+///
+/// This failed (candidates 45 and 49 at h = 0.3: 40.648 against 41.088 deg; 0 and 4 at h = 0.45:
+/// 12.0632 against 12.0594, the coverage term) until two causes were fixed: a seed on the plane
+/// was projected onto the tool by a ray along the plane's line of shared edges, which parry's
+/// exact ray cast let through both facets, so it fell back to the closest point, 3.5 mm to one
+/// side of the plane; and coverage sampled the net cut into triangles along one diagonal of each
+/// cell, which is the other diagonal in the mirror image (the same net numbered with its warp
+/// reversed covered 0.17687 of the tool against 0.17648).
 #[test]
-#[ignore = "fails: seeds on the plane at +-a differ by up to 1 deg (candidates 45/49, 46/48 at h = 0.3), on the facets and the smooth surface alike; open, see docs/ARCHITECTURE.md"]
 fn optimise_on_a_mirror_symmetric_part_gives_mirror_pairs_or_the_plane() {
-    for (h, objective) in [(0.3, "max-shear"), (0.45, "mean-shear:1,coverage:10")] {
+    let cases = [
+        (0.3, "max-shear", "facets"),
+        (0.3, "max-shear", "smooth"),
+        (0.45, "mean-shear:1,coverage:10", "facets"),
+        (0.45, "mean-shear:1,coverage:10", "smooth"),
+    ];
+    for (h, objective, surface) in cases {
         let dir = tempfile::tempdir().unwrap();
-        let tool = write_mesh(dir.path(), "bumps.obj", &two_bumps(h, 40));
+        let tool = write_mesh(dir.path(), "bumps.obj", &shapes::two_bumps(h, 40));
         let d = 0.05;
         // Seeded on the plane between two rows of vertices, so that no seed of the lattice sits
         // on a vertex, where the facet a fibre leaves by is a tie.
         // On the facets' edge along the plane (between the vertices at y = 0 and 0.04), so that
         // the seed's foot on the tool, and the seed lattice with it, lie on the plane.
         let y0 = 0.013;
-        let height = |y: f64| 2.0 * h * (-(0.16 + y * y) / 0.08f64).exp();
+        let height = |y: f64| shapes::two_bumps_height(h, 0.0, y);
         let z0 = height(0.0) + (y0 / 0.04) * (height(0.04) - height(0.0));
         let scene_path = write_scene(dir.path(), &tool, [0.0, y0, z0], d, 21);
-        // On the smooth surface: on the facets a fibre from a seed on the plane (an edge of two
-        // mirrored facets) starts in the facet the search for the seed returned, one of the two,
-        // and the two starts differ by that facet's tilt.
-        let text = std::fs::read_to_string(&scene_path).unwrap().replace("[[ply]]", "surface = \"smooth\"\n[[ply]]");
+        let text = std::fs::read_to_string(&scene_path)
+            .unwrap()
+            .replace("[[ply]]", &format!("surface = \"{surface}\"\n[[ply]]"));
         std::fs::write(&scene_path, text).unwrap();
         let scene = Scene::load(&scene_path).unwrap();
         let objective = Objective::parse(objective).unwrap();
         let mut opts = opt::Options::new(objective.clone(), Some(SeedRegion::Disc { radius: 0.5 }));
         opts.seed_step = Some(0.125);
-        // Not +-45 deg: those fibres from the seed run exactly along the triangles' diagonals,
-        // where which facet a fibre is in is decided by rounding, not by the shape.
-        opts.angles = AngleRange { lo: -40.0, hi: 40.0, step: 20.0 };
+        opts.angles = AngleRange { lo: -45.0, hi: 45.0, step: 22.5 };
         let plan = opt::candidates::plan_for(&scene, &opts).unwrap();
         let o = optimise(&plan, &dir.path().join("out"), 2);
         assert!(o.search.frame.origin[0].abs() < 1e-12 && o.search.frame.u[1].abs() < 1e-12, "{:?}", o.search.frame);
@@ -252,7 +235,7 @@ fn optimise_on_a_mirror_symmetric_part_gives_mirror_pairs_or_the_plane() {
             let (f, g) = (c.objective.unwrap(), m_objective(mirror));
             assert!(
                 (f - g).abs() <= MIRROR_TOLERANCE,
-                "h = {h}: candidate {} {f} against its image {} {g}",
+                "h = {h} on the {surface}: candidate {} {f} against its image {} {g}",
                 c.index,
                 mirror.index
             );
@@ -267,7 +250,7 @@ fn optimise_on_a_mirror_symmetric_part_gives_mirror_pairs_or_the_plane() {
                 .unwrap();
             assert!(
                 (image - b.objective).abs() <= MIRROR_TOLERANCE,
-                "h = {h}: optimum {} at {:?}, its image {image}",
+                "h = {h} on the {surface}: optimum {} at {:?}, its image {image}",
                 b.objective,
                 b.origin
             );

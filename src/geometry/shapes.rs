@@ -160,6 +160,44 @@ pub fn saddle_height(radius: f64, x: f64, y: f64) -> f64 {
     (x * x - y * y) / (2.0 * radius)
 }
 
+/// A part symmetric about the plane `x = 0`: two Gaussian bumps of height `h` at `x = +-0.4` on
+/// the rectangle `[-1, 1] x [-0.8, 0.8]` ([`two_bumps_height`]), `n x n` quads (`n` even, so
+/// that a column of vertices lies on the plane) whose diagonals mirror with them: the
+/// triangulation is the mirror image of itself, up to the rounding of the vertices'
+/// coordinates (`x = -1 + 2 i / n`, so the plane's facets meet along edges in it).
+///
+/// # Panics
+/// If `n` is odd or zero.
+pub fn two_bumps(h: f64, n: usize) -> TriangleMesh {
+    assert!(n > 0 && n.is_multiple_of(2), "two_bumps needs an even number of cells each way");
+    let at = |i: usize, j: usize| {
+        let (x, y) = (-1.0 + 2.0 * i as f64 / n as f64, -0.8 + 1.6 * j as f64 / n as f64);
+        Point::new(x, y, two_bumps_height(h, x, y))
+    };
+    let vertices: Vec<Point> = (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| at(i, j)).collect();
+    let id = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, e) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            // The diagonal mirrors with the quad: one way left of the plane, the other right.
+            if 2 * i < n {
+                triangles.extend([[a, b, c], [a, c, e]]);
+            } else {
+                triangles.extend([[a, b, e], [b, c, e]]);
+            }
+        }
+    }
+    TriangleMesh { vertices, triangles }
+}
+
+/// Height of the [`two_bumps`] surface: `h (exp(-((x - 0.4)^2 + y^2) / 0.08) + exp(-((x +
+/// 0.4)^2 + y^2) / 0.08))`, the same for `x` and `-x` to the last bit.
+pub fn two_bumps_height(h: f64, x: f64, y: f64) -> f64 {
+    let bump = |c: f64| (-((x - c) * (x - c) + y * y) / 0.08).exp();
+    h * (bump(0.4) + bump(-0.4))
+}
+
 // ---------------------------------------------------------------------------------------------
 // Double dome
 // ---------------------------------------------------------------------------------------------

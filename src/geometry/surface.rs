@@ -226,14 +226,10 @@ impl ToolSurface {
     }
 
     /// Distance along the unit direction `dir` from `origin` to the first facet it meets, if
-    /// any (the smallest of parry's ray casts on each facet).
+    /// any. A ray through an edge or a vertex that facets share meets them (see
+    /// [`ray_triangle`]), so a ray is never lost between two facets.
     pub fn cast_ray(&self, origin: &Point, dir: &Vector) -> Option<f64> {
-        use parry3d_f64::query::{Ray, RayCast};
-        let ray = Ray::new(*origin, *dir);
-        self.bvh.first_hit(origin, dir, |t| {
-            let [a, b, c] = self.corners(t);
-            parry3d_f64::shape::Triangle::new(a, b, c).cast_local_ray(&ray, f64::MAX, false)
-        })
+        self.bvh.first_hit(origin, dir, |t| ray_triangle(&self.corners(t), origin, dir))
     }
 
     /// Closest point of triangle `t` to `p`.
@@ -432,6 +428,37 @@ pub fn closest_point_on_triangle(p: &Point, a: &Point, b: &Point, c: &Point) -> 
     a + ab * (vb * denom) + ac * (vc * denom)
 }
 
+/// Distance along `dir` (a unit vector) from `origin` to triangle `t`, if the ray meets it at
+/// or ahead of its origin, from either side. Points within [`INSIDE_TOLERANCE`] (barycentric)
+/// outside an edge count as on it: with exact tests (parry's, which this replaced) a ray through
+/// an edge two facets share may be refused by both, each computing its barycentric coordinates
+/// from its own corners and rounding them to just below zero. That lost the seeds on a mirror
+/// plane of a symmetric mesh, where the plane runs along the facets' edges.
+fn ray_triangle(t: &[Point; 3], origin: &Point, dir: &Vector) -> Option<f64> {
+    let (ab, ac) = (t[1] - t[0], t[2] - t[0]);
+    let n = ab.cross(&ac);
+    let d = n.dot(dir);
+    if d == 0.0 {
+        return None;
+    }
+    let ap = origin - t[0];
+    let h = ap.dot(&n);
+    // The origin on the side the ray moves away from: no hit ahead.
+    if (h < 0.0 && d < 0.0) || (h > 0.0 && d > 0.0) {
+        return None;
+    }
+    // The hit's barycentric coordinates along ab and ac, times |d| (Cramer's rule).
+    let e = dir.cross(&ap);
+    let sign = d.signum();
+    let (v, w) = (sign * ac.dot(&e), -sign * ab.dot(&e));
+    let d = d.abs();
+    let slack = INSIDE_TOLERANCE * d;
+    if v < -slack || w < -slack || v + w > d + slack {
+        return None;
+    }
+    Some(h.abs() / d)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -526,5 +553,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Rays through the edges and vertices that facets share meet the tool: along the mirror
+    /// plane of the two-bump part, where mirrored facets meet in a line of edges and rounding
+    /// puts a ray a hair to either side (parry's exact ray cast, used before, lost 6 of these
+    /// 2,000 slanted rays: both facets refused them); vertical rays onto the plane's vertices; a
+    /// ray away from the tool or beside it meets nothing.
+    #[test]
+    fn a_ray_through_a_shared_edge_or_vertex_meets_the_tool() {
+        let tool = shapes::two_bumps(0.3, 40).into_surface().unwrap();
+        let on_tool = |q: &Point, n: &Vector, x: f64| {
+            let t = tool.cast_ray(q, n).unwrap_or_else(|| panic!("the ray from {q:?} along {n:?} missed"));
+            let hit = q + n * t;
+            assert!((hit.x - x).abs() < 1e-15 && tool.closest_point(&hit).distance < 1e-12, "{hit:?}");
+            t
+        };
+        let slanted = Vector::new(0.0, -0.03, 1.0).normalize();
+        for k in 0..2000 {
+            let y = -0.6 + 1.2 * (k as f64 + 0.37) / 2000.0;
+            let q = Point::new(-3.5e-18, y, 1.0);
+            let down = on_tool(&q, &-slanted, -3.5e-18);
+            // From below, the same point of the tool.
+            let below = q - slanted * 2.0;
+            let up = on_tool(&below, &slanted, -3.5e-18);
+            assert!((up + down - 2.0).abs() < 1e-12, "{up} + {down}");
+            assert!(tool.cast_ray(&q, &slanted).is_none(), "away from the tool");
+        }
+        for j in 1..40 {
+            let q = Point::new(0.0, -0.8 + 1.6 * j as f64 / 40.0, 1.0);
+            on_tool(&q, &-Vector::z(), 0.0);
+        }
+        assert!(tool.cast_ray(&Point::new(1.2, 0.0, 1.0), &-Vector::z()).is_none(), "beside the tool");
     }
 }

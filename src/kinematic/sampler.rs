@@ -1,5 +1,5 @@
-//! Where a point lands on a net: [`NetSampler`] finds the closest point of a net's cells (two
-//! triangles a cell) and the fibre tangents of the bilinear cell patch there. The flow-mesh
+//! Where a point lands on a net: [`NetSampler`] finds the closest point of a net's cells (four
+//! triangles a cell, about its centre) and the fibre tangents of the bilinear cell patch there. The flow-mesh
 //! mapping samples the net at element centroids; the layup samples it at tool vertices to add a
 //! ply's thickness to the stack.
 use crate::geometry::surface::closest_point_on_triangle;
@@ -10,7 +10,7 @@ use rstar::{PointDistance, RTree, RTreeObject, AABB};
 /// A centroid whose closest point on the net lies further than this (times the net spacing) from
 /// it along the net's tangent plane is off the net's edge: the element is not covered.
 const EDGE_TOLERANCE_REL: f64 = 1e-6;
-/// Half-cells with less area than this (times d^2) are left out of the net's search mesh.
+/// Cell pieces with less area than this (times d^2) are left out of the net's search mesh.
 const MIN_TRIANGLE_AREA_REL: f64 = 1e-12;
 
 /// Where a point lands on a net: the cell, the bilinear parameters in it, the closest point and
@@ -19,7 +19,8 @@ const MIN_TRIANGLE_AREA_REL: f64 = 1e-12;
 pub struct NetSample {
     /// Cell (i, j) of the net.
     pub cell: (usize, usize),
-    /// Bilinear parameters in the cell, along the warp (`s`) and the weft (`t`), in [0, 1].
+    /// Bilinear parameters of the closest point in the cell, along the warp (`s`) and the weft
+    /// (`t`), in [0, 1].
     pub s: f64,
     /// Bilinear parameter along the weft, in [0, 1].
     pub t: f64,
@@ -45,35 +46,45 @@ impl NetSample {
     }
 }
 
-/// A net as triangles (two per complete cell) in an R-tree (`rstar`), for closest-point queries
-/// near the net. Collapsed halves of folded or locked cells are left out (they carry no area to
+/// A net as triangles (four per complete cell) in an R-tree (`rstar`), for closest-point queries
+/// near the net. Collapsed pieces of folded or locked cells are left out (they carry no area to
 /// find); the tree takes the flat boxes of coincident cells as they are.
+///
+/// A cell is cut into four triangles, each of its sides with its centre, not into two along a
+/// diagonal: the pieces are then the same whichever way the net's warp and weft run (a diagonal
+/// would be the other one for a net with its warp reversed, and where the cell is not flat the
+/// two halves lie differently), so a net and its mirror image cover the same share of a
+/// symmetric tool and map alike onto a symmetric mesh.
 pub struct NetSampler<'a> {
     net: &'a DrapeNet,
-    tree: RTree<HalfCell>,
+    tree: RTree<CellPiece>,
 }
 
-/// One triangle of the net: half 0 of cell (i, j) has the corners 00-10-11, half 1 00-11-01.
-struct HalfCell {
+/// One triangle of the net: a side of cell (i, j) and the cell's centre.
+struct CellPiece {
     /// Its number: ties between triangles at the same distance go to the lowest, so the answer
     /// does not depend on how the tree is built.
     number: u32,
-    /// Corner node indices.
-    nodes: [usize; 3],
-    /// Corner positions.
+    /// Corner positions: the side's two nodes, then the cell's centre.
     corners: [Point; 3],
-    /// Cell (i, j) and half.
-    cell: (usize, usize, u8),
+    /// The bilinear parameters (s, t) of the corners in the cell.
+    params: [[f64; 2]; 3],
+    /// Cell (i, j).
+    cell: (usize, usize),
 }
 
-impl HalfCell {
+/// A cell's corners in order round it, with their bilinear parameters: 00, 10, 11, 01.
+const CELL_CORNERS: [((usize, usize), [f64; 2]); 4] =
+    [((0, 0), [0.0, 0.0]), ((1, 0), [1.0, 0.0]), ((1, 1), [1.0, 1.0]), ((0, 1), [0.0, 1.0])];
+
+impl CellPiece {
     fn closest_point(&self, p: &Point) -> Point {
         let [a, b, c] = &self.corners;
         closest_point_on_triangle(p, a, b, c)
     }
 }
 
-impl RTreeObject for HalfCell {
+impl RTreeObject for CellPiece {
     type Envelope = AABB<[f64; 3]>;
     fn envelope(&self) -> Self::Envelope {
         let [a, b, c] = &self.corners;
@@ -82,7 +93,7 @@ impl RTreeObject for HalfCell {
     }
 }
 
-impl PointDistance for HalfCell {
+impl PointDistance for CellPiece {
     fn distance_2(&self, p: &[f64; 3]) -> f64 {
         let p = Point::from(*p);
         (self.closest_point(&p) - p).norm_squared()
@@ -99,16 +110,21 @@ impl<'a> NetSampler<'a> {
                 if net.cell_corners(i, j).is_none() {
                     continue;
                 }
-                let c = [net.index(i, j), net.index(i + 1, j), net.index(i + 1, j + 1), net.index(i, j + 1)];
-                for (half, nodes) in [(0u8, [c[0], c[1], c[2]]), (1, [c[0], c[2], c[3]])] {
-                    let corners = nodes.map(|k| net.positions[k]);
-                    let [a, b, d] = corners;
-                    // Collapsed halves (a folded or locked cell) carry no area to find.
-                    if (b - a).cross(&(d - a)).norm() <= min_area {
+                let p = CELL_CORNERS.map(|((di, dj), _)| net.positions[net.index(i + di, j + dj)]);
+                // Summed diagonal by diagonal, so that the centre is the same to the last bit
+                // whichever corner the cell is numbered from and whichever way round.
+                let centre = Point::from(((p[0].coords + p[2].coords) + (p[1].coords + p[3].coords)) * 0.25);
+                for k in 0..4 {
+                    let next = (k + 1) % 4;
+                    let corners = [p[k], p[next], centre];
+                    let [a, b, c] = corners;
+                    // Collapsed pieces (a folded or locked cell) carry no area to find.
+                    if (b - a).cross(&(c - a)).norm() <= min_area {
                         continue;
                     }
                     let number = triangles.len() as u32;
-                    triangles.push(HalfCell { number, nodes, corners, cell: (i, j, half) });
+                    let params = [CELL_CORNERS[k].1, CELL_CORNERS[next].1, [0.5, 0.5]];
+                    triangles.push(CellPiece { number, corners, params, cell: (i, j) });
                 }
             }
         }
@@ -119,7 +135,7 @@ impl<'a> NetSampler<'a> {
     pub fn nearest_within(&self, p: &Point, radius: f64) -> Option<NetSample> {
         let net = self.net;
         // The nearest triangles come first; of those at the same distance, the lowest number.
-        let mut best: Option<(f64, &HalfCell)> = None;
+        let mut best: Option<(f64, &CellPiece)> = None;
         for (t, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&[p.x, p.y, p.z]) {
             match best {
                 Some((bd, _)) if d2 > bd => break,
@@ -127,17 +143,21 @@ impl<'a> NetSampler<'a> {
                 _ => best = Some((d2, t)),
             }
         }
-        let (d2, half) = best?;
-        let x = half.closest_point(p);
-        let ([k0, k1, k2], (i, j, half)) = (half.nodes, half.cell);
+        let (d2, piece) = best?;
+        let x = piece.closest_point(p);
+        let (i, j) = piece.cell;
         if d2 > radius * radius {
             return None;
         }
         // Parameters of p's projection onto the triangle's plane, not clamped: a point over the
         // net lies inside its cell up to the kink between neighbouring facets; one beyond the
         // net's edge lies outside a cell that has no neighbour on that side.
-        let l = barycentric(p, &net.positions[k0], &net.positions[k1], &net.positions[k2]);
-        let (s, t) = if half == 0 { (l[1] + l[2], l[2]) } else { (l[1], l[1] + l[2]) };
+        let [a, b, c] = &piece.corners;
+        let params = |l: [f64; 3]| {
+            let param = |k: usize| l[0] * piece.params[0][k] + l[1] * piece.params[1][k] + l[2] * piece.params[2][k];
+            (param(0), param(1))
+        };
+        let (s, t) = params(barycentric(p, a, b, c));
         let complete = |a: isize, b: isize| {
             a >= 0
                 && b >= 0
@@ -173,6 +193,10 @@ impl<'a> NetSampler<'a> {
             beyond = beyond.max(over_s.min(over_t));
         }
         let beyond_edge = beyond * net.spacing;
+        // Where p lands: the parameters of its closest point, not of its projection, which
+        // differ where the closest point lies on an edge between two pieces (over a kink) and
+        // would then depend on which of the two equally near pieces was found first.
+        let (s, t) = params(barycentric(&x, a, b, c));
         let (s, t) = (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
         let q = |a: usize, b: usize| net.positions[net.index(a, b)];
         let (p00, p10, p11, p01) = (q(i, j), q(i + 1, j), q(i + 1, j + 1), q(i, j + 1));
@@ -203,4 +227,67 @@ fn barycentric(p: &Point, a: &Point, b: &Point, c: &Point) -> [f64; 3] {
     let l1 = (d22 * x - d12 * y) / den;
     let l2 = (d11 * y - d12 * x) / den;
     [1.0 - l1 - l2, l1, l2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematic::NodeStatus;
+
+    /// A net of one twisted cell (three corners in z = 0, the fourth raised) and the same net
+    /// numbered with its warp reversed, its weft reversed, or warp and weft swapped.
+    fn twisted(number: impl Fn(usize, usize) -> (usize, usize)) -> DrapeNet {
+        let corner = |i: usize, j: usize| Point::new(i as f64, j as f64, if (i, j) == (0, 1) { 0.4 } else { 0.0 });
+        let mut net = DrapeNet::new("cell", 1.0, 2, 2, (0, 0));
+        for i in 0..2 {
+            for j in 0..2 {
+                let (a, b) = number(i, j);
+                let k = net.index(i, j);
+                net.positions[k] = corner(a, b);
+                net.status[k] = NodeStatus::Placed;
+            }
+        }
+        net
+    }
+
+    /// Where a point lands on a net does not depend on how the net is numbered: the same
+    /// parameters (mapped with the numbering), distance along the normal (its sign with the
+    /// normal's) and distance beyond the edge, above a twisted cell and beyond its edges. Cut
+    /// along the diagonal 00-11 (before), the halves were other triangles with the warp
+    /// reversed: a point above the middle landed at s = 0.41 one way and 0.50 the other, one
+    /// 0.2 beyond an edge was 0.155 beyond it.
+    #[test]
+    fn a_sample_does_not_depend_on_the_nets_numbering() {
+        let net = twisted(|i, j| (i, j));
+        let sampler = NetSampler::new(&net).unwrap();
+        // Each numbering of the nodes and its map of the parameters (s, t); every one turns the
+        // normal (warp x weft) over.
+        type Numbering = (fn(usize, usize) -> (usize, usize), fn(f64, f64) -> (f64, f64));
+        let numberings: [Numbering; 3] = [
+            (|i, j| (1 - i, j), |s, t| (1.0 - s, t)),
+            (|i, j| (i, 1 - j), |s, t| (s, 1.0 - t)),
+            (|i, j| (j, i), |s, t| (t, s)),
+        ];
+        let points = [
+            [0.5, 0.5, 0.3],
+            [0.3, 0.6, 0.25],
+            [0.75, 0.15, -0.1],
+            [0.5, -0.2, 0.05],
+            [1.3, 0.6, 0.1],
+            [-0.1, 0.9, 0.5],
+        ];
+        for (k, (number, map)) in numberings.iter().enumerate() {
+            let other = twisted(number);
+            let other_sampler = NetSampler::new(&other).unwrap();
+            for p in points.map(Point::from) {
+                let a = sampler.nearest_within(&p, 10.0).unwrap();
+                let b = other_sampler.nearest_within(&p, 10.0).unwrap();
+                let (s, t) = map(b.s, b.t);
+                assert!((a.s - s).abs() < 1e-12 && (a.t - t).abs() < 1e-12, "numbering {k}, {p:?}: {a:?} {b:?}");
+                assert!((a.normal_distance + b.normal_distance).abs() < 1e-12, "numbering {k}, {p:?}");
+                assert!((a.beyond_edge - b.beyond_edge).abs() < 1e-12, "numbering {k}, {p:?}");
+                assert!((a.point - b.point).norm() < 1e-12, "numbering {k}, {p:?}");
+            }
+        }
+    }
 }
