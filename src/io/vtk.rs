@@ -10,11 +10,11 @@
 //! `cell_j` (Int32); for a net that records its wrinkles (`meta.wrinkles`, a ply of `drape
 //! run`) also `waviness_m` (Float64, m), `wrinkled` (Int32: 1 where the waviness exceeds the
 //! ply's threshold), `tool_gap_m` (Float64, m) and, for a ply with a material card,
-//! `bending_energy_density_j_m2` (Float64, J/m^2). PointData: `node_i`, `node_j` (Int32); for a refined net also how each node
-//! meets the tool (`meta.contact`): `contact_state` (Int32: 0 free, 1 stick, 2 slip, 3 held;
-//! [`ContactState::code`]), `slip` (Float64, m, over all load steps) and `contact_pressure`
-//! (Float64, Pa). Floats are written with `{:?}`, the shortest text that parses back to the same
-//! f64.
+//! `bending_energy_density_j_m2` (Float64, J/m^2). PointData: `node_i`, `node_j` (Int32); for a
+//! refined net also how each node meets the tool (`meta.contact`): `contact_state` (Int32: 0
+//! free, 1 stick, 2 slip, 3 held; [`ContactState::code`]), `slip` (Float64, m, over all load
+//! steps) and `contact_pressure` (Float64, Pa). Floats are written with `{:?}`, the shortest
+//! text that parses back to the same f64.
 //!
 //! The flow mesh with the fibres of a mapped layup as cell data (`drape export --format vtu`,
 //! `flow.vtu`): points are the mesh nodes in mesh order; cells are VTK_TRIANGLE (5) and VTK_QUAD (9) in
