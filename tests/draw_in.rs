@@ -10,18 +10,7 @@ fn read_json(p: &Path) -> serde_json::Value {
 /// Run `scene` (TOML text, the tool written beside it as `tool.obj`) and return the first ply's
 /// draw-in from layup.json, the same from its net, and the CLI's output.
 fn run(dir: &Path, tool: &drape::geometry::TriangleMesh, scene: &str) -> (DrawIn, DrawIn, String) {
-    std::fs::write(dir.join("tool.obj"), tool.to_obj_string()).unwrap();
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    let out = dir.join("out");
-    let run = assert_cmd::Command::cargo_bin("drape")
-        .unwrap()
-        .arg("run")
-        .arg(dir.join("scene.toml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    let (out, stdout) = crate::common::run_scene(dir, &[("tool.obj", tool)], scene);
     let row = &read_json(&out.join("layup.json"))["plies"][0];
     let table: DrawIn = serde_json::from_value(row["draw_in"].clone()).unwrap();
     let name = row["name"].as_str().unwrap();

@@ -10,20 +10,7 @@ fn read_json(p: &Path) -> serde_json::Value {
 /// Write the tools and `scene` into `dir` and run it: the CLI's output, layup.json's first row
 /// and that ply's net JSON.
 fn run(dir: &Path, tools: &[(&str, &TriangleMesh)], scene: &str) -> (String, serde_json::Value, serde_json::Value) {
-    for (name, mesh) in tools {
-        std::fs::write(dir.join(name), mesh.to_obj_string()).unwrap();
-    }
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    let out = dir.join("out");
-    let run = assert_cmd::Command::cargo_bin("drape")
-        .unwrap()
-        .arg("run")
-        .arg(dir.join("scene.toml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+    let (out, stdout) = crate::common::run_scene(dir, tools, scene);
     let row = read_json(&out.join("layup.json"))["plies"][0].clone();
     let name = row["name"].as_str().unwrap().to_string();
     (stdout, row, read_json(&out.join(format!("{name}.drape.json"))))

@@ -374,18 +374,7 @@ fn repo(rel: &str) -> std::path::PathBuf {
 /// Run `scene` with `tool` written beside it as `tool.obj`; the output folder and the command's
 /// output.
 fn drape_run(dir: &Path, tool: &TriangleMesh, scene: &str) -> (std::path::PathBuf, String) {
-    std::fs::write(dir.join("tool.obj"), tool.to_obj_string()).unwrap();
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    let out = dir.join("out");
-    let run = assert_cmd::Command::cargo_bin("drape")
-        .unwrap()
-        .arg("run")
-        .arg(dir.join("scene.toml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    (out, String::from_utf8_lossy(&run.get_output().stdout).to_string())
+    crate::common::run_scene(dir, &[("tool.obj", tool)], scene)
 }
 
 /// The largest distance of a facet's centroid inside the sphere of radius `r` about the origin:
