@@ -59,3 +59,12 @@ for row in layup.plies:
     print(row["name"], row["method"], f"max |shear| {row['max_abs_shear_deg']:.2f} deg")
 mapped = drape.export(net, tool, "vtu", out / "flow.vtu", material=card, permeability=True)
 print(f"flow mesh: {mapped['covered']} of {mapped['elements']} elements covered -> {mapped['files']}")
+
+# %% [markdown]
+# ## The best seed and angle of the +45 ply: a global search of candidate drapes, refined
+
+# %%
+best = drape.optimise(repo / "geometries" / "hemisphere" / "scene.toml", out / "optimise", ply="p45",
+                      seed_radius=0.02, angle_range=(-30, 30), angle_step=15, refine=2)
+print(f"{best.result['objective_text']}: {best.objective:.3f} at seed {np.round(best.best['origin'], 4)} m, "
+      f"angle {best.best['angle_deg']:.2f} deg ({len(best.landscape)} candidates) -> {best.scene}")

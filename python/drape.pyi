@@ -99,6 +99,40 @@ class Layup:
         """The net of ply ``name`` from the run folder (written with the json format)."""
     def __len__(self) -> int: ...
 
+class Optimisation:
+    """An optimisation's result (``optimise.json`` in its folder) and the files it wrote."""
+
+    @property
+    def best(self) -> dict[str, Any]:
+        """The best placement at the ply's spacing: ``origin`` (the seed on the tool, m),
+        ``angle_deg``, ``objective``, ``stats`` (``max_abs_shear_deg``, ``mean_abs_shear_deg``,
+        ``area_over_locking_m2``, ``coverage``, ``cells``), ``seed_ab`` (the seed in the seed
+        plane, m), ``spacing``, ``outcome`` and ``start`` (the global search's candidate it was
+        refined from, its objective at both spacings, the drapes the refinement ran)."""
+    @property
+    def objective(self) -> float:
+        """The best placement's objective (smaller is better)."""
+    @property
+    def runners_up(self) -> list[dict[str, Any]]:
+        """The other refined placements, best first, as dicts like ``best``."""
+    @property
+    def landscape(self) -> list[dict[str, Any]]:
+        """Every candidate of the global search in plan order: ``index``, ``seed_ab``, ``origin``,
+        ``angle_deg``, ``objective`` (None where it gave no complete cell), ``outcome``."""
+    @property
+    def result(self) -> dict[str, Any]:
+        """The whole ``optimise.json``."""
+    @property
+    def files(self) -> list[Path]:
+        """The files written: ``optimise.json``, ``optimal.toml``, ``optimise.png``,
+        ``optimise.svg``."""
+    @property
+    def scene(self) -> Path:
+        """The scene with the optimal ply (``optimal.toml``), ready for ``drape.run``."""
+    @property
+    def out(self) -> Path:
+        """The optimisation's folder."""
+
 def kinematic(
     tool: Tool,
     origin: Vec3,
@@ -186,4 +220,44 @@ def export(
     Returns a dict: ``files`` (the Paths written), ``nodes`` and ``elements`` of the mesh,
     ``covered`` (elements the ply covers), ``max_abs_shear_deg`` and ``mean_abs_shear_deg`` over
     them, ``vf_capped`` (elements at the fibre packing limit), ``notes`` (on the mesh and map).
+    """
+
+
+def optimise(
+    scene: PathLike,
+    out: PathLike,
+    *,
+    ply: Optional[str] = None,
+    vary: Union[str, Sequence[str]] = "seed,angle",
+    seed_radius: Optional[float] = None,
+    seed_polygon: Optional[Union[PathLike, npt.ArrayLike]] = None,
+    seed_step: Optional[float] = None,
+    angle_range: Union[str, Tuple[float, float]] = (-45.0, 45.0),
+    angle_step: float = 5.0,
+    objective: str = "max-shear",
+    spacing: Optional[float] = None,
+    refine: int = 3,
+    max_candidates: int = 10000,
+    jobs: Optional[int] = None,
+    shard: Optional[Union[str, Tuple[int, int]]] = None,
+) -> Optional[Optimisation]:
+    """Find the seed and angle of a ply of a scene file that minimise ``objective``, into the
+    folder ``out``, as ``drape optimise`` does (the keywords are its options; lengths in the
+    scene's units).
+
+    A global search drapes every candidate (the seeds of a lattice of step ``seed_step`` over the
+    seed region, ``seed_radius`` around the ply's origin or inside ``seed_polygon`` (a points
+    file, ``"x,y,z;x,y,z;..."`` or corners shaped (n, 3)), at every angle of ``angle_range`` by
+    ``angle_step``) kinematically at ``spacing`` (default: twice the ply's), ``jobs`` at a time
+    (default: every core); the best ``refine`` are refined by a pattern search at the ply's own
+    spacing. ``vary`` names what moves: ``seed``, ``angle`` or both. ``objective``:
+    ``max-shear``, ``locked-area``, ``mean-shear``, ``coverage`` (maximised) or a weighted sum
+    like ``"max-shear:1,coverage:0.5"``.
+
+    Writes ``optimise.json``, ``optimal.toml`` (the scene with the optimal ply), the landscape
+    pictures and the study's ``study.json`` and ``cases/`` (run again into ``out`` to resume).
+    With ``shard="K/N"`` only that shard of the global search runs: the result is None until a
+    folder holds every candidate (``drape study merge`` joins shard folders and finishes).
+
+    Raises InputError on bad input, with the command line's message.
     """

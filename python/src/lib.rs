@@ -1,5 +1,5 @@
-//! The Python module `drape`: the library's pipeline (`drape::pipeline`) called from Python, a
-//! draped net as numpy arrays. Every function here converts arguments, calls the same library
+//! The Python module `drape`: the library's pipeline (`drape::pipeline`) and placement
+//! optimisation (`drape::study::optimise`) called from Python, a draped net as numpy arrays. Every function here converts arguments, calls the same library
 //! functions as the command line (with the GIL released while they work) and converts the
 //! result; a refusal is raised with the command line's message.
 use drape::geometry::{Point, ToolSurface};
@@ -13,6 +13,12 @@ use drape::pipeline::ply::{check_converged, read_tool, PlyOptions};
 use drape::pipeline::refine::{check_refined, parse_mode, refine_net, RefineOptions};
 use drape::pipeline::run::{run as run_scene, RunError};
 use drape::pipeline::Scene;
+use drape::study::optimise::run::{
+    parse_angle_range, DEFAULT_ANGLE_RANGE, DEFAULT_ANGLE_STEP, DEFAULT_OBJECTIVE, DEFAULT_VARY,
+};
+use drape::study::optimise::{self as opt, PolygonArg, Request, DEFAULT_MAX_CANDIDATES, DEFAULT_REFINE_STARTS};
+use drape::study::runner::jobs_or_cores;
+use drape::study::{Finished, Shard};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -541,6 +547,200 @@ fn export<'py>(
     Ok(result)
 }
 
+/// An optimisation's result (`optimise.json` in its folder) and the files it wrote.
+#[pyclass(module = "drape", name = "Optimisation", frozen)]
+struct Optimisation {
+    result: Py<PyAny>,
+    files: Vec<PathBuf>,
+    scene: PathBuf,
+    out: PathBuf,
+}
+
+#[pymethods]
+impl Optimisation {
+    /// The best placement at the ply's spacing, a dict: `origin` (the seed on the tool, m),
+    /// `angle_deg`, `objective`, `stats` (the figures it is made of), `seed_ab`, `spacing`,
+    /// `outcome` and `start` (the global search's candidate it was refined from).
+    #[getter]
+    fn best<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.result.bind(py).get_item("best")
+    }
+
+    /// The best placement's objective (smaller is better).
+    #[getter]
+    fn objective(&self, py: Python<'_>) -> PyResult<f64> {
+        self.best(py)?.get_item("objective")?.extract()
+    }
+
+    /// The other refined placements, best first, as dicts like `best`.
+    #[getter]
+    fn runners_up<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.result.bind(py).get_item("runners_up")
+    }
+
+    /// Every candidate of the global search in plan order (the objective's landscape), dicts:
+    /// `index`, `seed_ab`, `origin`, `angle_deg`, `objective` (None where it gave no complete
+    /// cell), `outcome`.
+    #[getter]
+    fn landscape<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.result.bind(py).get_item("landscape")
+    }
+
+    /// The whole `optimise.json` as a dict.
+    #[getter]
+    fn result<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        self.result.bind(py).clone()
+    }
+
+    /// The files written: `optimise.json`, the scene with the optimal ply, the landscape
+    /// pictures (PNG, SVG).
+    #[getter]
+    fn files(&self) -> Vec<PathBuf> {
+        self.files.clone()
+    }
+
+    /// The scene with the optimal ply (`optimal.toml`), ready for `drape.run`.
+    #[getter]
+    fn scene(&self) -> PathBuf {
+        self.scene.clone()
+    }
+
+    /// The optimisation's folder.
+    #[getter]
+    fn out(&self) -> PathBuf {
+        self.out.clone()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let best = self.best(py)?;
+        Ok(format!(
+            "<drape.Optimisation of ply {}: {} = {} at {} deg, seed {} in {}>",
+            self.result.bind(py).get_item("ply")?,
+            self.result.bind(py).get_item("objective_text")?,
+            best.get_item("objective")?,
+            best.get_item("angle_deg")?,
+            best.get_item("origin")?,
+            self.out.display()
+        ))
+    }
+}
+
+/// `vary` as Python gives it: `"seed,angle"` or a sequence like `["seed", "angle"]`.
+fn vary_arg(vary: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(text) = vary.extract::<String>() {
+        return Ok(text);
+    }
+    let names: Vec<String> = vary
+        .extract()
+        .map_err(|_| InputError::new_err("vary: give \"seed\", \"angle\", \"seed,angle\" or a list of them"))?;
+    Ok(names.join(","))
+}
+
+/// `seed_polygon` as Python gives it: a points file, the corners as text (`x,y,z;x,y,z;...`), or
+/// an array-like of corners shaped (n, 3).
+fn polygon_arg(polygon: &Bound<'_, PyAny>) -> PyResult<PolygonArg> {
+    if let Ok(path) = polygon.extract::<PathBuf>() {
+        return Ok(PolygonArg::Text(path.to_string_lossy().into_owned()));
+    }
+    let bad = || {
+        InputError::new_err(
+            "seed_polygon: give a points file, the corners as x,y,z;x,y,z;... or an array shaped (n, 3)",
+        )
+    };
+    let array =
+        polygon.py().import("numpy")?.call_method1("ascontiguousarray", (polygon, "float64")).map_err(|_| bad())?;
+    let array: PyReadonlyArray2<f64> = array.extract().map_err(|_| bad())?;
+    if array.shape()[1] != 3 {
+        return Err(bad());
+    }
+    Ok(PolygonArg::Points(array.as_array().rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect()))
+}
+
+/// `angle_range` as Python gives it: `"LO,HI"` or a pair of degrees.
+fn angle_range_arg(range: &Bound<'_, PyAny>) -> PyResult<[f64; 2]> {
+    if let Ok(text) = range.extract::<String>() {
+        return parse_angle_range(&text).map_err(|e| to_py(e.into()));
+    }
+    range
+        .extract::<[f64; 2]>()
+        .map_err(|_| InputError::new_err("angle_range: give (LO, HI) in degrees, like (-45, 45)"))
+}
+
+/// `shard` as Python gives it: `"K/N"` or a pair `(K, N)`.
+fn shard_arg(shard: &Bound<'_, PyAny>) -> PyResult<Shard> {
+    let text = match shard.extract::<String>() {
+        Ok(text) => text,
+        Err(_) => {
+            let (k, n): (usize, usize) =
+                shard.extract().map_err(|_| InputError::new_err("shard: give \"K/N\" or (K, N), like \"2/8\""))?;
+            format!("{k}/{n}")
+        }
+    };
+    Shard::parse(&text).map_err(|m| InputError::new_err(format!("--shard: {m}")))
+}
+
+/// Find the best seed and angle of a ply of a scene file, into the folder `out`, as `drape
+/// optimise` does.
+#[pyfunction]
+#[pyo3(signature = (
+    scene, out, *, ply=None, vary=None, seed_radius=None, seed_polygon=None, seed_step=None,
+    angle_range=None, angle_step=None, objective=None, spacing=None, refine=None,
+    max_candidates=None, jobs=None, shard=None
+))]
+#[allow(clippy::too_many_arguments)]
+fn optimise(
+    py: Python<'_>,
+    scene: PathBuf,
+    out: PathBuf,
+    ply: Option<String>,
+    vary: Option<&Bound<'_, PyAny>>,
+    seed_radius: Option<f64>,
+    seed_polygon: Option<&Bound<'_, PyAny>>,
+    seed_step: Option<f64>,
+    angle_range: Option<&Bound<'_, PyAny>>,
+    angle_step: Option<f64>,
+    objective: Option<String>,
+    spacing: Option<f64>,
+    refine: Option<usize>,
+    max_candidates: Option<usize>,
+    jobs: Option<usize>,
+    shard: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Option<Optimisation>> {
+    let request = Request {
+        ply,
+        vary: vary.map(vary_arg).transpose()?.unwrap_or_else(|| DEFAULT_VARY.into()),
+        seed_radius,
+        seed_polygon: seed_polygon.map(polygon_arg).transpose()?,
+        seed_step,
+        angle_range: angle_range.map(angle_range_arg).transpose()?.unwrap_or(DEFAULT_ANGLE_RANGE),
+        angle_step: angle_step.unwrap_or(DEFAULT_ANGLE_STEP),
+        objective: objective.unwrap_or_else(|| DEFAULT_OBJECTIVE.into()),
+        spacing,
+        refine: refine.unwrap_or(DEFAULT_REFINE_STARTS),
+        max_candidates: max_candidates.unwrap_or(DEFAULT_MAX_CANDIDATES),
+    };
+    let shard = shard.map(shard_arg).transpose()?.unwrap_or(Shard::ALL);
+    let done = py
+        .detach(|| -> Result<_, Failure> {
+            let scene = Scene::load(&scene).map_err(input)?;
+            let done = opt::optimise(&scene, &request, &out, shard, jobs_or_cores(jobs), |_| {}, |_, _| {})?;
+            let Some((o, path)) = done.result else { return Ok(None) };
+            let text = serde_json::to_string(&o).map_err(compute)?;
+            let scene_file = out.join(&o.scene);
+            // The landscape pictures, as the command line draws them.
+            let pictures = drape::report::study::draw(&out, &Finished::Optimise(Box::new(o)))
+                .map_err(|m| compute(anyhow::anyhow!(m)))?;
+            let files = [vec![path, scene_file.clone()], pictures].concat();
+            Ok(Some((text, files, scene_file, drape::study::shear_range_warning(&out))))
+        })
+        .map_err(to_py)?;
+    let Some((text, files, scene_file, warning)) = done else { return Ok(None) };
+    if let Some(w) = warning {
+        warn(py, &w)?;
+    }
+    Ok(Some(Optimisation { result: json_to_py(py, &text)?.unbind(), files, scene: scene_file, out }))
+}
+
 /// Plans how woven composite plies lie on a part: the drape library from Python.
 #[pymodule]
 #[pyo3(name = "drape")]
@@ -548,10 +748,12 @@ fn drape_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<Net>()?;
     m.add_class::<Layup>()?;
+    m.add_class::<Optimisation>()?;
     m.add_function(wrap_pyfunction!(kinematic, m)?)?;
     m.add_function(wrap_pyfunction!(refine, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(export, m)?)?;
+    m.add_function(wrap_pyfunction!(optimise, m)?)?;
     m.add("DrapeError", py.get_type::<DrapeError>())?;
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("ComputeError", py.get_type::<ComputeError>())?;

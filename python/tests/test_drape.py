@@ -294,7 +294,84 @@ def test_export_matches_cli(cli, tmp_path):
         drape.export(net, HEMISPHERE, "stl", tmp_path / "x.stl")
 
 
-def test_the_gil_is_released_while_draping():
+# An optimisation small enough for a test: 13 seeds x 3 angles of the hemisphere scene's p45 at
+# 8 mm, the best 2 refined at its 4 mm; as command-line arguments and the same as Python keywords.
+OPTIMISE_ARGS = ["--ply", "p45", "--seed-radius", "0.02", "--seed-step", "0.01", "--angle-range=-30,30",
+                 "--angle-step", "30", "--objective", "max-shear:1,coverage:2", "--refine", "2", "--jobs", "2"]
+OPTIMISE_KEYWORDS = dict(ply="p45", seed_radius=0.02, seed_step=0.01, angle_range=(-30, 30), angle_step=30,
+                         objective="max-shear:1,coverage:2", refine=2, jobs=2)
+OPTIMISE_SCENE = REPO / "geometries" / "hemisphere" / "scene.toml"
+
+
+def without_run_times(result):
+    """optimise.json without the wall-clock times, which differ from run to run."""
+    return {k: v for k, v in result.items() if k not in ("search_drape_s", "refine_s")}
+
+
+def test_optimise_matches_cli(cli, tmp_path):
+    cli("optimise", OPTIMISE_SCENE, "--out", tmp_path / "cli", *OPTIMISE_ARGS)
+    o = drape.optimise(OPTIMISE_SCENE, tmp_path / "py", **OPTIMISE_KEYWORDS)
+    cli_result = json.loads((tmp_path / "cli" / "optimise.json").read_text())
+    # The same best placement and objective, runners-up and landscape, to the last bit.
+    assert o.best == cli_result["best"] and o.objective == cli_result["best"]["objective"]
+    assert o.runners_up == cli_result["runners_up"] and len(o.landscape) == 39
+    assert without_run_times(o.result) == without_run_times(cli_result)
+    names = ["optimise.json", "optimal.toml", "optimise.png", "optimise.svg"]
+    assert o.files == [tmp_path / "py" / n for n in names] and all(f.is_file() for f in o.files)
+    assert o.scene == tmp_path / "py" / "optimal.toml"
+    # The scene with the optimal ply is the command line's, but for the folder it names.
+    py_scene = o.scene.read_text().replace(str(tmp_path / "py"), "OUT")
+    assert py_scene == (tmp_path / "cli" / "optimal.toml").read_text().replace(str(tmp_path / "cli"), "OUT")
+    # The same options as a polygon of corners and text where the command line takes text.
+    again = drape.optimise(OPTIMISE_SCENE, tmp_path / "py", **{**OPTIMISE_KEYWORDS, "angle_range": "-30,30",
+                                                               "vary": ["seed", "angle"]})
+    assert again.best == o.best
+
+
+def test_optimise_in_shards(tmp_path):
+    keywords = {**OPTIMISE_KEYWORDS, "vary": "seed", "refine": 1}
+    assert drape.optimise(OPTIMISE_SCENE, tmp_path, shard="1/2", **keywords) is None
+    assert not (tmp_path / "optimise.json").exists()
+    done = drape.optimise(OPTIMISE_SCENE, tmp_path, shard=(2, 2), **keywords)
+    whole = drape.optimise(OPTIMISE_SCENE, tmp_path / "whole", **keywords)
+    assert done.best == whole.best and done.best["angle_deg"] is None
+
+
+# Bad optimisations: the command-line arguments and the same as Python keywords.
+BAD_OPTIMISATIONS = {
+    "objective": (["--seed-radius", "0.02", "--objective", "wrinkles"], {"seed_radius": 0.02, "objective": "wrinkles"}),
+    "no-region": ([], {}),
+    "vary": (["--seed-radius", "0.02", "--vary", "tilt"], {"seed_radius": 0.02, "vary": "tilt"}),
+    "ply": (["--seed-radius", "0.02", "--ply", "nope"], {"seed_radius": 0.02, "ply": "nope"}),
+    "angle-range": (["--seed-radius", "0.02", "--angle-range", "30,-30"], {"seed_radius": 0.02, "angle_range": (30, -30)}),
+    "too-many": (["--seed-radius", "0.02", "--seed-step", "0.001", "--angle-step", "1"],
+                 {"seed_radius": 0.02, "seed_step": 0.001, "angle_step": 1}),
+    "polygon": (["--seed-polygon", "0,0,0.1;0.01,0,0.1", "--vary", "seed"],
+                {"seed_polygon": [(0, 0, 0.1), (0.01, 0, 0.1)], "vary": "seed"}),
+    "shard": (["--seed-radius", "0.02", "--shard", "3/2"], {"seed_radius": 0.02, "shard": "3/2"}),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_OPTIMISATIONS))
+def test_optimise_refuses_like_the_cli(cli, tmp_path, case):
+    args, keywords = BAD_OPTIMISATIONS[case]
+    done = cli("optimise", OPTIMISE_SCENE, "--out", tmp_path / "cli", *args, check=False)
+    assert done.returncode == 2, done.stderr
+    with pytest.raises(drape.InputError) as raised:
+        drape.optimise(OPTIMISE_SCENE, tmp_path / "py", **keywords)
+    assert str(raised.value) == done.stderr.strip().removeprefix("error: ")
+    assert not (tmp_path / "py").exists()
+
+
+# Long calls, each given a folder to write into.
+LONG_CALLS = {
+    "kinematic": lambda out: drape.kinematic(HEMISPHERE, (0, 0, 0.1), (1, 0, 0), 0.0008, (301, 301), surface="smooth"),
+    "optimise": lambda out: drape.optimise(OPTIMISE_SCENE, out, **OPTIMISE_KEYWORDS),
+}
+
+
+@pytest.mark.parametrize("call", sorted(LONG_CALLS))
+def test_the_gil_is_released_while_draping(tmp_path, call):
     # With a switch interval far longer than the test, a thread gives the GIL up only when it
     # waits (the main thread's sleep(0)) or when the extension releases it. The main thread
     # counts while another drapes: released, the count goes on during the drape; held, it
@@ -304,10 +381,12 @@ def test_the_gil_is_released_while_draping():
     done = threading.Event()
 
     def work():
-        seen["before"] = count[0]
-        drape.kinematic(HEMISPHERE, (0, 0, 0.1), (1, 0, 0), 0.0008, (301, 301), surface="smooth")
-        seen["after"] = count[0]
-        done.set()
+        try:
+            seen["before"] = count[0]
+            LONG_CALLS[call](tmp_path)
+            seen["after"] = count[0]
+        finally:
+            done.set()
 
     interval = sys.getswitchinterval()
     sys.setswitchinterval(100.0)

@@ -17,6 +17,7 @@ use clap::{Parser, Subcommand};
 // The failure type lives in the library, so the Python package reports the same messages.
 pub(crate) use crate::pipeline::failure::{compute, input, write_failure};
 pub use crate::pipeline::failure::{Failure, EXIT_BAD_INPUT, EXIT_FAILED};
+pub use crate::pipeline::parse_vec3;
 
 /// Plan how composite plies lie on a part: kinematic (fishnet) drape on OBJ tool surfaces.
 #[derive(Debug, Parser)]
@@ -64,16 +65,6 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Report(a) => report::run(a),
         Command::Study(a) => study::run(a),
         Command::Optimise(a) => optimise::run(a),
-    }
-}
-
-/// Parse `X,Y,Z` into three finite numbers.
-pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let nums: Result<Vec<f64>, _> = parts.iter().map(|p| p.parse::<f64>()).collect();
-    match nums {
-        Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => Ok([v[0], v[1], v[2]]),
-        _ => Err(format!("'{s}' is not a vector: give three finite numbers separated by commas, like 0,0,1.5")),
     }
 }
 

@@ -1,10 +1,14 @@
 //! `drape optimise`: the best seed and angle of a ply. The search lives in
 //! [`crate::study::optimise`] and runs as a study (shards, merge, resume); this file parses the
-//! arguments and prints the result.
-use super::{input, parse_vec3, Failure};
-use crate::io::points::read_points;
+//! arguments into its [`Request`], calls [`opt::optimise`] and prints the result.
+use super::{input, Failure};
 use crate::pipeline::Scene;
-use crate::study::optimise::{self as opt, AngleRange, Objective, Optimisation, SeedRegion};
+use crate::study::optimise::run::{
+    parse_angle_range, DEFAULT_ANGLE_RANGE, DEFAULT_ANGLE_STEP, DEFAULT_OBJECTIVE, DEFAULT_VARY,
+};
+use crate::study::optimise::{self as opt, Optimisation, PolygonArg, Request};
+use crate::study::runner::jobs_or_cores;
+use crate::study::{Finished, Plan, StudyKind};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -21,7 +25,7 @@ pub struct OptimiseArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// What is varied: seed, angle or seed,angle.
-    #[arg(long, default_value = "seed,angle")]
+    #[arg(long, default_value = DEFAULT_VARY)]
     pub vary: String,
     /// The seed region: within this distance of the ply's origin (scene units).
     #[arg(long)]
@@ -33,15 +37,16 @@ pub struct OptimiseArgs {
     /// Step of the seed lattice (scene units; default: an eighth of the region's size).
     #[arg(long)]
     pub seed_step: Option<f64>,
-    /// The ply angles tried, LO,HI in degrees (a balanced fabric at a + 90 deg is the same ply).
-    #[arg(long, default_value = "-45,45")]
-    pub angle_range: String,
+    /// The ply angles tried, LO,HI in degrees (default: -45,45; a balanced fabric at a + 90 deg
+    /// is the same ply).
+    #[arg(long)]
+    pub angle_range: Option<String>,
     /// Step of the angles, degrees.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = DEFAULT_ANGLE_STEP)]
     pub angle_step: f64,
     /// What is minimised: max-shear, locked-area, mean-shear, coverage (maximised), or a
     /// weighted sum like max-shear:1,coverage:0.5.
-    #[arg(long, default_value = "max-shear")]
+    #[arg(long, default_value = DEFAULT_OBJECTIVE)]
     pub objective: String,
     /// Fibre spacing of the global search (scene units; default: twice the ply's).
     #[arg(long)]
@@ -64,84 +69,47 @@ pub struct OptimiseArgs {
     pub slurm: Option<usize>,
 }
 
-fn bad(message: String) -> Failure {
-    input(anyhow::anyhow!(message))
-}
-
-/// `x,y,z;x,y,z;...`, or a points file.
-fn polygon(text: &str, scale: f64) -> Result<Vec<[f64; 3]>, Failure> {
-    let path = Path::new(text);
-    let points = if path.is_file() {
-        read_points(path, scale)
-            .map_err(|m| bad(format!("--seed-polygon: {m}")))?
-            .into_iter()
-            .map(|p| p.coords.into())
-            .collect()
-    } else if text.contains(';') {
-        text.split(';')
-            .filter(|p| !p.trim().is_empty())
-            .map(|p| parse_vec3(p).map(|v| v.map(|x| x * scale)))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|m| bad(format!("--seed-polygon: {m}")))?
-    } else {
-        return Err(bad(format!(
-            "--seed-polygon: {text} is not a file, nor points x,y,z;x,y,z;...: give a points file or the corners"
-        )));
-    };
-    Ok(points)
-}
-
 /// Run `drape optimise`.
 pub fn run(a: OptimiseArgs) -> Result<(), Failure> {
     let scene = Scene::load(&a.scene).map_err(input)?;
-    let s = scene.scale;
-    let objective = Objective::parse(&a.objective).map_err(bad)?;
-    let mut vary_seed = false;
-    let mut vary_angle = false;
-    for v in a.vary.split(',').map(str::trim) {
-        match v {
-            "seed" => vary_seed = true,
-            "angle" => vary_angle = true,
-            other => return Err(bad(format!("--vary: unknown '{other}': give seed, angle or seed,angle"))),
-        }
-    }
-    let region = match (a.seed_radius, &a.seed_polygon) {
-        (Some(_), Some(_)) => return Err(bad("give --seed-radius or --seed-polygon, not both".into())),
-        (Some(r), None) => Some(SeedRegion::Disc { radius: r * s }),
-        (None, Some(p)) => Some(SeedRegion::Polygon { points: polygon(p, s)? }),
-        (None, None) => None,
-    };
-    let range: Vec<f64> =
-        a.angle_range.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
-            bad(format!("--angle-range: '{}' is not LO,HI: give two angles in degrees, like -45,45", a.angle_range))
-        })?;
-    let [lo, hi] = range[..] else {
-        return Err(bad(format!(
-            "--angle-range: '{}' is not LO,HI: give two angles in degrees, like -45,45",
-            a.angle_range
-        )));
-    };
-    let opts = opt::Options {
-        ply: a.ply.clone(),
-        vary_seed,
-        vary_angle,
-        seed_step: a.seed_step.map(|h| h * s),
-        angles: AngleRange { lo, hi, step: a.angle_step },
-        spacing: a.spacing.map(|d| d * s),
-        refine_starts: a.refine,
+    let request = Request {
+        ply: a.ply,
+        vary: a.vary,
+        seed_radius: a.seed_radius,
+        seed_polygon: a.seed_polygon.map(PolygonArg::Text),
+        seed_step: a.seed_step,
+        angle_range: a.angle_range.as_deref().map_or(Ok(DEFAULT_ANGLE_RANGE), parse_angle_range)?,
+        angle_step: a.angle_step,
+        objective: a.objective,
+        spacing: a.spacing,
+        refine: a.refine,
         max_candidates: a.max_candidates,
-        ..opt::Options::new(objective, region)
     };
-    let plan = opt::candidates::plan_for(&scene, &opts).map_err(|e| input(anyhow::anyhow!(e)))?;
-    println!(
-        "ply {}: {} candidate placements at d = {} m, then the best {} refined at d = {} m",
-        plan.ply,
-        plan.cases.len(),
-        plan.cases[0].variant.spacing,
-        opts.refine_starts,
-        plan.search.as_ref().map_or(0.0, |x| x.ply_spacing)
-    );
-    super::study::execute_plan(&plan, &a.out, a.shard.as_deref(), a.jobs, a.slurm)
+    let planned = |plan: &Plan| {
+        println!(
+            "ply {}: {} candidate placements at d = {} m, then the best {} refined at d = {} m",
+            plan.ply,
+            plan.cases.len(),
+            plan.cases[0].variant.spacing,
+            request.refine,
+            plan.search.as_ref().map_or(0.0, |x| x.ply_spacing)
+        )
+    };
+    let jobs = jobs_or_cores(a.jobs);
+    if let Some(n) = a.slurm {
+        let plan = opt::candidates::plan_for(&scene, &request.options(scene.scale)?)?;
+        planned(&plan);
+        return super::study::write_slurm(&plan, &a.out, n, jobs);
+    }
+    let shard = super::study::shard_of(a.shard.as_deref())?;
+    let bar = super::progress::bar(0, StudyKind::Optimise.name());
+    let done = opt::optimise(&scene, &request, &a.out, shard, jobs, planned, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    super::study::print_run(&done.plan, &a.out, shard, done.summary, done.search_s, jobs);
+    super::study::report(&a.out, done.result.map(|(o, path)| (Finished::Optimise(Box::new(o)), path)))
 }
 
 /// Print a finished optimisation.

@@ -2,8 +2,9 @@
 //! studies live in [`crate::study`], their pictures in [`crate::report::study`].
 use super::{compute, input, Failure};
 use crate::pipeline::Scene;
+use crate::study::runner::{jobs_or_cores as jobs, RunSummary};
 use crate::study::stability::{self, Parameter};
-use crate::study::{self as st, speed_accuracy, Finished, Plan, Shard, StudyError};
+use crate::study::{self as st, speed_accuracy, Finished, Plan, Shard};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 
@@ -122,17 +123,6 @@ pub struct ShardArgs {
     pub jobs: Option<usize>,
 }
 
-fn study_failure(e: StudyError) -> Failure {
-    match e {
-        StudyError::Input(_) => input(e),
-        StudyError::Write(_) => compute(e),
-    }
-}
-
-fn jobs(j: Option<usize>) -> usize {
-    j.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1)
-}
-
 /// Run `drape study`.
 pub fn run(a: StudyArgs) -> Result<(), Failure> {
     match a.command {
@@ -147,7 +137,7 @@ pub fn run(a: StudyArgs) -> Result<(), Failure> {
                 repeats: s.repeats,
                 frictions: s.frictions,
             };
-            let plan = speed_accuracy::plan(&scene, &opts).map_err(study_failure)?;
+            let plan = speed_accuracy::plan(&scene, &opts)?;
             execute(&plan, &s.common)
         }
         StudyCommand::Stability(s) => {
@@ -168,19 +158,19 @@ pub fn run(a: StudyArgs) -> Result<(), Failure> {
                 axes: Some([parse(a0)?, parse(a1)?]),
                 tools: s.common.tools.clone(),
             };
-            let plan = stability::plan_for(&scene, &opts).map_err(study_failure)?;
+            let plan = stability::plan_for(&scene, &opts)?;
             execute(&plan, &s.common)
         }
         StudyCommand::Merge(m) => {
-            st::runner::merge(&m.shards, &m.out).map_err(study_failure)?;
+            st::runner::merge(&m.shards, &m.out)?;
             println!("merged {} shard folders into {}", m.shards.len(), m.out.display());
-            let finished = st::finish(&m.out).map_err(study_failure)?;
+            let finished = st::finish(&m.out)?;
             report(&m.out, finished)
         }
         StudyCommand::Shard(s) => {
             let shard = Shard::parse(&s.shard).map_err(|m| input(anyhow::anyhow!("--shard: {m}")))?;
             let dir = s.plan.parent().unwrap_or(Path::new("."));
-            let plan = st::runner::read_plan(dir).map_err(study_failure)?;
+            let plan = st::runner::read_plan(dir)?;
             run_shard(&plan, &s.out, shard, jobs(s.jobs))
         }
     }
@@ -190,9 +180,17 @@ fn execute(plan: &Plan, c: &Common) -> Result<(), Failure> {
     execute_plan(plan, &c.out, c.shard.as_deref(), c.jobs, c.slurm)
 }
 
+/// The `--shard K/N` asked, or the whole plan.
+pub(super) fn shard_of(text: Option<&str>) -> Result<Shard, Failure> {
+    match text {
+        Some(s) => Shard::parse(s).map_err(|m| input(anyhow::anyhow!("--shard: {m}"))),
+        None => Ok(Shard::ALL),
+    }
+}
+
 /// Run `plan` into `out`: its shard (`K/N`), `jobs` cases at a time, or write its Slurm array of
 /// `slurm` shards; print what it gave when the study is complete.
-pub(super) fn execute_plan(
+fn execute_plan(
     plan: &Plan,
     out: &Path,
     shard: Option<&str>,
@@ -200,39 +198,46 @@ pub(super) fn execute_plan(
     slurm: Option<usize>,
 ) -> Result<(), Failure> {
     if let Some(n) = slurm {
-        if n == 0 {
-            return Err(input(anyhow::anyhow!("--slurm: give the number of shards, at least 1")));
-        }
-        st::runner::prepare(plan, out).map_err(study_failure)?;
-        let exe = std::env::current_exe().map_err(compute)?;
-        let path = st::runner::write_sbatch(out, n, &exe, jobs(jobs_asked)).map_err(study_failure)?;
-        println!("{} cases in {n} shards; submit with: sbatch {}", plan.cases.len(), path.display());
-        return Ok(());
+        return write_slurm(plan, out, n, jobs(jobs_asked));
     }
-    let shard = match shard {
-        Some(s) => Shard::parse(s).map_err(|m| input(anyhow::anyhow!("--shard: {m}")))?,
-        None => Shard::ALL,
-    };
-    run_shard(plan, out, shard, jobs(jobs_asked))
+    run_shard(plan, out, shard_of(shard)?, jobs(jobs_asked))
+}
+
+/// Prepare `out` for `plan` and write its Slurm array of `n` shards of `jobs` threads.
+pub(super) fn write_slurm(plan: &Plan, out: &Path, n: usize, jobs: usize) -> Result<(), Failure> {
+    if n == 0 {
+        return Err(input(anyhow::anyhow!("--slurm: give the number of shards, at least 1")));
+    }
+    st::runner::prepare(plan, out)?;
+    let exe = std::env::current_exe().map_err(compute)?;
+    let path = st::runner::write_sbatch(out, n, &exe, jobs)?;
+    println!("{} cases in {n} shards; submit with: sbatch {}", plan.cases.len(), path.display());
+    Ok(())
 }
 
 fn run_shard(plan: &Plan, out: &Path, shard: Shard, jobs: usize) -> Result<(), Failure> {
     let mine = plan.cases.iter().filter(|c| shard.holds(c.index)).count();
     let bar = super::progress::bar(mine as u64, plan.kind.name());
     let started = std::time::Instant::now();
-    st::runner::prepare(plan, out).map_err(study_failure)?;
-    let summary =
-        st::runner::run(plan, out, shard, jobs, |done, _| bar.set_position(done as u64)).map_err(study_failure)?;
-    let ran = summary.cases - summary.resumed;
+    st::runner::prepare(plan, out)?;
+    let summary = st::runner::run(plan, out, shard, jobs, |done, _| bar.set_position(done as u64))?;
     let seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    let finished = st::finish(out)?;
+    print_run(plan, out, shard, summary, seconds, jobs);
+    report(out, finished)
+}
+
+/// Print what running `shard` of `plan` into `out` did: the cases run, how fast, how many were
+/// there from an earlier run.
+pub(super) fn print_run(plan: &Plan, out: &Path, shard: Shard, summary: RunSummary, seconds: f64, jobs: usize) {
+    let ran = summary.cases - summary.resumed;
     if ran > 0 {
         println!(
             "ran {ran} cases in {seconds:.2} s on {jobs} threads ({:.0} a minute)",
             60.0 * ran as f64 / seconds.max(f64::MIN_POSITIVE)
         );
     }
-    let finished = st::finish(out).map_err(study_failure)?;
     println!(
         "{} {}: {} cases ({} from an earlier run) of ply {} in {}",
         plan.kind.name(),
@@ -242,10 +247,10 @@ fn run_shard(plan: &Plan, out: &Path, shard: Shard, jobs: usize) -> Result<(), F
         plan.ply,
         out.display()
     );
-    report(out, finished)
 }
 
-fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failure> {
+/// Print a study's result (or that it is not complete), its warnings, and draw its charts.
+pub(super) fn report(dir: &Path, finished: Option<(Finished, PathBuf)>) -> Result<(), Failure> {
     let Some((finished, path)) = finished else {
         println!("the study is not complete in {}: run its other shards and merge them", dir.display());
         return Ok(());

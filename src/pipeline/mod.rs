@@ -16,6 +16,16 @@ use crate::io::points::read_points;
 use crate::kinematic::GeneratorKind;
 use std::path::Path;
 
+/// Parse `X,Y,Z` into three finite numbers.
+pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let nums: Result<Vec<f64>, _> = parts.iter().map(|p| p.parse::<f64>()).collect();
+    match nums {
+        Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => Ok([v[0], v[1], v[2]]),
+        _ => Err(format!("'{s}' is not a vector: give three finite numbers separated by commas, like 0,0,1.5")),
+    }
+}
+
 /// Parse a generator choice: `geodesic`, `min-shear`, or `steer:FILE` (FILE relative to `base`).
 pub fn parse_generators(s: &str, base: &Path, scale: f64) -> Result<GeneratorKind, String> {
     match s.trim() {

@@ -31,6 +31,18 @@ pub enum StudyError {
     Write(String),
 }
 
+impl From<StudyError> for crate::pipeline::failure::Failure {
+    /// Bad input is the user's to fix (exit code 2); a file that could not be written is a
+    /// failed run (exit code 1).
+    fn from(e: StudyError) -> Self {
+        use crate::pipeline::failure::{compute, input};
+        match e {
+            StudyError::Input(_) => input(e),
+            StudyError::Write(_) => compute(e),
+        }
+    }
+}
+
 /// A finished study's result.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Finished {

@@ -77,6 +77,11 @@ pub fn finished(dir: &Path, case: &Case) -> Option<CaseRecord> {
     (&rec.case == case).then_some(rec)
 }
 
+/// The cases run at once: `asked`, else the machine's cores.
+pub fn jobs_or_cores(asked: Option<usize>) -> usize {
+    asked.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1)
+}
+
 /// What [`run`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RunSummary {

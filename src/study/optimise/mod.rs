@@ -8,7 +8,9 @@
 //! resuming and Slurm arrays work as for the other studies. When every case is in, [`finish`]
 //! ranks them, refines the best few by a pattern search ([`refine`]) at the ply's own spacing,
 //! and writes `optimise.json` ([`Optimisation`]) and the scene with the optimal ply
-//! ([`scene_file`]); the landscape pictures are drawn by `crate::report::optimise`.
+//! ([`scene_file`]); the landscape pictures are drawn by `crate::report::optimise`. [`optimise`]
+//! ([`run`]) does all of it from the options as the user gives them, for the command line and
+//! the Python package.
 //!
 //! The ply is draped alone on the tool (a ply higher in the stack is searched on the tool, not
 //! on the plies below it), kinematically with its own generators, as `drape run` drapes it
@@ -18,12 +20,14 @@ pub mod finish;
 pub mod objective;
 pub mod refine;
 pub mod region;
+pub mod run;
 pub mod scene_file;
 
 pub use candidates::{plan, Options};
 pub use finish::finish;
 pub use objective::{Measure, Objective};
 pub use region::{Frame, SeedRegion};
+pub use run::{optimise, Optimised, PolygonArg, Request};
 
 use super::case::CaseStats;
 use serde::{Deserialize, Serialize};
