@@ -5,7 +5,6 @@
 use assert_cmd::Command;
 use drape::kinematic::fabric_field::ShearField;
 use drape::study::speed_accuracy::{ReferenceKind, SpeedAccuracy};
-use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 fn drape() -> Command {
@@ -16,9 +15,7 @@ fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
-fn read_json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
+use crate::common::read_json;
 
 /// `drape study speed-accuracy` on `scene` into `out` (one repeat, one job) at the kinematic
 /// `spacings` and `mechanical` spacings: its stdout and `speed_accuracy.json`.

@@ -15,7 +15,6 @@ use drape::layup::flat::{
     flat_pattern, flat_pattern_smooth, ply_pattern, shoelace_area, with_margin, CutLine, CutWarning, FlatPattern,
 };
 use drape::layup::nest::{nest, Rotation};
-use serde_json::Value;
 use std::f64::consts::PI;
 
 /// Points sampled on each edge of the loops of a pattern (ends and `k - 1` between).
@@ -213,9 +212,7 @@ fn smooth_cut_through_the_boundary_nodes_follows_the_disc_closer_than_the_chords
     assert_eq!(layer["lines"].as_u64().unwrap_or(0) + layer["texts"].as_u64().unwrap_or(0), 0);
 }
 
-fn read_json(p: &std::path::Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
-}
+use crate::common::read_json;
 
 /// A ply whose outline the net does not reach (its nodes stop at a shear limit before the rim)
 /// is cut along the smooth curve through its boundary nodes, and the run says so: on its output,

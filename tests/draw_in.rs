@@ -3,9 +3,7 @@ use drape::geometry::shapes;
 use drape::kinematic::provenance::{DrawIn, DrawInLine};
 use std::path::Path;
 
-fn read_json(p: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
+use crate::common::read_json;
 
 /// Run `scene` (TOML text, the tool written beside it as `tool.obj`) and return the first ply's
 /// draw-in from layup.json, the same from its net, and the CLI's output.

@@ -3,9 +3,7 @@ use drape::geometry::{shapes, TriangleMesh};
 use drape::kinematic::provenance::DrawIn;
 use std::path::Path;
 
-fn read_json(p: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
+use crate::common::read_json;
 
 /// Write the tools and `scene` into `dir` and run it: the CLI's output, layup.json's first row
 /// and that ply's net JSON.

@@ -13,9 +13,7 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn read_json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
-}
+use crate::common::read_json;
 
 /// Thickness of the glass card the hemisphere scene uses, m.
 const GLASS_T: f64 = 5.5e-4;

@@ -219,9 +219,7 @@ fn drape_run(scene: &Path, out: &Path) -> assert_cmd::assert::Assert {
     assert_cmd::Command::cargo_bin("drape").unwrap().arg("run").arg(scene).arg("--out").arg(out).assert()
 }
 
-fn read_json(p: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
+use crate::common::read_json;
 
 /// On a developable tool the kinematic net is exact; with friction the pressed ply stays on it
 /// (within 0.5 deg of shear) and `method = "auto"` keeps it. Frictionless and held by nothing,

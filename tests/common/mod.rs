@@ -28,3 +28,8 @@ pub fn run_scene(
         .success();
     (out, String::from_utf8_lossy(&run.get_output().stdout).to_string())
 }
+
+/// A JSON file the run wrote (a panic naming the file when it is missing or not JSON).
+pub fn read_json(p: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
+}
