@@ -15,7 +15,7 @@
 //! the fabric ([`Binder::bearing`]). Drawn in past the opening's edge it is let go.
 use super::contact::{ContactSurface, Foot};
 use super::friction::Bearing;
-use super::sheet::{point_in_polygon, polygon_area};
+use super::sheet::{point_in_polygon, polygon_round, PolygonFault};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use std::sync::Arc;
 
@@ -110,15 +110,21 @@ impl Forming {
             )));
         }
         if let Some(b) = &self.binder {
-            if b.outline.len() < 3 || b.outline.iter().flatten().any(|x| !x.is_finite()) {
-                return Err(binder_error(
-                    "the binder's outline needs three or more corners [x, y] of finite numbers".into(),
-                ));
-            }
-            if !(polygon_area(&b.outline) > 0.0) {
-                return Err(binder_error(
-                    "the binder's outline encloses no area: give its corners in order round the opening".into(),
-                ));
+            let c = PlanView::across(&self.stroke).at(origin);
+            // The outline's own faults first, then the pressure, then where the blank lies.
+            let fault = polygon_round(&b.outline, (c[0], c[1])).err();
+            match fault {
+                Some(PolygonFault::TooFew | PolygonFault::NonFinite) => {
+                    return Err(binder_error(
+                        "the binder's outline needs three or more corners [x, y] of finite numbers".into(),
+                    ))
+                }
+                Some(PolygonFault::NoArea) => {
+                    return Err(binder_error(
+                        "the binder's outline encloses no area: give its corners in order round the opening".into(),
+                    ))
+                }
+                _ => {}
             }
             if !(b.pressure.is_finite() && b.pressure >= 0.0) {
                 return Err(binder_error(format!(
@@ -126,8 +132,7 @@ impl Forming {
                     b.pressure
                 )));
             }
-            let c = PlanView::across(&self.stroke).at(origin);
-            if !point_in_polygon((c[0], c[1]), &b.outline) {
+            if fault == Some(PolygonFault::Outside) {
                 return Err(binder_error(format!(
                     "the blank's centre (the ply's origin, at [{:.4}, {:.4}] m in plan) lies under the binder, outside its opening: give the opening's outline round the punch",
                     c[0], c[1]

@@ -544,6 +544,8 @@ fn refine_among<L: Laws + ?Sized>(
     });
     let die: Option<&dyn ContactSurface> = forming.and_then(|f| f.die.as_deref()).map(|d| d as &dyn ContactSurface);
     let plan_view = forming.map(|f| PlanView::across(&f.stroke));
+    // The nodes that may move at all (the binder grips only these).
+    let body: Vec<bool> = freedom.iter().map(|f| f.dofs() > 0).collect();
     let mut steps = Vec::new();
     let mut increments = Vec::new();
     let mut objective = NetObjective::new(grid, laws, settings.gravity / load_steps as f64);
@@ -585,7 +587,6 @@ fn refine_among<L: Laws + ?Sized>(
         let binder = forming.and_then(|f| f.binder.as_ref());
         let gripped = match (binder, plan_view, blank_plane) {
             (Some(b), Some(view), Some((point, normal))) => {
-                let body: Vec<bool> = (0..x.len()).map(|k| active[k] && !held[k]).collect();
                 b.gripped(&view, &x, &body, &point, &normal, kinematic.spacing)
             }
             _ => vec![false; x.len()],

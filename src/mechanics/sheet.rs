@@ -106,30 +106,54 @@ pub struct SheetFeatures {
 pub const BLANK_SLIVER: f64 = 1e-6;
 
 /// The area of the polygon `p` (either orientation), m^2.
-pub(crate) fn polygon_area(p: &[[f64; 2]]) -> f64 {
+fn polygon_area(p: &[[f64; 2]]) -> f64 {
     let n = p.len();
     0.5 * (0..n).map(|k| p[k][0] * p[(k + 1) % n][1] - p[(k + 1) % n][0] * p[k][1]).sum::<f64>().abs()
+}
+
+/// What is wrong with a polygon that must enclose an area round a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PolygonFault {
+    /// Fewer than three corners.
+    TooFew,
+    /// A corner that is not a finite number.
+    NonFinite,
+    /// Its corners enclose no area.
+    NoArea,
+    /// The point lies outside it.
+    Outside,
+}
+
+/// Check a polygon that must enclose an area with `inside` in it: its area, m^2, or what is wrong
+/// (the caller words it for its field).
+pub(crate) fn polygon_round(p: &[[f64; 2]], inside: (f64, f64)) -> Result<f64, PolygonFault> {
+    if p.len() < 3 {
+        return Err(PolygonFault::TooFew);
+    }
+    if p.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(PolygonFault::NonFinite);
+    }
+    let area = polygon_area(p);
+    if !(area > 0.0) {
+        return Err(PolygonFault::NoArea);
+    }
+    if !point_in_polygon(inside, p) {
+        return Err(PolygonFault::Outside);
+    }
+    Ok(area)
 }
 
 /// Check a blank outline: three points or more, finite, enclosing an area, with the origin node
 /// (0, 0) inside. Its area, m^2.
 pub fn check_blank(blank: &[[f64; 2]]) -> Result<f64, SheetError> {
-    if blank.len() < 3 {
-        return Err(SheetError(format!("a blank needs at least three corners (u, v), got {}", blank.len())));
-    }
-    if blank.iter().flatten().any(|x| !x.is_finite()) {
-        return Err(SheetError("the blank's corners must be finite numbers".into()));
-    }
-    let area = polygon_area(blank);
-    if !(area > 0.0) {
-        return Err(SheetError("the blank encloses no area: give its corners in order round it".into()));
-    }
-    if !point_in_polygon((0.0, 0.0), blank) {
-        return Err(SheetError(
-            "the blank must contain the origin node (0, 0): give its corners in fabric coordinates from the origin node".into(),
-        ));
-    }
-    Ok(area)
+    polygon_round(blank, (0.0, 0.0)).map_err(|fault| {
+        SheetError(match fault {
+            PolygonFault::TooFew => format!("a blank needs at least three corners (u, v), got {}", blank.len()),
+            PolygonFault::NonFinite => "the blank's corners must be finite numbers".into(),
+            PolygonFault::NoArea => "the blank encloses no area: give its corners in order round it".into(),
+            PolygonFault::Outside => "the blank must contain the origin node (0, 0): give its corners in fabric coordinates from the origin node".into(),
+        })
+    })
 }
 
 /// Whether `q` lies inside the polygon `p` (even-odd rule).
