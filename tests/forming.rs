@@ -189,3 +189,119 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
     };
     assert!(most(true) > 2.0 * most(false), "{draw_in:?}");
 }
+
+/// The binder's opening round a double dome's body: a stadium `clearance` outside its foot, in
+/// `segments` straight pieces per rounded end, as the scene's `outline` value.
+fn stadium_opening(p: &shapes::DoubleDome, clearance: f64, segments: usize) -> String {
+    let r = p.body_width / 2.0 + clearance;
+    let a = p.body_length / 2.0 - p.body_width / 2.0;
+    let mut corners = Vec::new();
+    for (centre, start) in [(a, -std::f64::consts::FRAC_PI_2), (-a, std::f64::consts::FRAC_PI_2)] {
+        for k in 0..=segments {
+            let t = start + std::f64::consts::PI * k as f64 / segments as f64;
+            corners.push(format!("[{:.6}, {:.6}]", centre + r * t.cos(), r * t.sin()));
+        }
+    }
+    format!("[{}]", corners.join(", "))
+}
+
+/// The +/-45 plies of a double dome (not the bundled one: other proportions) formed from flat
+/// blanks cut square to the part, the part rising through a binder's opening: each converges
+/// to a minimum with its whole blank present, none of it inside the part, the blank under the
+/// binder still in its plane; each is symmetric under the half turn about the part's axis, and
+/// the -45 ply is the +45 ply's mirror image (the set-up's mirror maps one onto the other).
+#[test]
+fn a_double_domes_plus_minus_45_plies_formed_with_a_binder_mirror_each_other() {
+    // Mirror and half-turn images agree to this share of the spacing: the tool, the blank and
+    // the binder are symmetric, so image nodes see the same arithmetic up to rounding.
+    const IMAGE_SPACINGS: f64 = 1e-6;
+    // The nodes meet the part's smooth surface, within this of its height field (the facets'
+    // sagitta on the fillets; the smooth surface lies between them and the exact part).
+    const SURFACE_TOLERANCE: f64 = 2e-4;
+    let dome = shapes::DoubleDome {
+        flange_length: 0.3,
+        flange_width: 0.24,
+        body_length: 0.17,
+        body_width: 0.09,
+        height: 0.035,
+        wall_angle: 60f64.to_radians(),
+        base_fillet: 0.01,
+        top_fillet: 0.012,
+    };
+    let tool = shapes::double_dome(&dome, 36);
+    let (spacing, n) = (0.01, 37);
+    // The blank: 0.26 x 0.2 m square to the part, in each ply's fabric coordinates.
+    let (hx, hy) = (0.13, 0.1);
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let corners = [(hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy)];
+    let blank = |angle: f64| {
+        let c: Vec<String> = corners
+            .iter()
+            .map(|&(x, y)| {
+                // u along the warp (x turned by the angle), v along the weft (90 deg further).
+                let (u, v) = if angle > 0.0 { ((x + y) * s, (y - x) * s) } else { ((x - y) * s, (x + y) * s) };
+                format!("[{u:.6}, {v:.6}]")
+            })
+            .collect();
+        format!("[{}]", c.join(", "))
+    };
+    let opening = stadium_opening(&dome, 0.015, 8);
+    let form = |angle: f64| {
+        let tmp = tempfile::tempdir().unwrap();
+        let scene = format!(
+            "units = \"m\"\ntool = \"part.obj\"\nreference = [1.0, 0.0, 0.0]\nfriction = 0.2\n\
+             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {h}]\nangle_deg = {angle}\n\
+             material = \"{card}\"\nspacing = {spacing}\ngrid = [{n}, {n}]\nmethod = \"mechanical\"\n\
+             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {h}]\nblank = {b}\nmax_iterations = 2000\n\
+             [ply.binder]\npressure = 2.0e4\noutline = {opening}\n",
+            h = dome.height,
+            b = blank(angle),
+            card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/carbon-twill.toml").display()
+        );
+        let (stdout, _, net) = run(tmp.path(), &[("part.obj", &tool)], &scene);
+        assert_eq!(net["meta"]["solver"]["converged"], true, "{angle} deg: {stdout}");
+        assert_eq!(net["meta"]["solver"]["stability"], "minimum", "{angle} deg: {stdout}");
+        // The whole blank is formed: every node of the grid is placed or cut away by the blank.
+        let status = &net["status"];
+        let cut = status["failed"]["outside_outline"].as_u64().unwrap_or(0);
+        assert_eq!(status["placed"].as_u64().unwrap() + cut, (n * n) as u64, "{status}");
+        let x: Vec<Option<[f64; 3]>> = net["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p.as_array().map(|p| [0, 1, 2].map(|c| p[c].as_f64().unwrap())))
+            .collect();
+        for p in x.iter().flatten() {
+            let below = dome.height_at(p[0], p[1]) - p[2];
+            assert!(below < SURFACE_TOLERANCE, "{angle} deg: node {p:?} is inside the part by {below} m");
+            // The binder holds the blank in its plane outside the opening (z = 0 at the end).
+            if dome.outline_distance(p[0], p[1]) > 0.015 + spacing {
+                assert!(p[2].abs() < 1e-9, "{angle} deg: node {p:?} left the binder's plane");
+            }
+        }
+        (x, stdout)
+    };
+    let (plus, out_plus) = form(45.0);
+    let (minus, out_minus) = form(-45.0);
+    let at = |x: &[Option<[f64; 3]>], i: usize, j: usize| x[i * n + j];
+    let distance =
+        |p: [f64; 3], q: [f64; 3]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+    let (mut half_turn, mut mirror): (f64, f64) = (0.0, 0.0);
+    for i in 0..n {
+        for j in 0..n {
+            // The half turn about z maps the +45 ply onto itself: (u, v) -> (-u, -v).
+            match (at(&plus, i, j), at(&plus, n - 1 - i, n - 1 - j)) {
+                (Some(p), Some(q)) => half_turn = half_turn.max(distance([-p[0], -p[1], p[2]], q)),
+                (p, q) => assert_eq!(p.is_some(), q.is_some(), "node ({i}, {j}) and its half-turn image"),
+            }
+            // The mirror y -> -y maps the +45 ply's warp onto the -45 ply's and its weft onto
+            // the -45 ply's weft reversed: (u, v) -> (u, -v).
+            match (at(&plus, i, j), at(&minus, i, n - 1 - j)) {
+                (Some(p), Some(q)) => mirror = mirror.max(distance([p[0], -p[1], p[2]], q)),
+                (p, q) => assert_eq!(p.is_some(), q.is_some(), "node ({i}, {j}) and its mirror image"),
+            }
+        }
+    }
+    assert!(half_turn < IMAGE_SPACINGS * spacing, "half-turn images differ by {half_turn} m\n{out_plus}");
+    assert!(mirror < IMAGE_SPACINGS * spacing, "mirror images differ by {mirror} m\n{out_plus}\n{out_minus}");
+}
