@@ -188,6 +188,24 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
         draw_in.edges.iter().filter(|e| e.line.is_fibre() == fibre).map(|e| e.draw_in_m).fold(0.0, f64::max)
     };
     assert!(most(true) > 2.0 * most(false), "{draw_in:?}");
+    // The net records how it was formed, and the report says so and draws the binder's opening
+    // beside the draw-in.
+    let formed = &net["meta"]["forming"];
+    assert_eq!(formed["stroke_m"], serde_json::json!([0.0, 0.0, stroke]), "{formed}");
+    assert_eq!(formed["increments"], net["meta"]["solver"]["increments"].as_array().unwrap().len(), "{formed}");
+    assert_eq!(formed["die"], false);
+    assert_eq!(formed["binder"]["pressure_pa"], 1.0e4);
+    assert_eq!(formed["binder"]["outline_m"].as_array().unwrap().len(), 24);
+    let out = tmp.path().join("out");
+    assert_cmd::Command::cargo_bin("drape").unwrap().arg("report").arg(&out).assert().success();
+    let page = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    assert!(page.contains("stroke (0.0, 0.0, 35.0) mm in"), "the report does not say how the ply was formed");
+    assert!(page.contains("binder at 10.0 kPa"), "the report does not name the binder");
+    let svg = std::fs::read_to_string(out.join("report/p-draw-in.svg")).unwrap();
+    assert!(
+        svg.contains("the binder&apos;s opening") || svg.contains("the binder's opening"),
+        "no binder in the draw-in picture"
+    );
 }
 
 /// The binder's opening round a double dome's body: a stadium `clearance` outside its foot, in

@@ -68,6 +68,10 @@ pub struct Provenance {
     /// ([`super::wrinkle`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wrinkles: Option<WrinkleRecord>,
+    /// For a blank formed by tools in motion: the stroke, the die and the binder it was formed
+    /// with.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub forming: Option<FormingRecord>,
     /// Keys other tools wrote, kept on a round trip.
     #[serde(flatten)]
     pub other: Map<String, Value>,
@@ -486,6 +490,33 @@ pub struct EdgeDrawIn {
     pub plan_m: f64,
     /// `flat_m - plan_m`, m: how far the edge moved in towards the seed (negative: out).
     pub draw_in_m: f64,
+}
+
+/// How a blank was formed (`meta.forming` in the net's JSON): what the report draws the draw-in
+/// against.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FormingRecord {
+    /// The punch's travel over the whole process, m.
+    pub stroke_m: [f64; 3],
+    /// The increments the stroke was taken in.
+    pub increments: usize,
+    /// Whether a die stood opposite the punch.
+    pub die: bool,
+    /// The axes of the plan across the stroke that the binder's outline is given in (unit
+    /// vectors).
+    pub plan_axes: [[f64; 3]; 2],
+    /// The binder, if one held the blank.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub binder: Option<BinderRecord>,
+}
+
+/// A binder as the blank was formed with it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BinderRecord {
+    /// Its opening's inner boundary in the plan across the stroke, m.
+    pub outline_m: Vec<[f64; 2]>,
+    /// Its clamping pressure, Pa.
+    pub pressure_pa: f64,
 }
 
 /// A ply's draw-in (`meta.draw_in` in the net's JSON; its largest in the layup table).

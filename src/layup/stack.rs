@@ -346,6 +346,10 @@ pub fn drape_layup(
         };
         net.meta.draw_in = plan.and_then(|(n, from)| crate::kinematic::draw_in::draw_in(&net, &n, from));
         net.meta.wrinkles = layup.wrinkles.then(|| ply.wrinkles(&net, surface));
+        net.meta.forming = match (ply.refinement.as_ref().and_then(|r| r.forming.as_ref()), &refined) {
+            (Some(f), Some(r)) => Some(f.record(r.increments.len())),
+            _ => None,
+        };
         // What later stages (exports, reports) need to know about the ply.
         net.meta.stack_offset_max_m = Some(offset.max_distance);
         net.meta.angle_deg = ply.angle_deg();

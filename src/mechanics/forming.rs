@@ -17,6 +17,7 @@ use super::contact::{ContactSurface, Foot};
 use super::friction::Bearing;
 use super::sheet::{point_in_polygon, polygon_round, PolygonFault};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
+use crate::kinematic::provenance::{BinderRecord, FormingRecord};
 use std::sync::Arc;
 
 /// The punch moves at most this many spacings per increment: the solver's contact search
@@ -93,6 +94,11 @@ impl PlanView {
         PlanView { axes: [e1, e2] }
     }
 
+    /// The plan's two axes (unit vectors normal to the stroke).
+    pub fn axes(&self) -> [Vector; 2] {
+        self.axes
+    }
+
     /// Where `p` appears in plan.
     pub fn at(&self, p: &Point) -> [f64; 2] {
         [self.axes[0].dot(&p.coords), self.axes[1].dot(&p.coords)]
@@ -140,6 +146,21 @@ impl Forming {
             }
         }
         Ok(())
+    }
+
+    /// What the net records of the process, formed in `increments` increments.
+    pub fn record(&self, increments: usize) -> FormingRecord {
+        let axes = PlanView::across(&self.stroke).axes().map(|a| [a.x, a.y, a.z]);
+        FormingRecord {
+            stroke_m: [self.stroke.x, self.stroke.y, self.stroke.z],
+            increments,
+            die: self.die.is_some(),
+            plan_axes: axes,
+            binder: self
+                .binder
+                .as_ref()
+                .map(|b| BinderRecord { outline_m: b.outline.clone(), pressure_pa: b.pressure }),
+        }
     }
 
     /// Increments for a stroke at `spacing`: enough that the punch moves at most

@@ -1,7 +1,7 @@
 //! The draw-in picture (`<ply>-draw-in.png/.svg`): the blank as cut, flat, and the ply as
 //! draped, both seen in the plan its draw-in is measured in ([`crate::kinematic::draw_in`]),
 //! every k-th fibre of each, with the edge points of the fibre and diagonal lines through the
-//! seed and how far each moved in.
+//! seed and how far each moved in; for a blank formed with a binder, the binder's opening.
 use super::render::{de, DrawResult, FONT};
 use crate::geometry::Vector;
 use crate::kinematic::draw_in::origin_tangents;
@@ -15,6 +15,7 @@ const FIBRES_DRAWN: usize = 24;
 const FLAT_COLOUR: RGBColor = RGBColor(175, 175, 175);
 const DRAPED_COLOUR: RGBColor = RGBColor(49, 130, 189);
 const EDGE_COLOUR: RGBColor = RGBColor(215, 48, 39);
+const BINDER_COLOUR: RGBColor = RGBColor(35, 139, 69);
 
 /// The plan's axes: the warp at the seed in plan, and the normal across it turned so the weft at
 /// the seed points along the second. None where the net has no fibres through its origin node.
@@ -46,6 +47,23 @@ pub fn draw_plan<DB: DrawingBackend>(
         let v = net.positions[net.index(i, j)] - o;
         (v.dot(&e1) * 1e3, v.dot(&e2) * 1e3)
     };
+    // The binder's opening (given in the plan across the stroke), seen in this plan.
+    let opening: Option<Vec<(f64, f64)>> = net.meta.forming.as_ref().and_then(|f| {
+        let [a0, a1] = f.plan_axes.map(Vector::from);
+        let (o0, o1) = (a0.dot(&o.coords), a1.dot(&o.coords));
+        f.binder.as_ref().map(|b| {
+            let mut ring: Vec<(f64, f64)> = b
+                .outline_m
+                .iter()
+                .map(|q| {
+                    let r = a0 * (q[0] - o0) + a1 * (q[1] - o1);
+                    (r.dot(&e1) * 1e3, r.dot(&e2) * 1e3)
+                })
+                .collect();
+            ring.extend(ring.first().copied());
+            ring
+        })
+    });
     let mut lo = (f64::INFINITY, f64::INFINITY);
     let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
     for i in 0..net.nu {
@@ -58,7 +76,12 @@ pub fn draw_plan<DB: DrawingBackend>(
             }
         }
     }
-    let title = format!("Ply {stem}: draw-in, the blank flat (grey) and draped (blue) in plan");
+    for &(x, y) in opening.iter().flatten() {
+        lo = (lo.0.min(x), lo.1.min(y));
+        hi = (hi.0.max(x), hi.1.max(y));
+    }
+    let binder = if opening.is_some() { ", the binder's opening (green)" } else { "" };
+    let title = format!("Ply {stem}: draw-in, the blank flat (grey) and draped (blue) in plan{binder}");
     let root = root.titled(&title, (FONT, 22)).map_err(de)?;
     let (w, h) = root.dim_in_pixel();
     // Equal scales on both axes: widen the narrower range to the picture's proportions.
@@ -117,6 +140,9 @@ pub fn draw_plan<DB: DrawingBackend>(
     }
     for line in fibres(&draped) {
         chart.draw_series(LineSeries::new(line, DRAPED_COLOUR.stroke_width(1))).map_err(de)?;
+    }
+    if let Some(ring) = opening {
+        chart.draw_series(LineSeries::new(ring, BINDER_COLOUR.stroke_width(2))).map_err(de)?;
     }
     for e in &d.edges {
         let [i, j] = e.node;

@@ -70,6 +70,23 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
             None => {}
         }
     }
+    if let Some(fm) = &m.forming {
+        let stroke = fm.stroke_m;
+        let mut process = format!(
+            "stroke ({:.1}, {:.1}, {:.1}) mm in {} increments",
+            stroke[0] * 1e3,
+            stroke[1] * 1e3,
+            stroke[2] * 1e3,
+            fm.increments
+        );
+        if fm.die {
+            process += ", with a die";
+        }
+        if let Some(b) = &fm.binder {
+            process += &format!(", binder at {:.1} kPa outside its opening", b.pressure_pa * 1e-3);
+        }
+        f.push(("formed".to_string(), process));
+    }
     if let Some(c) = &m.change_from_kinematic {
         let max = c
             .warp_angle_deg
