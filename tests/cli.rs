@@ -267,6 +267,8 @@ fn refine_and_cantilever_from_the_command_line() {
             "0",
             "--hold",
             "10,10",
+            "--format",
+            "json,csv",
             "--out",
             mech.to_str().unwrap(),
         ])
@@ -275,6 +277,22 @@ fn refine_and_cantilever_from_the_command_line() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(mech.join("k.drape.json")).unwrap()).unwrap();
     assert_eq!(json["method"], "mechanical");
+    // Both nets record their wrinkles, measured where their nodes are: none on a plate. The
+    // refined one has the card's bending energy, and its cell CSV carries them all.
+    let kinematic: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&net).unwrap()).unwrap();
+    for n in [&kinematic, &json] {
+        assert_eq!(n["meta"]["wrinkles"]["wrinkled_area_m2"], 0.0, "{}", n["meta"]["wrinkles"]);
+        assert_eq!(n["meta"]["wrinkles"]["waviness_m"].as_array().unwrap().len(), 20 * 20);
+    }
+    assert_eq!(json["meta"]["wrinkles"]["threshold_from"], "thickness");
+    assert_eq!(json["meta"]["wrinkles"]["bending_energy_density_j_m2"].as_array().unwrap().len(), 20 * 20);
+    let csv = std::fs::read_to_string(mech.join("k.cells.csv")).unwrap();
+    assert_eq!(
+        csv.lines().next().unwrap(),
+        format!("{},{},bending_energy_density_j_m2", drape::io::CSV_HEADER, drape::io::csv::CSV_WRINKLE_COLUMNS)
+    );
+    assert_eq!(csv.lines().count(), 1 + 20 * 20);
+    assert!(csv.lines().skip(1).all(|l| l.split(',').nth(16) == Some("0")), "a plate's cells are not wrinkled");
     // A 20 deg pre-sheared net pressed frictionless on a plate, held at its seed only (as the
     // user asked), relaxes to no shear.
     let shear: Vec<f64> = json["cell_shear_deg"].as_array().unwrap().iter().filter_map(|g| g.as_f64()).collect();

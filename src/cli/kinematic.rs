@@ -116,6 +116,9 @@ pub fn run(a: KinematicArgs) -> Result<(), Failure> {
         None => net.shear_stats(locking),
     };
     println!("{}", summary_with(&net, &stats, locking, load_ms, write_ms));
+    if let Some(line) = super::summary::wrinkles_line(&net.name, &net) {
+        println!("{line}");
+    }
     for p in written {
         println!("  wrote {}", p.display());
     }

@@ -116,6 +116,9 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         summary(&out, DEFAULT_LOCKING_ANGLE_DEG.to_radians(), load_ms, t_write.elapsed().as_secs_f64() * 1e3)
     );
     print_solver(&refined);
+    if let Some(line) = super::summary::wrinkles_line(&out.name, &out) {
+        println!("{line}");
+    }
     for p in written {
         println!("  wrote {}", p.display());
     }

@@ -198,8 +198,9 @@ fn layup_table(scene: &Scene, results: &[PlyResult]) -> String {
         );
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {
-        if let Some(w) = &r.net.meta.wrinkles {
-            out += &format!("wrinkles: ply '{}': {}\n", ply.settings.name, w.summary.describe());
+        if let Some(line) = super::summary::wrinkles_line(&ply.settings.name, &r.net) {
+            out += &line;
+            out.push('\n');
         }
     }
     for (ply, r) in scene.layup.plies.iter().zip(results) {

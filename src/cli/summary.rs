@@ -40,3 +40,8 @@ pub fn summary_with(net: &DrapeNet, stats: &ShearStats, locking_angle: f64, load
     };
     out
 }
+
+/// The `wrinkles:` line of a ply named `name` whose net records its wrinkles.
+pub fn wrinkles_line(name: &str, net: &DrapeNet) -> Option<String> {
+    net.meta.wrinkles.as_ref().map(|w| format!("wrinkles: ply '{name}': {}", w.summary.describe()))
+}

@@ -1,7 +1,8 @@
 //! CSV files: the cells of a draped net and the fibres of a layup on a flow mesh.
 //!
 //! `<ply>.cells.csv`: one row per complete cell (all four corners placed), in cell order, with its
-//! centre, shear (degrees) and unit fibre frame. Floats are written with `{:?}` (shortest exact round trip, exponent when needed).
+//! centre, shear (degrees) and unit fibre frame, and for a net that records its wrinkles their
+//! measures ([`CSV_WRINKLE_COLUMNS`]). Floats are written with `{:?}` (shortest exact round trip, exponent when needed).
 //!
 //! The flow CSV (`drape export --format csv`, `flow.csv`): one row per element and ply (elements in mesh order, plies in stacking order).
 //!
@@ -16,9 +17,13 @@ use crate::kinematic::DrapeNet;
 use crate::mapping::{FlowMesh, LayupMap};
 use std::io::{self, Write};
 use std::path::Path;
-/// The header line of the cell CSV.
+/// The header line of the cell CSV (its first columns, all a net without wrinkles has).
 pub const CSV_HEADER: &str =
     "i,j,cx,cy,cz,shear_deg,warp_x,warp_y,warp_z,weft_x,weft_y,weft_z,normal_x,normal_y,normal_z";
+/// The columns after [`CSV_HEADER`] of a net that records its wrinkles (`meta.wrinkles`):
+/// waviness (m), wrinkled (1 where the waviness exceeds the record's threshold, else 0) and the
+/// tool gap (m); then `bending_energy_density_j_m2` when the record has it.
+pub const CSV_WRINKLE_COLUMNS: &str = "waviness_m,wrinkled,tool_gap_m";
 
 /// Write the complete cells of `net` to `path` (normally `DIR/<ply>.cells.csv`) atomically.
 /// Fails, writing nothing, if a value would not be finite or a complete cell is degenerate.
@@ -28,13 +33,34 @@ pub fn write_csv(net: &DrapeNet, path: &Path) -> Result<(), ExportError> {
 }
 
 fn write_csv_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
-    writeln!(w, "{CSV_HEADER}")?;
+    let wrinkles = net.meta.wrinkles.as_ref();
+    let bending = wrinkles.is_some_and(|wr| !wr.bending_energy_density_j_m2.is_empty());
+    let mut header = CSV_HEADER.to_string();
+    if wrinkles.is_some() {
+        header += &format!(",{CSV_WRINKLE_COLUMNS}");
+    }
+    if bending {
+        header += ",bending_energy_density_j_m2";
+    }
+    writeln!(w, "{header}")?;
+    let cv = net.nv.saturating_sub(1);
     for (i, j) in cells(net) {
         let (Some(g), Some(f)) = (net.cell_shear(i, j), net.cell_frame(i, j)) else { continue };
         let (c, a, b, n) = (f.centre, f.warp, f.weft, f.normal);
+        // The net check made sure every complete cell has each measure the record holds.
+        let mut extra = String::new();
+        if let Some(wr) = wrinkles {
+            let at = |list: &[Option<f64>]| list[i * cv + j].expect("checked: complete cell");
+            let waviness = at(&wr.waviness_m);
+            let wrinkled = (waviness > wr.summary.threshold_m) as u8;
+            extra += &format!(",{waviness:?},{wrinkled},{:?}", at(&wr.tool_gap_m));
+            if bending {
+                extra += &format!(",{:?}", at(&wr.bending_energy_density_j_m2));
+            }
+        }
         writeln!(
             w,
-            "{i},{j},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
+            "{i},{j},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}{extra}",
             c.x,
             c.y,
             c.z,

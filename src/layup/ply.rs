@@ -117,15 +117,26 @@ impl Ply {
     /// ply's thickness, and with a card ([`Ply::card`]) the bending energy density of its
     /// bending term ([`bending_energy_density`], with the sheet's features the refinement used).
     pub fn wrinkles(&self, net: &DrapeNet, surface: &ToolSurface) -> WrinkleRecord {
-        let sheet = self.refinement.as_ref().map(|r| &r.sheet);
-        // The sheet's features were laid out on this grid by the refinement; if they no longer
-        // fit, its bending is measured without them.
-        let bending = self.card().map(|card| {
-            bending_energy_density(net, card, sheet)
-                .unwrap_or_else(|_| bending_energy_density(net, card, None).expect("no sheet features: nothing to fit"))
-        });
-        wrinkle::measure(net, surface, self.thickness, bending)
+        wrinkles_of(net, surface, self.thickness, self.card(), self.refinement.as_ref().map(|r| &r.sheet))
     }
+}
+
+/// The wrinkles of `net` draped on `surface`: waviness and tool gap per cell
+/// ([`crate::kinematic::wrinkle`]) against `thickness` (m), and with a `card` the bending energy
+/// density of its bending term ([`bending_energy_density`], with the `sheet`'s features where
+/// they still fit the grid, else without them).
+pub fn wrinkles_of(
+    net: &DrapeNet,
+    surface: &ToolSurface,
+    thickness: Option<f64>,
+    card: Option<&MaterialCard>,
+    sheet: Option<&SheetFeatures>,
+) -> WrinkleRecord {
+    let bending = card.map(|card| {
+        bending_energy_density(net, card, sheet)
+            .unwrap_or_else(|_| bending_energy_density(net, card, None).expect("no sheet features: nothing to fit"))
+    });
+    wrinkle::measure(net, surface, thickness, bending)
 }
 
 /// Solver iterations per load step of a mechanical ply when the scene gives none.

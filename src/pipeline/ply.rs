@@ -9,6 +9,7 @@ use crate::io::points::read_points;
 use crate::kinematic::fishnet::check_settings;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, SurfaceKind, DEFAULT_MAX_SHEAR_DEG};
 use crate::layup::auto::{drape_auto, DEFAULT_TOLERANCE_DEG};
+use crate::layup::ply::wrinkles_of;
 use crate::layup::{locking_angle_deg, AutoModel, Refinement};
 use crate::material::MaterialCard;
 use std::path::{Path, PathBuf};
@@ -153,7 +154,8 @@ impl PlyOptions {
 
 impl PreparedPly {
     /// Drape the ply on `tool` (read at [`PreparedPly::scale`]): the kinematic net, or with
-    /// `auto` the model it chose, its choice in `meta.method_choice`.
+    /// `auto` the model it chose, its choice in `meta.method_choice`; its wrinkles in
+    /// `meta.wrinkles`.
     pub fn drape(&self, tool: &ToolSurface) -> Result<DrapeNet, Failure> {
         match &self.auto {
             None => drape(tool, &self.settings).map_err(input),
@@ -165,6 +167,11 @@ impl PreparedPly {
                 Ok(net)
             }
         }
+        .map(|mut net| {
+            let card = self.card.as_ref();
+            net.meta.wrinkles = Some(wrinkles_of(&net, tool, card.map(|c| c.thickness), card, None));
+            net
+        })
     }
 
     /// The warning that the ply shears past the range its card's law was calibrated to, given

@@ -125,8 +125,15 @@ pub fn refine_net(
     let solve_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut out = refined.net.clone();
     annotate(&mut out, net, &refined, material_path);
-    // Wrinkles the net recorded were measured on its nodes before they moved.
-    out.meta.wrinkles = None;
+    // Wrinkles the net recorded were measured on its nodes before they moved: again, where
+    // they are now.
+    out.meta.wrinkles = Some(crate::layup::ply::wrinkles_of(
+        &out,
+        tool,
+        Some(material.thickness),
+        Some(material),
+        Some(&settings.sheet),
+    ));
     out.timing.generators_ms = 0.0;
     out.timing.fill_ms = solve_ms;
     out.timing.total_ms = solve_ms;
