@@ -621,6 +621,20 @@ mod tests {
     }
 
     #[test]
+    fn a_foot_on_a_facet_the_plies_below_cover_meets_them_and_a_die_facet_the_tool() {
+        let plies = PliesBelow { mu: 0.1, facets: vec![true, false, true], under_binder: false };
+        let c = Coulomb { tool: 0.3, plies: Some(plies) };
+        assert_eq!(c.on_facet(0), (0.1, true));
+        assert_eq!(c.on_facet(1), (0.3, false));
+        // A die's facets are numbered after the punch's.
+        assert_eq!(c.on_facet(3), (0.3, false));
+        // The plies below do not reach under the binder: both its faces grip the tool's way.
+        assert_eq!(c.binder(), 0.3);
+        assert_eq!(c.largest(), 0.3);
+        assert_eq!(Coulomb::tool(0.2).on_facet(0), (0.2, false));
+    }
+
+    #[test]
     fn a_binders_grip_with_one_coefficient_is_that_coefficient_exactly() {
         for mu in [0.0, 0.1, 0.2, 0.3, 1.0 / 3.0] {
             let plies = PliesBelow { mu, facets: Vec::new(), under_binder: true };
