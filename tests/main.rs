@@ -35,6 +35,7 @@ mod module_layers;
 mod net_properties;
 mod offset_bladelike;
 mod optimise;
+mod ply_friction;
 mod report;
 mod sphere_chebyshev;
 mod study;

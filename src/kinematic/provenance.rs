@@ -282,6 +282,10 @@ impl ContactState {
 pub struct ContactRecord {
     /// Coulomb's coefficient between the ply and the tool.
     pub friction: f64,
+    /// Coulomb's coefficient between the ply and the plies below it, where a layup gives one
+    /// (`ply_friction`) and plies lie below.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ply_friction: Option<f64>,
     /// Seed 000's restraint (`stick = true`, free drape): the nodes the tool holds up stay where
     /// they touch until pulled off, friction without limit.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -299,13 +303,25 @@ pub struct ContactRecord {
     /// forces at the end tell (0: it rests in neutral balance, any friction holds it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction_needed: Option<f64>,
+    /// [`BETWEEN_PLIES`] when `friction_needed` is the least `ply_friction` (the ply slides on
+    /// the plies below; the tool's friction as given where it bears on bare tool); absent when
+    /// it is the tool's `friction`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_needed_between: Option<String>,
 }
+
+/// What [`ContactRecord::friction_needed_between`] says when the coefficient needed is the one
+/// between the ply and the plies below it.
+pub const BETWEEN_PLIES: &str = "plies";
 
 /// How a refined ply meets the tool, in a few numbers (the layup table's and the report's).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContactSummary {
     /// Coulomb's coefficient between the ply and the tool.
     pub friction: f64,
+    /// Coulomb's coefficient between the ply and the plies below it ([`ContactRecord::ply_friction`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ply_friction: Option<f64>,
     /// Seed 000's restraint instead of friction ([`ContactRecord::sticky`]).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub sticky: bool,
@@ -325,15 +341,24 @@ pub struct ContactSummary {
     /// forces tell.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction_needed: Option<f64>,
+    /// Which coefficient that is ([`ContactRecord::friction_needed_between`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_needed_between: Option<String>,
 }
 
 impl ContactRecord {
+    /// The largest coefficient the ply met (0: frictionless everywhere).
+    pub fn largest_friction(&self) -> f64 {
+        self.ply_friction.map_or(self.friction, |p| p.max(self.friction))
+    }
+
     /// The record in a few numbers.
     pub fn summary(&self) -> ContactSummary {
         let count = |s: ContactState| self.state.iter().flatten().filter(|&&x| x == s).count();
         let largest = |v: &[Option<f64>]| v.iter().flatten().copied().fold(0.0, f64::max);
         ContactSummary {
             friction: self.friction,
+            ply_friction: self.ply_friction,
             sticky: self.sticky,
             stick: count(ContactState::Stick),
             slip: count(ContactState::Slip),
@@ -342,6 +367,7 @@ impl ContactRecord {
             max_slip_m: largest(&self.slip_m),
             max_pressure_pa: largest(&self.pressure_pa),
             friction_needed: self.friction_needed,
+            friction_needed_between: self.friction_needed_between.clone(),
         }
     }
 }
@@ -352,7 +378,10 @@ impl ContactSummary {
         let grip = if self.sticky {
             "stick = true (nodes the tool holds up stay where they touch)".to_string()
         } else {
-            format!("friction {}", self.friction)
+            match self.ply_friction {
+                Some(p) => format!("friction {}, ply_friction {p} on the plies below", self.friction),
+                None => format!("friction {}", self.friction),
+            }
         };
         let mut s = format!("{grip}: {} nodes stick, {} slip, {} free", self.stick, self.slip, self.free);
         if self.held > 0 {

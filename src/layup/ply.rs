@@ -8,6 +8,7 @@ use crate::kinematic::{wrinkle, DrapeNet, KinematicSettings};
 use crate::material::MaterialCard;
 use crate::mechanics::energy::bending_energy_density;
 use crate::mechanics::forming::Forming;
+use crate::mechanics::friction::PliesBelow;
 use crate::mechanics::refine::{annotate, refine_draped, refine_from, RefineError, RefineSettings, Refined};
 use crate::mechanics::sheet::SheetFeatures;
 use crate::mechanics::{ContactMode, SolverSettings};
@@ -168,6 +169,12 @@ pub struct Refinement {
     pub stick: bool,
     /// Coulomb's coefficient between the ply and the tool.
     pub friction: f64,
+    /// Coulomb's coefficient between the ply and the plies below it in a layup (`ply_friction`;
+    /// None: the tool's `friction` there too).
+    pub ply_friction: Option<f64>,
+    /// Where the plies below lie, with `ply_friction` (set by the layup, [`super::stack`],
+    /// for a ply on plies below that gives `ply_friction`).
+    pub plies_below: Option<PliesBelow>,
     /// Fabric points held in place at the user's request (u, v from the origin node, m; see
     /// [`RefineSettings::holds`]).
     pub holds: Vec<[f64; 2]>,
@@ -183,6 +190,8 @@ impl Refinement {
     pub fn pressed(material: MaterialCard, material_path: PathBuf) -> Refinement {
         Refinement {
             friction: material.friction.unwrap_or(0.0),
+            ply_friction: None,
+            plies_below: None,
             holds: Vec::new(),
             material,
             material_path,
@@ -206,6 +215,7 @@ impl Refinement {
             sheet: self.sheet.clone(),
             stick: self.stick,
             friction: self.friction,
+            plies_below: self.plies_below.clone(),
             holds: self.holds.clone(),
             forming: self.forming.clone(),
             ..RefineSettings::default()

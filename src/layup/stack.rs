@@ -14,6 +14,8 @@ use crate::kinematic::outline::Outline;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice, NodeStatus};
 use crate::material::flow::sheared_thickness;
+use crate::mechanics::forming::PlanView;
+use crate::mechanics::friction::PliesBelow;
 use crate::mechanics::refine::{RefineError, Refined};
 use crate::mechanics::sheet::{blank_fractions, blank_nodes, default_origin_node, flat_sheet, SheetError};
 
@@ -308,7 +310,12 @@ pub fn drape_layup(
         let refine_error = |source| LayupError::Refine { ply: name.clone(), line, source };
         // The net mechanics starts from (or the kinematic net that stands), the refined net and
         // the solver's record when mechanics ran, and an automatic ply's choice.
-        let (start_net, refined, choice) = match (start, &ply.auto, &ply.refinement) {
+        // A ply on plies below with a coefficient of its own against them meets them with it.
+        let refinement = match (&ply.refinement, k) {
+            (Some(r), 1..) if r.ply_friction.is_some() => Some(on_plies_below(r, &stack, tool, &results)),
+            (r, _) => r.clone(),
+        };
+        let (start_net, refined, choice) = match (start, &ply.auto, &refinement) {
             (Start::Kinematic, Some(auto), Some(r)) => {
                 let a = drape_auto(surface, &settings, r, ply.locking_angle, *auto).map_err(|e| match e {
                     AutoError::Drape(source) => drape_error(source),
@@ -379,6 +386,32 @@ pub fn drape_layup(
         results.push(PlyResult { net, refined, kinematic, choice, warp, offset, stats });
     }
     Ok(results)
+}
+
+/// Where a ply's corners must be covered by the plies below for a facet to bear on them: two of
+/// three (a facet across the edge of the plies below goes to the side most of it lies on).
+const COVERED_CORNERS: usize = 2;
+
+/// The refinement `r` of a ply that gives `ply_friction`, meeting the plies below it (`below`,
+/// their results; `stack`, their thickness at every vertex of `tool`) with that coefficient:
+/// on the facets they cover ([`COVERED_CORNERS`] of whose corners they lie over), and under
+/// the binder when one of them reaches under it (outside its opening in plan). Elsewhere, and
+/// on the die and the binder's upper face, the ply meets the tool with its `friction`.
+fn on_plies_below(r: &super::Refinement, stack: &[f64], tool: &ToolSurface, below: &[PlyResult]) -> super::Refinement {
+    let Some(mu) = r.ply_friction else { return r.clone() };
+    let facets = (tool.triangles().iter())
+        .map(|t| t.iter().filter(|&&v| stack[v as usize] > 0.0).count() >= COVERED_CORNERS)
+        .collect();
+    let under_binder = r.forming.as_ref().is_some_and(|f| {
+        f.binder.as_ref().is_some_and(|b| {
+            let view = PlanView::across(&f.stroke);
+            below.iter().any(|p| {
+                let placed = p.net.positions.iter().zip(&p.net.status).filter(|(_, s)| **s == NodeStatus::Placed);
+                b.reaches_under(&view, placed.map(|(x, _)| x))
+            })
+        })
+    });
+    super::Refinement { plies_below: Some(PliesBelow { mu, facets, under_binder }), ..r.clone() }
 }
 
 /// Add a draped ply's thickness t0 / cos(gamma) (sheared cells keep their fibre lengths, so their

@@ -12,7 +12,9 @@
 //! The binder clamps the blank in its plane: a node outside the binder's opening in plan view
 //! (across the stroke) and still in the blank's plane slides in that plane only, and friction
 //! on both faces holds it with a normal force of the binder's pressure over the node's share of
-//! the fabric ([`Binder::bearing`]). Drawn in past the opening's edge it is let go.
+//! the fabric ([`Binder::bearing`]). Drawn in past the opening's edge it is let go. A ply of a
+//! layup formed over the plies below grips them with its lower face: the two faces' coefficients
+//! differ then (`ply_friction`, [`super::friction::Coulomb::binder`]).
 use super::contact::{ContactSurface, Foot};
 use super::friction::Bearing;
 use super::sheet::{point_in_polygon, polygon_round, PolygonFault};
@@ -199,10 +201,19 @@ impl Binder {
             .collect()
     }
 
+    /// Whether any of `points` lies under the binder: outside its opening in plan (`view`).
+    pub fn reaches_under<'a>(&self, view: &PlanView, mut points: impl Iterator<Item = &'a Point>) -> bool {
+        points.any(|p| {
+            let q = view.at(p);
+            !point_in_polygon((q[0], q[1]), &self.outline)
+        })
+    }
+
     /// Where a gripped node bears: on the blank's plane, with the binder's pressure over its
-    /// share of the fabric `area` (m^2) on each of its two faces (friction acts on both).
-    pub fn bearing(&self, plane_normal: &Vector, area: f64) -> Bearing {
-        Bearing { normal: *plane_normal, force: 2.0 * self.pressure * area }
+    /// share of the fabric `area` (m^2) on each of its two faces (friction acts on both), `mu`
+    /// the mean of the two faces' coefficients ([`super::friction::Coulomb::binder`]).
+    pub fn bearing(&self, plane_normal: &Vector, area: f64, mu: f64) -> Bearing {
+        Bearing { normal: *plane_normal, force: 2.0 * self.pressure * area, mu, on_plies: false }
     }
 }
 

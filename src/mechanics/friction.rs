@@ -67,19 +67,81 @@ pub const BEARING_GAP: f64 = 1e-6;
 /// (about 1e-4 on the bundled tools).
 pub const RIGID_TANGENT: f64 = 1e-3;
 
-/// Where each node bears on the tool at a state, with the force the tool gives it.
+/// Where each node bears on the tool at a state, with the force the tool gives it and the
+/// friction coefficient of what it bears on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bearing {
     /// The tool's outward unit normal at the node's foot.
     pub normal: Vector,
     /// The normal force, N (positive: the tool pushes the node out).
     pub force: f64,
+    /// Coulomb's coefficient there: the tool's, or where a ply of a layup lies on the plies
+    /// below it, theirs ([`Coulomb`]); a binder's grip, the mean of its two faces'.
+    pub mu: f64,
+    /// Whether it bears on the plies below (their coefficient, `ply_friction`) rather than on a
+    /// tool: what [`friction_needed`] asks about.
+    pub on_plies: bool,
+}
+
+/// Coulomb's coefficients a ply meets: the tool's, and in a layup, where the ply lies on the
+/// plies below it, theirs.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Coulomb {
+    /// Between the ply and a tool (the tool, the punch, the die, the binder's upper face).
+    pub tool: f64,
+    /// Between the ply and the plies below it, when a layup gives its own (`ply_friction`).
+    pub plies: Option<PliesBelow>,
+}
+
+/// Where the plies below a ply of a layup lie, and the friction between them and it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PliesBelow {
+    /// Coulomb's coefficient between plies.
+    pub mu: f64,
+    /// Per facet of the tool (the surface the ply lies on has the same facets, offset): whether
+    /// the plies below cover it (a node whose foot is on it bears on fabric). Facets numbered
+    /// past these (a die's) are bare tool.
+    pub facets: Vec<bool>,
+    /// Whether the plies below reach under the binder: its lower face then grips them.
+    pub under_binder: bool,
+}
+
+impl Coulomb {
+    /// Just the tool's coefficient.
+    pub fn tool(mu: f64) -> Self {
+        Coulomb { tool: mu, plies: None }
+    }
+
+    /// The coefficient, and whether it is the plies', where a node's foot is on `facet`.
+    pub fn on_facet(&self, facet: u32) -> (f64, bool) {
+        match &self.plies {
+            Some(p) if p.facets.get(facet as usize).copied().unwrap_or(false) => (p.mu, true),
+            _ => (self.tool, false),
+        }
+    }
+
+    /// The coefficient of a binder's grip per unit of its normal force on both faces: the
+    /// mean of the upper face's (on the binder, the tool's) and the lower face's (on the plies
+    /// below where they reach under it, else on the tool's flange, the tool's). With one
+    /// coefficient it is that one exactly.
+    pub fn binder(&self) -> f64 {
+        match &self.plies {
+            Some(p) if p.under_binder => (self.tool + p.mu) / 2.0,
+            _ => self.tool,
+        }
+    }
+
+    /// The largest coefficient any contact has (0: frictionless everywhere).
+    pub fn largest(&self) -> f64 {
+        self.plies.as_ref().map_or(self.tool, |p| p.mu.max(self.tool))
+    }
 }
 
 /// The friction of one increment: its data lagged from the last state.
 #[derive(Debug, Clone)]
 pub struct FrictionLag {
-    /// Coulomb's coefficient.
+    /// The largest of Coulomb's coefficients the bearings may carry ([`Coulomb::largest`]):
+    /// 0, frictionless, and the potential is left out.
     pub mu: f64,
     /// The stick distance eps (m).
     pub stick: f64,
@@ -100,7 +162,8 @@ fn smoothed(s: f64, eps: f64) -> (f64, f64, f64) {
 }
 
 impl FrictionLag {
-    /// A lag at the state `x` (the origins) with its bearings.
+    /// A lag at the state `x` (the origins) with its bearings, whose coefficients are at most
+    /// `mu`.
     pub fn new(mu: f64, stick: f64, x: &[Point], bearing: Vec<Option<Bearing>>) -> Self {
         FrictionLag { mu, stick, origin: x.to_vec(), bearing }
     }
@@ -134,9 +197,10 @@ impl FrictionLag {
         }
     }
 
-    /// The friction force capacity mu lambda of node k (N).
+    /// The friction force capacity mu lambda of node k (N), with the coefficient of what it
+    /// bears on.
     fn capacity(&self, k: usize) -> f64 {
-        self.bearing[k].map_or(0.0, |b| self.mu * b.force.max(0.0))
+        self.bearing[k].map_or(0.0, |b| b.mu * b.force.max(0.0))
     }
 
     /// The potential at `x`.
@@ -303,10 +367,10 @@ impl Objective for Frictional<'_> {
 
 /// Where each node bears on the tool at `x` under the net's own forces (`eval`: internal
 /// forces F without friction, loads P): the tool's reaction `n . (F - P)` at every node that
-/// slides on it (pressed) or touches it (free contact), where it pushes the node out; stitched
-/// nodes bear through their representative. None: no contact, or the tool pulls (a pressed
-/// node over a hollow).
-pub fn bearings(cons: &Constraints, x: &[Point], eval: &Evaluation) -> Vec<Option<Bearing>> {
+/// slides on it (pressed) or touches it (free contact), where it pushes the node out, with the
+/// coefficient `coulomb` has on its foot's facet; stitched nodes bear through their
+/// representative. None: no contact, or the tool pulls (a pressed node over a hollow).
+pub fn bearings(cons: &Constraints, x: &[Point], eval: &Evaluation, coulomb: &Coulomb) -> Vec<Option<Bearing>> {
     let n = x.len();
     let Some(tool) = cons.tool else { return vec![None; n] };
     let rep: Vec<usize> = cons.stitched.clone().unwrap_or_else(|| (0..n).collect());
@@ -322,7 +386,8 @@ pub fn bearings(cons: &Constraints, x: &[Point], eval: &Evaluation) -> Vec<Optio
             }
             let foot = foot_of(tool, cons, k, &x[k])?;
             let force = foot.normal.dot(&push[k]);
-            (force > 0.0).then_some(Bearing { normal: foot.normal, force })
+            let (mu, on_plies) = coulomb.on_facet(foot.facet);
+            (force > 0.0).then_some(Bearing { normal: foot.normal, force, mu, on_plies })
         })
         .collect()
 }
@@ -392,20 +457,46 @@ pub fn tangent_rigid_motions(x: &[Point], bearing: &[Option<Bearing>]) -> Vec<Ve
     motions
 }
 
+/// What a coefficient [`friction_needed`] reports is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Needed {
+    /// One coefficient for every contact: the tool's `friction`.
+    Friction,
+    /// The coefficient between the ply and the plies below it (`ply_friction`), the tool's as
+    /// given where the ply bears on bare tool.
+    PlyFriction,
+}
+
 /// The least friction coefficient that would hold the ply against a motion `v` (per node) that
 /// keeps its fibres at their lengths (a slide, a rigid motion), under the loads `drive`: the
 /// work the loads do along it over the work friction of coefficient 1 would take from it (the
 /// fabric's own forces do no work along such a motion). None where nothing bears on the tool
 /// along it.
-pub fn friction_needed(v: &[Vector], drive: &[Vector], bearing: &[Option<Bearing>]) -> Option<f64> {
+///
+/// Where some nodes bear on the plies below with a coefficient of their own
+/// ([`Bearing::on_plies`]), it is about that one: the least `ply_friction` that would hold the
+/// ply, with the friction the other nodes bear with (their own coefficients) taken off the work
+/// first (0 when they alone hold it). A ply sliding on the plies below needs that coefficient;
+/// one coefficient for all would mix the tool's into it.
+pub fn friction_needed(v: &[Vector], drive: &[Vector], bearing: &[Option<Bearing>]) -> Option<(f64, Needed)> {
     let work: f64 = v.iter().zip(drive).map(|(v, d)| v.dot(d)).sum();
-    let resisted: f64 = (v.iter().zip(bearing))
-        .filter_map(|(v, b)| {
-            let b = (*b)?;
-            Some(b.force.max(0.0) * (v - b.normal * b.normal.dot(v)).norm())
-        })
-        .sum();
-    (resisted > 0.0).then(|| work.abs() / resisted)
+    // The work friction of coefficient 1 takes along v from the nodes on the plies below and
+    // from the others, and what the others' own coefficients take.
+    let (mut plies, mut others, mut others_own) = (0.0, 0.0, 0.0);
+    for (v, b) in v.iter().zip(bearing) {
+        let Some(b) = b else { continue };
+        let w = b.force.max(0.0) * (v - b.normal * b.normal.dot(v)).norm();
+        if b.on_plies {
+            plies += w;
+        } else {
+            others += w;
+            others_own += b.mu * w;
+        }
+    }
+    if plies > 0.0 {
+        return Some((((work.abs() - others_own) / plies).max(0.0), Needed::PlyFriction));
+    }
+    (others > 0.0).then(|| (work.abs() / others, Needed::Friction))
 }
 
 #[cfg(test)]
@@ -433,7 +524,10 @@ mod tests {
     fn the_potential_gradient_and_hessian_agree_with_finite_differences() {
         let x0 = vec![Point::new(0.0, 0.0, 0.0), Point::new(1.0, 0.0, 0.0)];
         let n = Vector::new(0.0, 0.3, 1.0).normalize();
-        let bearing = vec![Some(Bearing { normal: n, force: 2.0 }), Some(Bearing { normal: Vector::z(), force: 0.5 })];
+        let bearing = vec![
+            Some(Bearing { normal: n, force: 2.0, mu: 0.4, on_plies: false }),
+            Some(Bearing { normal: Vector::z(), force: 0.5, mu: 0.3, on_plies: true }),
+        ];
         let lag = FrictionLag::new(0.4, 0.01, &x0, bearing);
         for x in [
             vec![Point::new(0.003, -0.002, 0.001), Point::new(1.02, 0.01, 0.0)],
@@ -468,7 +562,7 @@ mod tests {
                 for j in 0..9 {
                     let (p, n) = f(-0.4 + 0.1 * i as f64, -0.4 + 0.1 * j as f64);
                     x.push(p);
-                    b.push(Some(Bearing { normal: n, force: 1.0 }));
+                    b.push(Some(Bearing { normal: n, force: 1.0, mu: 0.0, on_plies: false }));
                 }
             }
             (x, b)
@@ -502,9 +596,49 @@ mod tests {
         let down = Vector::new(0.0, -a.cos(), -a.sin());
         let weight = Vector::new(0.0, 0.0, -2.0);
         let drive = vec![weight; 4];
-        let bearing = vec![Some(Bearing { normal: n, force: 2.0 * a.cos() }); 4];
+        let bearing = vec![Some(Bearing { normal: n, force: 2.0 * a.cos(), mu: 0.0, on_plies: false }); 4];
         let v = vec![down; 4];
-        let mu = friction_needed(&v, &drive, &bearing).unwrap();
-        assert!((mu - a.tan()).abs() < 1e-12);
+        let (mu, of) = friction_needed(&v, &drive, &bearing).unwrap();
+        assert!((mu - a.tan()).abs() < 1e-12 && of == Needed::Friction);
+    }
+
+    /// Half of a ply on an incline bears on the tool with tan a / 2, half on a ply below: the
+    /// ply friction that holds it is 3/2 tan a (the two halves' friction adds up to its pull).
+    #[test]
+    fn the_ply_friction_needed_takes_the_tools_share_off_first() {
+        let a: f64 = 0.35;
+        let n = Vector::new(0.0, -a.sin(), a.cos());
+        let down = Vector::new(0.0, -a.cos(), -a.sin());
+        let drive = vec![Vector::new(0.0, 0.0, -2.0); 4];
+        let on = |mu, on_plies| Some(Bearing { normal: n, force: 2.0 * a.cos(), mu, on_plies });
+        let tool = 0.5 * a.tan();
+        let bearing = vec![on(tool, false), on(tool, false), on(0.1, true), on(0.1, true)];
+        let (mu, of) = friction_needed(&[down; 4], &drive, &bearing).unwrap();
+        assert!((mu - 1.5 * a.tan()).abs() < 1e-12 && of == Needed::PlyFriction, "{mu}");
+        // Held by the tool's share alone, it needs none.
+        let bearing = vec![on(5.0, false), on(5.0, false), on(0.1, true), on(0.1, true)];
+        assert_eq!(friction_needed(&[down; 4], &drive, &bearing), Some((0.0, Needed::PlyFriction)));
+    }
+
+    #[test]
+    fn a_foot_on_a_facet_the_plies_below_cover_meets_them_and_a_die_facet_the_tool() {
+        let plies = PliesBelow { mu: 0.1, facets: vec![true, false, true], under_binder: false };
+        let c = Coulomb { tool: 0.3, plies: Some(plies) };
+        assert_eq!(c.on_facet(0), (0.1, true));
+        assert_eq!(c.on_facet(1), (0.3, false));
+        // A die's facets are numbered after the punch's.
+        assert_eq!(c.on_facet(3), (0.3, false));
+        // The plies below do not reach under the binder: both its faces grip the tool's way.
+        assert_eq!(c.binder(), 0.3);
+        assert_eq!(c.largest(), 0.3);
+        assert_eq!(Coulomb::tool(0.2).on_facet(0), (0.2, false));
+    }
+
+    #[test]
+    fn a_binders_grip_with_one_coefficient_is_that_coefficient_exactly() {
+        for mu in [0.0, 0.1, 0.2, 0.3, 1.0 / 3.0] {
+            let plies = PliesBelow { mu, facets: Vec::new(), under_binder: true };
+            assert_eq!(Coulomb { tool: mu, plies: Some(plies) }.binder(), mu);
+        }
     }
 }

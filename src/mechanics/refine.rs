@@ -4,15 +4,15 @@ use super::contact::{ContactMode, ContactSurface, Freedom};
 use super::energy::{Gravity, Grid, HessianKind, Laws, Model};
 use super::forming::{Forming, PlanView, ToolsAt};
 use super::friction::{
-    bearings, friction_needed, tangent_rigid_motions, Bearing, FrictionLag, Frictional, LAG_TOLERANCE, MAX_LAGS,
-    RELAG_SHARE, RELAG_TRAVEL_SPACINGS, SLIDE_MIN_SPACINGS, SLIDE_SHARE, STICK_SPACINGS,
+    bearings, friction_needed, tangent_rigid_motions, Bearing, Coulomb, FrictionLag, Frictional, Needed, PliesBelow,
+    LAG_TOLERANCE, MAX_LAGS, RELAG_SHARE, RELAG_TRAVEL_SPACINGS, SLIDE_MIN_SPACINGS, SLIDE_SHARE, STICK_SPACINGS,
 };
 use super::qp::HessianBlocks;
 use super::sheet::{SheetError, SheetFeatures, SheetLayout};
 use super::solver::{solve, Constraints, Evaluation, Objective, Outcome, SolveReport, SolverSettings};
 use crate::geometry::{Point, SmoothSurface, ToolSurface, Vector};
 use crate::kinematic::provenance::{
-    CellChanges, ContactRecord, ContactState, SolverRecord, Stability, UnbalancedRecord,
+    CellChanges, ContactRecord, ContactState, SolverRecord, Stability, UnbalancedRecord, BETWEEN_PLIES,
 };
 use crate::kinematic::{drape_smooth, DrapeNet, KinematicSettings, Method, NodeStatus, SurfaceKind};
 
@@ -134,6 +134,9 @@ pub struct RefineSettings {
     pub stick: bool,
     /// Coulomb's coefficient of friction between the ply and the tool (0: frictionless).
     pub friction: f64,
+    /// A ply of a layup with a coefficient of its own against the plies below it
+    /// (`ply_friction`): where they lie. None: the tool's `friction` everywhere.
+    pub plies_below: Option<PliesBelow>,
     /// Nodes held in place at the user's request, as fabric coordinates from the origin node
     /// (u along the warp, v along the weft, m): the node there is held, on a grid of any
     /// spacing (a ply draped again at another spacing holds the same fabric points). Nothing
@@ -156,9 +159,17 @@ impl Default for RefineSettings {
             sheet: SheetFeatures::default(),
             stick: false,
             friction: 0.0,
+            plies_below: None,
             holds: Vec::new(),
             forming: None,
         }
+    }
+}
+
+impl RefineSettings {
+    /// The coefficients the ply meets: the tool's, and the plies' below it where they lie.
+    pub fn coulomb(&self) -> Coulomb {
+        Coulomb { tool: self.friction, plies: self.plies_below.clone() }
     }
 }
 
@@ -191,6 +202,9 @@ pub enum Slide {
         distance: f64,
         /// The least friction coefficient that would hold it, as the forces there tell.
         friction_needed: Option<f64>,
+        /// Which coefficient that is ([`friction_needed`]): the tool's `friction`, or on a ply
+        /// of a layup bearing on the plies below, `ply_friction`.
+        about: Needed,
     },
     /// Frictionless and held by nothing, on a tool that lets it move rigidly (a plane, a
     /// cylinder, a sphere): its place is not determined.
@@ -211,18 +225,30 @@ impl Slide {
         }
     }
 
+    /// Which coefficient [`Slide::friction_needed`] is about.
+    pub fn about(&self) -> Needed {
+        match self {
+            Slide::Away { about, .. } => *about,
+            Slide::Free { .. } => Needed::Friction,
+        }
+    }
+
     /// What happened and what would hold the ply, in words.
     pub fn describe(&self) -> String {
         let hold = match self.friction_needed() {
             Some(mu) if mu < 1e-6 => {
                 "; it rests in neutral balance: any friction, or a hold, keeps it in place".to_string()
             }
+            Some(mu) if self.about() == Needed::PlyFriction => format!(
+                "; ply_friction >= {mu:.3} between it and the plies below would hold it (or hold nodes with `hold`)"
+            ),
             Some(mu) => format!("; friction mu >= {mu:.3} would hold it (or hold nodes with `hold`)"),
             None => "; hold nodes with `hold`, or give friction".to_string(),
         };
         match self {
-            Slide::Away { distance, .. } => {
-                format!("slides: the ply slid {:.1} mm over the tool and friction cannot stop it{hold}", distance * 1e3)
+            Slide::Away { distance, about, .. } => {
+                let over = if *about == Needed::PlyFriction { "the plies below" } else { "the tool" };
+                format!("slides: the ply slid {:.1} mm over {over} and friction cannot stop it{hold}", distance * 1e3)
             }
             Slide::Free { motions, .. } => format!(
                 "slides: frictionless and held by nothing, the ply is free to move rigidly over the tool \
@@ -276,7 +302,7 @@ impl Refined {
     /// friction never agreed with a solution.
     pub fn outcome(&self) -> Outcome {
         let last = self.steps.last().map_or(Outcome::Converged, |s| s.outcome);
-        let unsettled = self.increments.iter().any(|i| !i.settled(self.contact.friction));
+        let unsettled = self.increments.iter().any(|i| !i.settled(self.contact.largest_friction()));
         if self.slide.is_some() {
             Outcome::Slides
         } else if last == Outcome::Slides || (last == Outcome::Converged && unsettled) {
@@ -297,7 +323,8 @@ impl Refined {
             return slide.describe();
         }
         if self.outcome() == Outcome::FrictionUnsettled {
-            if let Some((k, i)) = self.increments.iter().enumerate().find(|(_, i)| !i.settled(self.contact.friction)) {
+            let friction = self.contact.largest_friction();
+            if let Some((k, i)) = self.increments.iter().enumerate().find(|(_, i)| !i.settled(friction)) {
                 let how = if i.lag_change.is_finite() {
                     format!("the normal forces still changed by {:.1}% over the last", 100.0 * i.lag_change)
                 } else {
@@ -570,7 +597,10 @@ fn refine_among<L: Laws + ?Sized>(
     let stick_distance = STICK_SPACINGS * kinematic.spacing;
     // How far each node slid over the tool, over all increments.
     let mut slid = vec![0.0; x.len()];
-    let mut lag = FrictionLag::new(settings.friction, stick_distance, &x, vec![None; x.len()]);
+    // The coefficients the ply meets, and the largest: 0, frictionless everywhere.
+    let coulomb = settings.coulomb();
+    let friction = coulomb.largest();
+    let mut lag = FrictionLag::new(friction, stick_distance, &x, vec![None; x.len()]);
     let mut slide = None;
     for step in 1..=load_steps {
         if step > 1 {
@@ -606,10 +636,10 @@ fn refine_among<L: Laws + ?Sized>(
         };
         // Where the nodes bear: on the tools, and the gripped ones on the binder.
         let bear = |x: &[Point], eval: &Evaluation| {
-            let mut b = bearings(&cons, x, eval);
+            let mut b = bearings(&cons, x, eval, &coulomb);
             if let (Some(binder), Some((_, normal))) = (binder, blank_plane) {
                 for (k, _) in gripped.iter().enumerate().filter(|(_, g)| **g) {
-                    b[k] = Some(binder.bearing(&normal, areas[k]));
+                    b[k] = Some(binder.bearing(&normal, areas[k], coulomb.binder()));
                 }
             }
             b
@@ -625,7 +655,7 @@ fn refine_among<L: Laws + ?Sized>(
         if step == 1 {
             eval.internal.iter_mut().for_each(|f| *f = Vector::zeros());
         }
-        lag = FrictionLag::new(settings.friction, stick_distance, &x, bear(&x, &eval));
+        lag = FrictionLag::new(friction, stick_distance, &x, bear(&x, &eval));
         let limit = slide_limit(&lag, kinematic.spacing);
         let mut increment = Increment { load_factor: step as f64 / load_steps as f64, solves: 0, lag_change: 0.0 };
         // The iterations of a load step, shared by its solves.
@@ -633,8 +663,7 @@ fn refine_among<L: Laws + ?Sized>(
         let ok = loop {
             increment.solves += 1;
             let before = x.clone();
-            let travel =
-                (settings.friction > 0.0).then_some((before.as_slice(), RELAG_TRAVEL_SPACINGS * kinematic.spacing));
+            let travel = (friction > 0.0).then_some((before.as_slice(), RELAG_TRAVEL_SPACINGS * kinematic.spacing));
             let step_limit = lag.mean_slip(&x) + RELAG_SHARE * limit;
             let frictional = Frictional { inner: &objective, lag: &lag, slide_limit: step_limit, travel };
             let mut this_solve = solver_settings.clone().max_iterations(budget);
@@ -656,7 +685,11 @@ fn refine_among<L: Laws + ?Sized>(
                     // The last solve's move is the slide itself (the first may settle the ply too).
                     let moved: Vec<Vector> = x.iter().zip(&before).map(|(p, o)| p - o).collect();
                     let needed = friction_needed(&moved, &objective.loads, &now);
-                    slide = Some(Slide::Away { distance: sliding, friction_needed: needed });
+                    slide = Some(Slide::Away {
+                        distance: sliding,
+                        friction_needed: needed.map(|(mu, _)| mu),
+                        about: needed.map_or(Needed::Friction, |(_, about)| about),
+                    });
                     lag.bearing = now;
                     break false;
                 }
@@ -669,7 +702,7 @@ fn refine_among<L: Laws + ?Sized>(
                 // It slid a little, or travelled a few spacings, with the normal forces of where
                 // it began: on from here, with those where it is now.
                 Outcome::Slides => {}
-                Outcome::Converged if settings.friction == 0.0 || increment.lag_change <= LAG_TOLERANCE || last_try => {
+                Outcome::Converged if friction == 0.0 || increment.lag_change <= LAG_TOLERANCE || last_try => {
                     lag.bearing = now;
                     break true;
                 }
@@ -677,13 +710,13 @@ fn refine_among<L: Laws + ?Sized>(
                 // A solve that stopped short with normal forces far from those where it stopped
                 // may have been held back by them (a start whose forces were the load's alone):
                 // once more with the forces where it is.
-                _ if settings.friction > 0.0 && increment.lag_change > LAG_TOLERANCE && !last_try => {}
+                _ if friction > 0.0 && increment.lag_change > LAG_TOLERANCE && !last_try => {}
                 // A solve that stalled, or found no step lowering the energy, with nodes sliding
                 // at the edge of their stick distance (where friction's slope turns from the stiff
                 // stick to the constant slide and Newton's model of it is poor: the 61 x 61
                 // punch-and-die blank stopped at |F-P|/|P| = 1.5e-4, a node on the die's face
                 // mostly friction): what they slid is banked, and they stick again where they are.
-                Outcome::Stalled | Outcome::LineSearchFailed if settings.friction > 0.0 && !last_try => {
+                Outcome::Stalled | Outcome::LineSearchFailed if friction > 0.0 && !last_try => {
                     for (k, s) in slid.iter_mut().enumerate() {
                         *s += lag.slip(k, &x[k]).norm();
                     }
@@ -699,7 +732,7 @@ fn refine_among<L: Laws + ?Sized>(
         for (k, s) in slid.iter_mut().enumerate() {
             *s += lag.slip(k, &x[k]).norm();
         }
-        let settled = increment.settled(settings.friction);
+        let settled = increment.settled(friction);
         increments.push(increment);
         if !ok || !settled {
             break;
@@ -708,13 +741,13 @@ fn refine_among<L: Laws + ?Sized>(
     // A frictionless ply that nothing holds, on a tool that lets it move rigidly (a plane, a
     // cylinder, a sphere): its place is not determined, however well its forces balance.
     // (Converged or not: a solve chasing such a motion may not settle at all.)
-    let free_to_move = settings.friction == 0.0 && !settings.stick && settings.holds.is_empty();
+    let free_to_move = friction == 0.0 && !settings.stick && settings.holds.is_empty();
     if slide.is_none() && free_to_move {
         let motions = tangent_rigid_motions(&x, &lag.bearing);
         if !motions.is_empty() {
             let needed = motions
                 .iter()
-                .filter_map(|v| friction_needed(v, &objective.loads, &lag.bearing))
+                .filter_map(|v| friction_needed(v, &objective.loads, &lag.bearing).map(|(mu, _)| mu))
                 .fold(None, |m: Option<f64>, f| Some(m.map_or(f, |m| m.max(f))));
             slide = Some(Slide::Free { motions: motions.len(), friction_needed: needed });
         }
@@ -746,8 +779,9 @@ fn slide_limit(lag: &FrictionLag, spacing: f64) -> f64 {
 fn reaction_scale(lag: &FrictionLag, gripped: &[bool]) -> f64 {
     (lag.bearing.iter().zip(gripped))
         .filter_map(|(b, &g)| {
-            let f = b.as_ref()?.force.max(0.0);
-            Some(if g { lag.mu * f } else { f })
+            let b = b.as_ref()?;
+            let f = b.force.max(0.0);
+            Some(if g { b.mu * f } else { f })
         })
         .map(|f| f * f)
         .sum::<f64>()
@@ -795,12 +829,17 @@ fn contact_record(
     }
     ContactRecord {
         friction: settings.friction,
+        ply_friction: settings.plies_below.as_ref().map(|p| p.mu),
         sticky: settings.stick,
         state,
         slip_m,
         pressure_pa,
         held: held_nodes,
         friction_needed: slide.as_ref().and_then(Slide::friction_needed),
+        friction_needed_between: slide
+            .as_ref()
+            .filter(|s| s.friction_needed().is_some() && s.about() == Needed::PlyFriction)
+            .map(|_| BETWEEN_PLIES.to_string()),
     }
 }
 

@@ -102,6 +102,7 @@ impl RefineOptions {
                 .iter()
                 .map(|&[i, j]| [(i as f64 - i0 as f64) * net.spacing, (j as f64 - j0 as f64) * net.spacing])
                 .collect(),
+            plies_below: None,
             forming: None,
         })
     }

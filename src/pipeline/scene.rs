@@ -16,6 +16,9 @@
 //! rotate_patterns = false     # optional: pieces may turn 90 deg on the roll (warp across)
 //! friction = 0.25             # optional: Coulomb's coefficient between mechanical plies and the
 //!                             # tool, for every ply without its own (default: each card's)
+//! ply_friction = 0.15         # optional: Coulomb's coefficient between a mechanical ply and the
+//!                             # plies below it, for every ply without its own (default: each
+//!                             # ply's `friction`); the tool's where the ply bears on bare tool
 //! [materials]                 # optional: names for material cards, relative to this file
 //! glass = "../../materials/glass-plain-weave.toml"
 //! [export]                    # optional: map every ply onto a resin-flow mesh
@@ -54,6 +57,10 @@
 //! # max_iterations = 500      # solver iterations per load step (default 500)
 //! # friction = 0.25          # Coulomb's coefficient between the ply and the tool (default: the
 //!                             # scene's `friction`, else the card's [contact] friction, else 0)
+//! # ply_friction = 0.15      # Coulomb's coefficient between the ply and the plies below it where
+//!                             # they cover the tool under it (default: the scene's
+//!                             # `ply_friction`, else the ply's `friction`); a formed ply's binder
+//!                             # grips with `friction` above and this below where plies lie under it
 //! # hold = [[30, 30]]         # grid nodes [i, j] held in place (nothing else holds a ply but
 //!                             # the tool and friction; a ply that slides says so)
 //! # stick = false             # free drape: nodes the tool holds up stay where they touch (until pulled off by over a tenth of their weight)
@@ -153,6 +160,7 @@ struct SceneFile {
     #[serde(default)]
     rotate_patterns: bool,
     friction: Option<f64>,
+    ply_friction: Option<f64>,
     #[serde(default)]
     materials: BTreeMap<String, String>,
     export: Option<toml::Spanned<ExportFile>>,
@@ -219,6 +227,7 @@ struct PlyFile {
     max_iterations: Option<usize>,
     stick: Option<bool>,
     friction: Option<f64>,
+    ply_friction: Option<f64>,
     hold: Option<Vec<[usize; 2]>>,
     escape_saddles: Option<bool>,
     #[serde(default)]
@@ -315,6 +324,7 @@ fn refinement(
     extent: &Extent,
     scale: f64,
     scene_friction: Option<f64>,
+    scene_ply_friction: Option<f64>,
     base: &Path,
 ) -> Result<Refinement, (&'static str, String)> {
     let m = material.ok_or((
@@ -467,6 +477,16 @@ fn refinement(
             }
             mu => mu.unwrap_or(0.0),
         },
+        ply_friction: match p.ply_friction.or(scene_ply_friction) {
+            Some(mu) if !(mu.is_finite() && mu >= 0.0) => {
+                return Err((
+                    "ply_friction",
+                    format!("must be a finite number >= 0 (Coulomb's coefficient between plies), got {mu}"),
+                ))
+            }
+            mu => mu,
+        },
+        plies_below: None,
         holds: match (extent, &p.hold) {
             (_, None) => Vec::new(),
             (Extent::Grid { nu, nv, origin_node }, Some(hold)) => {
@@ -742,6 +762,7 @@ impl Scene {
                         ("max_iterations", p.max_iterations.is_some()),
                         ("stick", p.stick.is_some()),
                         ("friction", p.friction.is_some()),
+                        ("ply_friction", p.ply_friction.is_some()),
                         ("hold", p.hold.is_some()),
                         ("escape_saddles", p.escape_saddles.is_some()),
                         ("reinforcement", !p.reinforcement.is_empty()),
@@ -759,7 +780,8 @@ impl Scene {
                     None
                 }
                 "mechanical" => Some(
-                    refinement(p, material.as_ref(), &extent, scale, file.friction, base).map_err(|(f, m)| at(f, m))?,
+                    refinement(p, material.as_ref(), &extent, scale, file.friction, file.ply_friction, base)
+                        .map_err(|(f, m)| at(f, m))?,
                 ),
                 "auto" => {
                     if material.is_none() {
@@ -768,7 +790,7 @@ impl Scene {
                             "method = \"auto\" weighs the kinematic net under the ply's material card: give material = \"card.toml\" or a name from [materials]".into(),
                         ));
                     }
-                    let r = refinement(p, material.as_ref(), &extent, scale, file.friction, base)
+                    let r = refinement(p, material.as_ref(), &extent, scale, file.friction, file.ply_friction, base)
                         .map_err(|(f, m)| at(f, m))?;
                     if r.mode != ContactMode::Pressed {
                         return Err(at(

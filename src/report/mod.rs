@@ -1034,7 +1034,8 @@ fn contact_picture<'a>(
     let scene = PlyScene::new(net, tool, paint, false);
     let mut subtitle = format!("{}; {tool_text}", summary.describe());
     if let Some(mu) = summary.friction_needed {
-        subtitle = format!("SLIDES (friction {mu:.3} would hold it); {subtitle}");
+        let which = if summary.friction_needed_between.is_some() { "ply_friction" } else { "friction" };
+        subtitle = format!("SLIDES ({which} {mu:.3} would hold it); {subtitle}");
     }
     let pic = ShadedPicture {
         title: format!("Ply {stem}: stick and slip on the tool"),
