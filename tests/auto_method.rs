@@ -140,11 +140,21 @@ fn auto_takes_the_smooth_kinematic_net_on_the_double_dome_and_refines_its_spacin
     assert!(ind["equilibrium_step_deg"].as_f64().unwrap() > 0.5, "{ind}");
     assert!(ind["smooth_equilibrium_step_deg"].as_f64().unwrap() < 0.5, "{ind}");
     assert!(ind["discretisation_deg"].as_f64().unwrap() > 0.5, "{ind}");
-    assert_eq!(choice["spacing_m"], 0.0025);
+    // Finer by the whole divisor of the asked spacing that its error estimate asks for
+    // (`spacing_needed_m`: the largest d/k below it), the net over the same extent. It was d/2
+    // while the smooth surface blended the flange into the domes over both sides of their
+    // tangent lines; d/3 since the flange stays flat up to them (`geometry::smooth`, face edges:
+    // the estimate 2.34 deg at 5 mm, 2.31 mm needed).
+    let needed = ind["spacing_needed_m"].as_f64().unwrap();
+    let k = (0.005 / needed).ceil();
+    assert!(k >= 2.0, "{ind}");
+    let spacing = choice["spacing_m"].as_f64().unwrap();
+    assert_eq!(spacing, 0.005 / k, "{choice}");
     let net = read_json(&out.join("p0.drape.json"));
-    assert_eq!(net["spacing"], 0.0025);
+    assert_eq!(net["spacing"], spacing);
     assert_eq!(net["meta"]["surface"], "smooth");
-    assert_eq!(net["grid"], serde_json::json!([201, 161]));
+    let k = k as usize;
+    assert_eq!(net["grid"], serde_json::json!([100 * k + 1, 80 * k + 1]));
 }
 
 /// Largest cell-shear difference of `fine` from `coarse` (the same ply at a coarser spacing) at

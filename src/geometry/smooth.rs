@@ -22,6 +22,16 @@
 //! facets joined by smooth edges. Flat regions are reproduced exactly (all quadrics are the same
 //! plane), a sphere to third order in h; a sharp edge is where two regions meet, each point
 //! taking the region of its closest facet.
+//!
+//! Flat faces stay flat where a fillet meets them tangentially ([`FaceEdge`]): a sector on the
+//! edge of a face takes the face's normal, and its curvature acts only across the edge, away
+//! from the face, over the fillet facets' reach. (Averaged over both sides the edge's normal
+//! tilted by half a facet's turn, and with the face's large facets' support its quadric bulged
+//! out of a die's face by 0.4 mm, into the blank a binder holds in that plane.) And a point
+//! reached by Newton's steps further from the facets than the surface ever lies
+//! ([`SURFACE_BAND_OVER_EDGE`]) is found again from the query's facet point: queries a few
+//! millimetres off a die's fillet, where few sectors reach, were taken to a zero set of the
+//! blend running on into the die's opening, or to the fillet a centimetre away.
 use super::surface::{SurfacePoint, ToolSurface};
 use super::{Point, Vector, NO_NEIGHBOUR};
 use nalgebra::{Matrix2, Matrix3, Vector2};
@@ -48,6 +58,17 @@ const BOUNDARY_TOLERANCE_REL: f64 = 1e-12;
 const CREASE_OVERSHOOT_BARYCENTRIC: f64 = 1e-9;
 /// Relative ridge added to the curvature fit (sectors with too few neighbours fit flat).
 const CURVATURE_FIT_RIDGE: f64 = 1e-6;
+/// Facets whose normals agree to within this (1 - cos of the angle between them) across an edge
+/// lie in one plane: a flat face (rounding in a generated or exported plane is far below it).
+const COPLANAR_COS_SLACK: f64 = 1e-12;
+/// The smooth surface over a facet lies within this fraction of the facet's longest edge of it:
+/// its sagitta is at most an eighth of the edge times the turn across it (under 0.08 below the
+/// crease angle).
+const SURFACE_BAND_OVER_EDGE: f64 = 0.25;
+/// A plane of facets is a flat face when it spans at least this angle round one of its
+/// vertices (an interior vertex 2 pi, one on a straight edge pi): a quad of a cylinder, cone or
+/// fillet split into two coplanar triangles spans its corner's angle, about pi / 2.
+const FACE_SPAN: f64 = 2.0 * std::f64::consts::FRAC_PI_3;
 /// A facet's sector list ([`SmoothSurface::near_facet`]) serves points within its bounding box
 /// grown by this fraction of its longest edge: the projections of nodes on or next to it.
 const FACET_REACH_OVER_EDGE: f64 = 0.25;
@@ -88,6 +109,26 @@ struct Sector {
     /// Support radius.
     h: f64,
     region: u32,
+    /// On the edge of a flat face ([`FaceEdge`]): the quadric's curvature acts only on the side
+    /// away from the face, where the support reaches less far.
+    edge: Option<FaceEdge>,
+}
+
+/// A sector on the edge of a flat face (a plane of facets round at least one vertex) whose other
+/// facets curve away from it: a fillet tangent to the face. The surface is tangent to the face
+/// along its edge, so the sector's normal is the face's; its curvature is zero along the edge
+/// (the edge lies in the plane, and the normal along it is the face's) and jumps there from
+/// zero on the face to the fillet's across it: `K = kappa m m^T` on the side `m . d > 0` only.
+/// Averaged over both sides as other sectors are, the normal tilts by half a facet's turn and
+/// the quadric bulges out of the face by a fraction of a millimetre (a die's face next to its
+/// entry fillet, where a binder holds the blank in that plane).
+#[derive(Debug, Clone, Copy)]
+struct FaceEdge {
+    /// Unit direction in the face's plane, across its edge, away from the face.
+    m: Vector,
+    /// The support radius on that side (over the edge's facets there: the face's facets are
+    /// often far larger than the fillet's, and the quadric fits the fillet only near the edge).
+    h_off: f64,
 }
 
 /// The tool's smooth surface (see the module docs).
@@ -189,6 +230,7 @@ impl<'a> SmoothSurface<'a> {
                         k: Matrix3::zeros(),
                         h: 0.0,
                         region: regions[t],
+                        edge: None,
                     });
                     sum_normal.push(Vector::zeros());
                 }
@@ -216,7 +258,13 @@ impl<'a> SmoothSurface<'a> {
                 }
             }
         }
-        let ks: Vec<Matrix3<f64>> = (0..sectors.len()).map(|s| fit_curvature(&sectors, s, &neighbours[s])).collect();
+        face_edges(tool, &mut sectors, &sector_of_corner, &regions);
+        let ks: Vec<Matrix3<f64>> = (0..sectors.len())
+            .map(|s| match sectors[s].edge {
+                Some(edge) => fit_edge_curvature(&sectors, s, &edge, &neighbours[s]),
+                None => fit_curvature(&sectors, s, &neighbours[s]),
+            })
+            .collect();
         for (s, k) in sectors.iter_mut().zip(ks) {
             s.k = k;
         }
@@ -236,6 +284,12 @@ impl<'a> SmoothSurface<'a> {
             return None;
         }
         Some(self.near_facet[t as usize].get_or_init(|| self.bvh.intersect_aabb(&bounds).collect()))
+    }
+
+    /// The longest edge of facet `t`.
+    fn longest_edge(&self, t: u32) -> f64 {
+        let c = self.tool.corners(t);
+        (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max)
     }
 
     /// Facet `t`'s bounding box grown by [`FACET_REACH_OVER_EDGE`] of its longest edge
@@ -304,30 +358,61 @@ impl<'a> SmoothSurface<'a> {
                 continue;
             }
             let d = p - sec.x;
-            let dist = d.norm();
-            let r = dist / sec.h;
+            // Off a flat face's edge, across it (`a` > 0): the curvature acts and the support
+            // reaches `h_off` along `m` (an ellipsoid, r^2 = d^T A d, meeting the face's sphere
+            // where a = 0 with r and its gradient continuous).
+            let off = sec.edge.and_then(|e| {
+                let a = e.m.dot(&d);
+                (a > 0.0).then_some((e, a))
+            });
+            let inv_h2 = 1.0 / (sec.h * sec.h);
+            let (r, ad) = match off {
+                None => (d.norm() / sec.h, d * inv_h2),
+                Some((e, a)) => {
+                    let extra = 1.0 / (e.h_off * e.h_off) - inv_h2;
+                    ((d.norm_squared() * inv_h2 + a * a * extra).sqrt(), d * inv_h2 + e.m * (a * extra))
+                }
+            };
             if r >= 1.0 {
                 continue;
             }
             let (w, _) = wendland(r);
-            let kd = sec.k * d;
+            let k = if sec.edge.is_none() || off.is_some() { sec.k } else { Matrix3::zeros() };
+            let kd = k * d;
             let q = sec.n.dot(&d) + 0.5 * d.dot(&kd);
             let dq = sec.n + kd;
-            // w = phi(r): grad w = -20 (1 - r)^3 d / h^2 (finite at d = 0).
+            // w = phi(r): grad w = -20 (1 - r)^3 A d (finite at d = 0).
             let one = 1.0 - r;
-            let dw = d * (-20.0 * one * one * one / (sec.h * sec.h));
+            let dw = match off {
+                None => d * (-20.0 * one * one * one / (sec.h * sec.h)),
+                Some(_) => ad * (-20.0 * one * one * one),
+            };
             w_sum += w;
             a_sum += w * q;
             dw_sum += dw;
             da_sum += dw * q + dq * w;
             if hessian {
-                // hess w = -20 (1 - r)^3 / h^2 I + 60 (1 - r)^2 / (h^3 |d|) d d^T.
-                let mut hw = Matrix3::identity() * (-20.0 * one * one * one / (sec.h * sec.h));
-                if dist > 0.0 {
-                    hw += d * d.transpose() * (60.0 * one * one / (sec.h * sec.h * sec.h * dist));
+                // hess w = -20 (1 - r)^3 A + 60 (1 - r)^2 / r (A d) (A d)^T.
+                let mut hw = match off {
+                    None => {
+                        let mut hw = Matrix3::identity() * (-20.0 * one * one * one / (sec.h * sec.h));
+                        let dist = d.norm();
+                        if dist > 0.0 {
+                            hw += d * d.transpose() * (60.0 * one * one / (sec.h * sec.h * sec.h * dist));
+                        }
+                        hw
+                    }
+                    Some((e, _)) => {
+                        let a_matrix =
+                            Matrix3::identity() * inv_h2 + e.m * e.m.transpose() * (1.0 / (e.h_off * e.h_off) - inv_h2);
+                        a_matrix * (-20.0 * one * one * one)
+                    }
+                };
+                if let (Some(_), true) = (off, r > 0.0) {
+                    hw += ad * ad.transpose() * (60.0 * one * one / r);
                 }
                 hw_sum += hw;
-                ha_sum += hw * q + dw * dq.transpose() + dq * dw.transpose() + sec.k * w;
+                ha_sum += hw * q + dw * dq.transpose() + dq * dw.transpose() + k * w;
             }
         }
         if w_sum <= 0.0 {
@@ -389,7 +474,17 @@ impl<'a> SmoothSurface<'a> {
         let (p, normal, curvature) = if beyond_boundary {
             self.past_open_edge(q, foot, curved)
         } else {
-            self.onto_region(q, foot, region, curved)
+            let found = self.onto_region(q, foot, region, curved);
+            // The surface lies within a sagitta of the facets. A point found further from the
+            // query's facet point than [`SURFACE_BAND_OVER_EDGE`] of the facet's size was reached
+            // from a query too far off for Newton's steps (where few sectors reach, the blend's
+            // gradient turns with their weights, and its zero set may even run on away from the
+            // facets): it is found again from the facet point, on the surface over the facet.
+            if (found.0 - foot.point).norm() > SURFACE_BAND_OVER_EDGE * self.longest_edge(foot.triangle) {
+                self.onto_region(&foot.point, foot, region, curved)
+            } else {
+                found
+            }
         };
         // A region's implicit surface runs on past its sharp edges (a table's top continues as a
         // plane beyond the rim): where the point found lies across such an edge of the facet under
@@ -564,6 +659,108 @@ impl NearSectors {
     }
 }
 
+/// Marks the sectors on the edge of a flat face ([`FaceEdge`]): a face is a set of facets in one
+/// plane joined across edges that spans [`FACE_SPAN`] or more round one of its vertices (two
+/// coplanar facets of a quad on a cylinder are not a face). A sector with facets in exactly
+/// one face and others, of its region, off it gets the face's normal, the direction across the
+/// edge and the support of its facets off the face. (A sector between two faces, a kink
+/// softer than a crease, stays as it is: no side is the flat one.)
+fn face_edges(tool: &ToolSurface, sectors: &mut [Sector], sector_of_corner: &[usize], regions: &[u32]) {
+    let tris = tool.triangles();
+    let verts = tool.vertices();
+    // Facets in one plane, joined across their edges.
+    let mut parent: Vec<usize> = (0..tris.len()).collect();
+    for t in 0..tris.len() {
+        for k in 0..3 {
+            let n = tool.neighbours(t as u32)[k];
+            if n == NO_NEIGHBOUR || regions[n as usize] != regions[t] {
+                continue;
+            }
+            if tool.normal(t as u32).dot(&tool.normal(n)) >= 1.0 - COPLANAR_COS_SLACK {
+                let (a, b) = (root(&mut parent, t), root(&mut parent, n as usize));
+                parent[a] = b;
+            }
+        }
+    }
+    let plane: Vec<usize> = (0..tris.len()).map(|t| root(&mut parent, t)).collect();
+    // Each sector's facets, and the angle each plane spans at each sector.
+    let mut facets: Vec<Vec<usize>> = vec![Vec::new(); sectors.len()];
+    let mut spans: Vec<Vec<(usize, f64)>> = vec![Vec::new(); sectors.len()];
+    for (corner, &s) in sector_of_corner.iter().enumerate() {
+        let (t, c) = (corner / 3, corner % 3);
+        facets[s].push(t);
+        let p = verts[tris[t][c] as usize];
+        let (u, v) = (verts[tris[t][(c + 1) % 3] as usize] - p, verts[tris[t][(c + 2) % 3] as usize] - p);
+        let angle = u.cross(&v).norm().atan2(u.dot(&v));
+        match spans[s].iter_mut().find(|(q, _)| *q == plane[t]) {
+            Some((_, a)) => *a += angle,
+            None => spans[s].push((plane[t], angle)),
+        }
+    }
+    // The planes that are faces: spanning FACE_SPAN at some vertex.
+    let mut is_face = vec![false; tris.len()];
+    for &(q, angle) in spans.iter().flatten() {
+        if angle >= FACE_SPAN {
+            is_face[q] = true;
+        }
+    }
+    for (s, f) in facets.iter().enumerate() {
+        let mut faces: Vec<usize> = f.iter().map(|&t| plane[t]).filter(|&p| is_face[p]).collect();
+        faces.sort_unstable();
+        faces.dedup();
+        let [face] = faces[..] else { continue };
+        let off: Vec<usize> = f.iter().copied().filter(|&t| plane[t] != face).collect();
+        if off.is_empty() {
+            continue;
+        }
+        let on = f.iter().copied().find(|&t| plane[t] == face).expect("a facet in the face");
+        let n = tool.normal(on as u32);
+        let x = sectors[s].x;
+        // Across the edge: towards the off-face facets' centroids, in the face's plane.
+        let towards: Vector = off
+            .iter()
+            .map(|&t| {
+                let c = tris[t].iter().map(|&v| verts[v as usize].coords).sum::<Vector>() / 3.0 - x.coords;
+                (c - n * n.dot(&c)).try_normalize(0.0).unwrap_or_else(Vector::zeros)
+            })
+            .sum();
+        let Some(m) = towards.try_normalize(1e-9) else { continue };
+        let longest = off
+            .iter()
+            .flat_map(|&t| {
+                (0..3).map(move |c| (verts[tris[t][(c + 1) % 3] as usize] - verts[tris[t][c] as usize]).norm())
+            })
+            .fold(0.0, f64::max);
+        let sec = &mut sectors[s];
+        sec.n = n;
+        sec.edge = Some(FaceEdge { m, h_off: (SUPPORT_OVER_EDGE * longest).min(sec.h) });
+    }
+}
+
+/// The curvature of a sector on a face's edge: `kappa m m^T`, kappa fitted to the normals of
+/// its neighbours across the edge (Weingarten along m, weighted least squares as
+/// [`fit_curvature`]); zero where none lies across it.
+fn fit_edge_curvature(sectors: &[Sector], s: usize, edge: &FaceEdge, neighbours: &[usize]) -> Matrix3<f64> {
+    let sec = &sectors[s];
+    let (mut num, mut den) = (0.0, 0.0);
+    for &j in neighbours {
+        let o = &sectors[j];
+        let d = o.x - sec.x;
+        let a = edge.m.dot(&d);
+        let len2 = (d - sec.n * sec.n.dot(&d)).norm_squared();
+        if a <= 0.0 || len2 <= 0.0 {
+            continue;
+        }
+        let w = 1.0 / len2;
+        num += w * a * edge.m.dot(&(o.n - sec.n));
+        den += w * a * a;
+    }
+    if den <= 0.0 {
+        return Matrix3::zeros();
+    }
+    edge.m * edge.m.transpose() * (num / den)
+}
+
 /// The curvature tensor of sector `s` fitted to its neighbours' normals: in the tangent frame
 /// (t1, t2) of n_s, the tangential change of the normal to each neighbour j is K times the
 /// tangential offset (Weingarten), weighted least squares over the neighbours; lifted to 3-D.
@@ -625,6 +822,49 @@ mod tests {
             assert!((s.point - Point::new(q.x, q.y, 0.0)).norm() < 1e-13, "{}", s.point);
             assert!((s.normal - tool.normal(s.triangle)).norm() < 1e-13);
         }
+    }
+
+    #[test]
+    fn a_dies_face_stays_flat_up_to_its_fillet_and_the_fillet_stays_round() {
+        // A die's flat face meets its entry fillet tangentially (opening R 80 mm, fillet 10 mm,
+        // eight facets over its quarter turn): the face's smooth surface is the face's plane
+        // (averaged over both sides, the edge's sectors tilted by half a facet's turn, 0.08 rad
+        // on the face, and bulged out of it by 0.4 mm), and the fillet is followed about as
+        // closely as by its facets: 1.5e-5 m from the face to 50 deg round it, 6e-5 m next to the
+        // wall (a cylinder, not a face: its sectors average over the junction as before),
+        // against the facets' 4.7e-5 m.
+        let (opening, fillet) = (0.08, 0.01);
+        let tool = shapes::die_ring(opening, fillet, 0.22, 0.07, 192, [8, 8, 12]).into_surface().unwrap();
+        let smooth = SmoothSurface::new(&tool);
+        // Beyond the reach of the fillet's own sectors (1.5 times its facets' longest edge) the
+        // face is its plane; nearer, the fillet's quadrics run on into the face and it recedes
+        // into the die by micrometres (4.4e-6 m at the edge), never out of it.
+        let reach = 1.5 * (fillet * std::f64::consts::FRAC_PI_2 / 7.0).hypot(std::f64::consts::TAU * 0.09 / 192.0);
+        let (mut face, mut recess, mut out) = (0.0f64, 0.0f64, 0.0f64);
+        for i in 0..400 {
+            let (r, t) = (opening + fillet + 1e-6 + 0.12 * (i as f64 / 399.0).powi(2), 0.37 * i as f64);
+            let s = smooth.project(&Point::new(r * t.cos(), r * t.sin(), -0.003));
+            // The die's solid lies at z > 0, the blank's side at z < 0.
+            out = out.max(-s.point.z);
+            if r > opening + fillet + reach {
+                face = face.max(s.point.z.abs()).max(s.normal.xy().norm());
+            } else {
+                recess = recess.max(s.point.z);
+            }
+        }
+        assert!(face < 1e-12, "past the fillet's reach the face leaves its plane by {face:e}");
+        assert!(out < 1e-15 && recess < 1e-5, "the face bulges out by {out:e} and in by {recess:e}");
+        let (mut smooth_err, mut facet_err) = (0.0f64, 0.0f64);
+        for i in 0..200 {
+            let (a, t) = (std::f64::consts::FRAC_PI_2 * i as f64 / 199.0, 0.61 * i as f64);
+            let (r, z) = (opening + fillet * (1.0 - a.sin()), fillet * (1.0 - a.cos()));
+            let q = Point::new(r * t.cos(), r * t.sin(), z);
+            let off = |p: &Point| ((p.x.hypot(p.y) - opening - fillet).hypot(p.z - fillet) - fillet).abs();
+            smooth_err = smooth_err.max(off(&smooth.project(&q).point));
+            facet_err = facet_err.max(off(&tool.closest_point(&q).point));
+        }
+        println!("die fillet: smooth {smooth_err:e} facets {facet_err:e}");
+        assert!(smooth_err < 2.0 * facet_err, "smooth {smooth_err:e} facets {facet_err:e}");
     }
 
     #[test]

@@ -227,9 +227,9 @@ pub struct ToolsAt<'a> {
     pub punch_facets: u32,
     /// Where the punch is, from where the tool file has it.
     pub offset: Vector,
-    /// The die's facets, their normals facing the ply ([`die_facing`]). Not its smooth patches:
-    /// they blend the flat face into the entry fillet and bulge out of the face by a fraction of
-    /// a millimetre, into the blank the binder holds on it.
+    /// The die (its smooth surface, or its facets), its normals facing the ply ([`die_facing`]).
+    /// Its flat face stays flat up to the entry fillet (the smooth surface's face edges,
+    /// `geometry::smooth`): the binder holds the blank in that plane.
     pub die: Option<&'a dyn ContactSurface>,
 }
 

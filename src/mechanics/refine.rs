@@ -569,7 +569,14 @@ fn refine_among<L: Laws + ?Sized>(
         let normal = crate::kinematic::draw_in::seed_normal(kinematic).unwrap_or_else(Vector::z);
         (starts[0][origin_index], normal)
     });
-    let die: Option<&dyn ContactSurface> = forming.and_then(|f| f.die.as_deref()).map(|d| d as &dyn ContactSurface);
+    // The die is met as the punch is: on its smooth surface (on its facets a node at the entry
+    // fillet, whose facets turn by a tenth of a right angle each, crawls from one to the next).
+    let die_tool = forming.and_then(|f| f.die.as_deref());
+    let die_smooth = die_tool.filter(|_| on_patches).map(SmoothSurface::new);
+    let die: Option<&dyn ContactSurface> = match (&die_smooth, die_tool) {
+        (Some(s), _) => Some(s),
+        (None, d) => d.map(|d| d as &dyn ContactSurface),
+    };
     let plan_view = forming.map(|f| PlanView::across(&f.stroke));
     // The nodes that may move at all (the binder grips only these).
     let body: Vec<bool> = freedom.iter().map(|f| f.dofs() > 0).collect();
