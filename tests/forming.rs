@@ -106,18 +106,30 @@ fn forming_keys_are_checked_before_anything_runs() {
         ),
         ("mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, 0.05]\ndie = \"nothing.obj\"\n", "die", "nothing.obj"),
     ] {
-        std::fs::write(tmp.path().join("scene.toml"), format!("{head}{tail}")).unwrap();
-        let run = assert_cmd::Command::cargo_bin("drape")
-            .unwrap()
-            .arg("run")
-            .arg(tmp.path().join("scene.toml"))
-            .arg("--out")
-            .arg(tmp.path().join("out"))
-            .assert()
-            .code(2);
-        let err = String::from_utf8_lossy(&run.get_output().stderr).to_string();
+        let err = crate::common::refused_scene(tmp.path(), &format!("{head}{tail}"));
         assert!(err.contains(&format!("field `{field}`")) && err.contains(says), "{tail}: {err}");
     }
+}
+
+/// The largest distance (m) of a square n x n net's nodes `x` from the images of their mirror
+/// nodes in the x and y planes and in the diagonal (warp and weft swapped).
+fn mirror_error(x: &[[f64; 3]], n: usize) -> f64 {
+    let at = |i: usize, j: usize| x[i * n + j];
+    let mut worst: f64 = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let p = at(i, j);
+            for (q, image) in [
+                (at(n - 1 - i, j), [-p[0], p[1], p[2]]),
+                (at(i, n - 1 - j), [p[0], -p[1], p[2]]),
+                (at(j, i), [p[1], p[0], p[2]]),
+            ] {
+                let d = ((q[0] - image[0]).powi(2) + (q[1] - image[1]).powi(2) + (q[2] - image[2]).powi(2)).sqrt();
+                worst = worst.max(d);
+            }
+        }
+    }
+    worst
 }
 
 /// A hemispherical punch rising into a square blank of a balanced fabric clamped outside a round
@@ -151,15 +163,7 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
     let (stdout, row, net) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
     assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
     assert_eq!(net["status"]["placed"], n * n, "{}", net["status"]);
-    let x: Vec<[f64; 3]> = net["nodes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let p = p.as_array().unwrap();
-            [0, 1, 2].map(|c| p[c].as_f64().unwrap())
-        })
-        .collect();
+    let x = crate::common::all_nodes(&net);
     // The nodes meet the punch's smooth surface, which lies within this share of the radius of
     // the sphere its facets stand for (their sagitta is 5e-4 R at 24 subdivisions).
     const SMOOTH_SHARE: f64 = 1e-4;
@@ -167,21 +171,7 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
         let inside = r - (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
         assert!(p[2] < 0.0 || inside < SMOOTH_SHARE * r, "node {p:?} is inside the punch by {inside} m");
     }
-    let at = |i: usize, j: usize| x[i * n + j];
-    let mut worst: f64 = 0.0;
-    for i in 0..n {
-        for j in 0..n {
-            let p = at(i, j);
-            for (q, image) in [
-                (at(n - 1 - i, j), [-p[0], p[1], p[2]]),
-                (at(i, n - 1 - j), [p[0], -p[1], p[2]]),
-                (at(j, i), [p[1], p[0], p[2]]),
-            ] {
-                let d = ((q[0] - image[0]).powi(2) + (q[1] - image[1]).powi(2) + (q[2] - image[2]).powi(2)).sqrt();
-                worst = worst.max(d);
-            }
-        }
-    }
+    let worst = mirror_error(&x, n);
     assert!(worst < MIRROR_SPACINGS * spacing, "mirror images differ by {worst} m\n{stdout}");
     let draw_in: DrawIn = serde_json::from_value(row["draw_in"].clone()).unwrap();
     let most = |fibre: bool| {
@@ -357,15 +347,7 @@ fn a_hemisphere_drawn_through_a_die_with_an_entry_fillet_stays_out_of_both_tools
     let (stdout, _, net) = run(tmp.path(), &[("punch.obj", &punch), ("die.obj", &die)], &scene);
     assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
     assert_eq!(net["status"]["placed"], n * n, "{}", net["status"]);
-    let x: Vec<[f64; 3]> = net["nodes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let p = p.as_array().unwrap();
-            [0, 1, 2].map(|c| p[c].as_f64().unwrap())
-        })
-        .collect();
+    let x = crate::common::all_nodes(&net);
     // Out of the punch (its smooth surface lies within 1e-4 R of the sphere) and the die (within
     // its fillet's torus and its wall, its smooth surface within a sagitta of the facets).
     let sagitta = {
@@ -392,21 +374,7 @@ fn a_hemisphere_drawn_through_a_die_with_an_entry_fillet_stays_out_of_both_tools
             assert!((p[2] - face).abs() < 1e-9, "node {p:?} left the binder's plane");
         }
     }
-    let at = |i: usize, j: usize| x[i * n + j];
-    let mut worst: f64 = 0.0;
-    for i in 0..n {
-        for j in 0..n {
-            let p = at(i, j);
-            for (q, image) in [
-                (at(n - 1 - i, j), [-p[0], p[1], p[2]]),
-                (at(i, n - 1 - j), [p[0], -p[1], p[2]]),
-                (at(j, i), [p[1], p[0], p[2]]),
-            ] {
-                let d = ((q[0] - image[0]).powi(2) + (q[1] - image[1]).powi(2) + (q[2] - image[2]).powi(2)).sqrt();
-                worst = worst.max(d);
-            }
-        }
-    }
+    let worst = mirror_error(&x, n);
     // The die's quads are split along one diagonal each, so mirror facets are not images of each
     // other and neither are their smooth surfaces (0.02 spacings measured; 1.7e-12 with the
     // punch alone, above).

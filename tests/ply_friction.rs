@@ -15,34 +15,16 @@ fn card() -> PathBuf {
 /// Write the tools and `scene` into `dir` and run it, whatever its exit code (a ply that slides
 /// ends the run with 1 after writing what it has): the code, the output folder, the CLI's output.
 fn run_any(dir: &Path, tools: &[(&str, &TriangleMesh)], scene: &str) -> (i32, PathBuf, String) {
-    for (name, mesh) in tools {
-        std::fs::write(dir.join(name), mesh.to_obj_string()).unwrap();
-    }
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    crate::common::write_scene(dir, tools, scene);
     let out = dir.join("out");
-    let run = assert_cmd::Command::cargo_bin("drape")
-        .unwrap()
-        .arg("run")
-        .arg(dir.join("scene.toml"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = crate::common::drape_run(dir).output().unwrap();
     let text = format!("{}{}", String::from_utf8_lossy(&run.stdout), String::from_utf8_lossy(&run.stderr));
     (run.status.code().unwrap_or(-1), out, text)
 }
 
 /// The nodes of a net JSON.
 fn nodes(net: &serde_json::Value) -> Vec<Point> {
-    net["nodes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let p = p.as_array().unwrap();
-            Point::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap())
-        })
-        .collect()
+    crate::common::all_nodes(net).into_iter().map(Point::from).collect()
 }
 
 /// A plate tilted by `a` about the x axis (downhill along -y), in facets of 5 mm: the surface
@@ -164,16 +146,7 @@ fn a_bad_ply_friction_exits_2_naming_the_field() {
         format!("tool = \"plate.obj\"\n{}", ply("ply_friction = inf\n")),
         format!("tool = \"plate.obj\"\n{}", ply("ply_friction = nan\n")),
     ] {
-        std::fs::write(tmp.path().join("scene.toml"), &scene).unwrap();
-        let run = assert_cmd::Command::cargo_bin("drape")
-            .unwrap()
-            .arg("run")
-            .arg(tmp.path().join("scene.toml"))
-            .arg("--out")
-            .arg(tmp.path().join("out"))
-            .assert()
-            .code(2);
-        let err = String::from_utf8_lossy(&run.get_output().stderr).to_string();
+        let err = crate::common::refused_scene(tmp.path(), &scene);
         assert!(err.contains("field `ply_friction`") && err.contains(">= 0"), "{scene}: {err}");
         assert!(!tmp.path().join("out").exists(), "{scene}: nothing is written");
     }
