@@ -135,6 +135,8 @@ pub fn refine_net(
         Some(material),
         Some(&settings.sheet),
     ));
+    // This refinement forms nothing, whatever the net it started from was formed by.
+    out.meta.forming = None;
     out.timing.generators_ms = 0.0;
     out.timing.fill_ms = solve_ms;
     out.timing.total_ms = solve_ms;
