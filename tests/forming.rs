@@ -182,7 +182,11 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
     // beside the draw-in.
     let formed = &net["meta"]["forming"];
     assert_eq!(formed["stroke_m"], serde_json::json!([0.0, 0.0, stroke]), "{formed}");
-    assert_eq!(formed["increments"], net["meta"]["solver"]["increments"].as_array().unwrap().len(), "{formed}");
+    let increments = net["meta"]["solver"]["increments"].as_array().unwrap();
+    assert_eq!(formed["increments"], increments.len(), "{formed}");
+    // Each increment says how many of the solver's iterations it took.
+    let per_increment: u64 = increments.iter().map(|i| i["iterations"].as_u64().unwrap()).sum();
+    assert_eq!(per_increment, net["meta"]["solver"]["iterations"].as_u64().unwrap());
     assert_eq!(formed["die"], false);
     assert_eq!(formed["binder"]["pressure_pa"], 1.0e4);
     assert_eq!(formed["binder"]["outline_m"].as_array().unwrap().len(), 24);

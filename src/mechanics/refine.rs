@@ -181,6 +181,8 @@ pub struct Increment {
     /// Solves: the first with the normal forces of the state before it, each next one with
     /// those of the last solution.
     pub solves: usize,
+    /// Solver iterations over its solves (where a forming stroke or a load path spends them).
+    pub iterations: usize,
     /// How much the normal forces changed over the last solve, relative to their sum
     /// ([`LAG_TOLERANCE`]: settled below it).
     pub lag_change: f64,
@@ -664,7 +666,8 @@ fn refine_among<L: Laws + ?Sized>(
         }
         lag = FrictionLag::new(friction, stick_distance, &x, bear(&x, &eval));
         let limit = slide_limit(&lag, kinematic.spacing);
-        let mut increment = Increment { load_factor: step as f64 / load_steps as f64, solves: 0, lag_change: 0.0 };
+        let mut increment =
+            Increment { load_factor: step as f64 / load_steps as f64, solves: 0, iterations: 0, lag_change: 0.0 };
         // The iterations of a load step, shared by its solves.
         let mut budget = solver_settings.max_iterations;
         let ok = loop {
@@ -680,6 +683,7 @@ fn refine_among<L: Laws + ?Sized>(
             }
             let report = solve(&frictional, &mut x, &cons, &this_solve);
             budget = budget.saturating_sub(report.iterations.len());
+            increment.iterations += report.iterations.len();
             let outcome = report.outcome;
             steps.push(report);
             let now = bear(&x, &objective.evaluate(&x, false));
