@@ -288,16 +288,14 @@ impl<'a> SmoothSurface<'a> {
 
     /// The longest edge of facet `t`.
     fn longest_edge(&self, t: u32) -> f64 {
-        let c = self.tool.corners(t);
-        (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max)
+        longest_edge(&self.tool.corners(t))
     }
 
     /// Facet `t`'s bounding box grown by [`FACET_REACH_OVER_EDGE`] of its longest edge
     /// (computed again at each query rather than kept: 48 bytes a facet on large tools).
     fn facet_box(&self, t: u32) -> Aabb {
         let c = self.tool.corners(t);
-        let longest = (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max);
-        let grow = Vector::repeat(FACET_REACH_OVER_EDGE * longest);
+        let grow = Vector::repeat(FACET_REACH_OVER_EDGE * longest_edge(&c));
         Aabb::new(c[0].inf(&c[1]).inf(&c[2]) - grow, c[0].sup(&c[1]).sup(&c[2]) + grow)
     }
 
@@ -659,6 +657,11 @@ impl NearSectors {
     }
 }
 
+/// The longest edge of a facet with corners `c`.
+fn longest_edge(c: &[Point; 3]) -> f64 {
+    (0..3).map(|k| (c[(k + 1) % 3] - c[k]).norm()).fold(0.0, f64::max)
+}
+
 /// Marks the sectors on the edge of a flat face ([`FaceEdge`]): a face is a set of facets in one
 /// plane joined across edges that spans [`FACE_SPAN`] or more round one of its vertices (two
 /// coplanar facets of a quad on a cylinder are not a face). A sector with facets in exactly
@@ -725,12 +728,7 @@ fn face_edges(tool: &ToolSurface, sectors: &mut [Sector], sector_of_corner: &[us
             })
             .sum();
         let Some(m) = towards.try_normalize(1e-9) else { continue };
-        let longest = off
-            .iter()
-            .flat_map(|&t| {
-                (0..3).map(move |c| (verts[tris[t][(c + 1) % 3] as usize] - verts[tris[t][c] as usize]).norm())
-            })
-            .fold(0.0, f64::max);
+        let longest = off.iter().map(|&t| longest_edge(&tool.corners(t as u32))).fold(0.0, f64::max);
         let sec = &mut sectors[s];
         sec.n = n;
         sec.edge = Some(FaceEdge { m, h_off: (SUPPORT_OVER_EDGE * longest).min(sec.h) });

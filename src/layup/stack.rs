@@ -312,7 +312,7 @@ pub fn drape_layup(
         // the solver's record when mechanics ran, and an automatic ply's choice.
         // A ply on plies below with a coefficient of its own against them meets them with it.
         let refinement = match (&ply.refinement, k) {
-            (Some(r), 1..) if r.ply_friction.is_some() => Some(on_plies_below(r, &stack, tool, &results)),
+            (Some(r), 1..) => Some(on_plies_below(r, &stack, tool, &results)),
             (r, _) => r.clone(),
         };
         let (start_net, refined, choice) = match (start, &ply.auto, &refinement) {
@@ -392,7 +392,7 @@ pub fn drape_layup(
 /// three (a facet across the edge of the plies below goes to the side most of it lies on).
 const COVERED_CORNERS: usize = 2;
 
-/// The refinement `r` of a ply that gives `ply_friction`, meeting the plies below it (`below`,
+/// The refinement `r` of a ply (as it is when it gives no `ply_friction`), meeting the plies below it (`below`,
 /// their results; `stack`, their thickness at every vertex of `tool`) with that coefficient:
 /// on the facets they cover ([`COVERED_CORNERS`] of whose corners they lie over), and under
 /// the binder when one of them reaches under it (outside its opening in plan). Elsewhere, and
