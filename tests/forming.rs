@@ -385,3 +385,75 @@ fn a_hemisphere_drawn_through_a_die_with_an_entry_fillet_stays_out_of_both_tools
     const DIE_MIRROR_SPACINGS: f64 = 0.05;
     assert!(worst < DIE_MIRROR_SPACINGS * spacing, "mirror images differ by {worst} m\n{stdout}");
 }
+
+/// A plate tilted by `a` about the y axis (rising along +x), `size` square.
+fn tilted_plate(a: f64, size: f64) -> TriangleMesh {
+    let TriangleMesh { vertices, triangles } = shapes::plate(size, size, 24, 24);
+    let (s, c) = a.sin_cos();
+    let vertices = vertices.into_iter().map(|p| drape::geometry::Point::new(p.x * c, p.y, p.x * s)).collect();
+    TriangleMesh { vertices, triangles }
+}
+
+/// A punch that moves along its own face carries the blank lying on it as friction allows
+/// (Coulomb acts on the slip between the two, not on the blank's motion in space): a blank on a
+/// plate tilted by a, carried up the slope and across it, rides along with the plate (every node
+/// moves by the stroke, within the issue's 1 mm of a ply that sticks) while tan a is within mu,
+/// and slides down off it (the named outcome) once mu falls short of tan a. On a level plate
+/// pushed sideways nothing but friction moves the blank either.
+#[test]
+fn a_punch_moving_along_its_face_carries_the_blank_friction_holds() {
+    // A ply that sticks moves no node further than this from where the plate carried it (m).
+    const STICK_MOVE: f64 = 1e-3;
+    let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+    for (a_deg, stroke, mu) in
+        [(0.0f64, [0.03, 0.0, 0.0], 0.2), (15.0, [0.03, 0.02, 0.0], 0.35), (20.0, [0.04, 0.0, 0.0], 0.5)]
+    {
+        let a = a_deg.to_radians();
+        // The stroke runs in the plate's plane: x up the slope, y across it.
+        let stroke = [stroke[0] * a.cos(), stroke[1], stroke[0] * a.sin()];
+        for (mu, holds) in [(mu, true), (0.9 * a.tan(), false)] {
+            if !holds && a_deg == 0.0 {
+                continue;
+            }
+            let tmp = tempfile::tempdir().unwrap();
+            let plate = tilted_plate(a, 0.4);
+            let scene = format!(
+                "units = \"m\"\ntool = \"plate.obj\"\nfriction = {mu}\n\
+                 [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, 0.0]\nwarp = [1.0, 0.0, 0.0]\n\
+                 material = \"{}\"\nspacing = 0.01\ngrid = [11, 11]\nmethod = \"mechanical\"\n\
+                 mode = \"pressed\"\nstart = \"flat\"\nsheet_normal = [{}, 0.0, {}]\n\
+                 stroke = [{}, {}, {}]\nmax_iterations = 400\n",
+                card.display(),
+                -a.sin(),
+                a.cos(),
+                stroke[0],
+                stroke[1],
+                stroke[2]
+            );
+            crate::common::write_scene(tmp.path(), &[("plate.obj", &plate)], &scene);
+            let out = tmp.path().join("out");
+            let run = crate::common::drape_run(tmp.path()).output().unwrap();
+            let stdout = String::from_utf8_lossy(&run.stdout).to_string() + &String::from_utf8_lossy(&run.stderr);
+            let net = read_json(&out.join("p.drape.json"));
+            if !holds {
+                assert_eq!(net["meta"]["solver"]["outcome"], "slides", "tilt {a_deg} deg, mu {mu}: {stdout}");
+                continue;
+            }
+            assert_eq!(net["meta"]["solver"]["converged"], true, "tilt {a_deg} deg, mu {mu}: {stdout}");
+            // Where the plate carried each node of the flat blank laid on it: the blank is laid
+            // where the plate begins its stroke (the scene's origin moved back by the stroke), so
+            // carried all the way it lies where the origin puts it on the plate's final place.
+            let (s, c) = a.sin_cos();
+            for (k, p) in crate::common::all_nodes(&net).iter().enumerate() {
+                let (i, j) = (k / 11, k % 11);
+                let (u, v) = ((i as f64 - 5.0) * 0.01, (j as f64 - 5.0) * 0.01);
+                let carried = [u * c, v, u * s];
+                let off = (0..3).map(|m| (p[m] - carried[m]).powi(2)).sum::<f64>().sqrt();
+                assert!(
+                    off < STICK_MOVE,
+                    "tilt {a_deg} deg, mu {mu}: node ({i}, {j}) is {off} m from where the plate carried it\n{stdout}"
+                );
+            }
+        }
+    }
+}

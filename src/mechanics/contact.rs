@@ -44,6 +44,11 @@ pub trait ContactSurface: Sync {
     fn locate_near(&self, p: &Point, range: f64, curved: bool, hint: Option<u32>) -> Option<Foot>;
     /// Computes the curvature of a foot found without it.
     fn curve(&self, foot: &mut Foot);
+    /// How far the surface at `foot` moved over the current increment (a punch on its stroke;
+    /// zero for a tool that stays still): friction measures a node's slip against it.
+    fn motion(&self, _foot: &Foot) -> Vector {
+        Vector::zeros()
+    }
 }
 
 impl ContactSurface for ToolSurface {

@@ -177,6 +177,11 @@ impl Forming {
     pub fn punch_offset(&self, step: usize, steps: usize) -> Vector {
         -self.stroke * (1.0 - step as f64 / steps as f64)
     }
+
+    /// How far the punch moves over increment `step` (from 1) of `steps`.
+    pub fn punch_step(&self, step: usize, steps: usize) -> Vector {
+        self.punch_offset(step, steps) - self.punch_offset(step - 1, steps)
+    }
 }
 
 impl Binder {
@@ -213,7 +218,13 @@ impl Binder {
     /// share of the fabric `area` (m^2) on each of its two faces (friction acts on both), `mu`
     /// the mean of the two faces' coefficients ([`super::friction::Coulomb::binder`]).
     pub fn bearing(&self, plane_normal: &Vector, area: f64, mu: f64) -> Bearing {
-        Bearing { normal: *plane_normal, force: 2.0 * self.pressure * area, mu, on_plies: false }
+        Bearing {
+            normal: *plane_normal,
+            force: 2.0 * self.pressure * area,
+            mu,
+            on_plies: false,
+            carried: Vector::zeros(),
+        }
     }
 }
 
@@ -227,6 +238,8 @@ pub struct ToolsAt<'a> {
     pub punch_facets: u32,
     /// Where the punch is, from where the tool file has it.
     pub offset: Vector,
+    /// How far the punch moved over this increment.
+    pub step: Vector,
     /// The die (its smooth surface, or its facets), its normals facing the ply ([`die_facing`]).
     /// Its flat face stays flat up to the entry fillet (the smooth surface's face edges,
     /// `geometry::smooth`): the binder holds the blank in that plane.
@@ -284,6 +297,14 @@ impl ContactSurface for ToolsAt<'_> {
             }
             // Curvature does not change with a translation.
             _ => self.punch.curve(foot),
+        }
+    }
+
+    fn motion(&self, foot: &Foot) -> Vector {
+        if foot.facet < self.punch_facets {
+            self.step
+        } else {
+            Vector::zeros()
         }
     }
 }

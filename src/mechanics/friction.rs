@@ -81,6 +81,10 @@ pub struct Bearing {
     /// Whether it bears on the plies below (their coefficient, `ply_friction`) rather than on a
     /// tool: what [`friction_needed`] asks about.
     pub on_plies: bool,
+    /// How far what it bears on moved over the increment (a punch's step; zero on a still
+    /// tool): a node that sticks moves with it, so its slip is measured from where the tool
+    /// carried its place ([`FrictionLag::new`]).
+    pub carried: Vector,
 }
 
 /// Coulomb's coefficients a ply meets: the tool's, and in a layup, where the ply lies on the
@@ -162,10 +166,12 @@ fn smoothed(s: f64, eps: f64) -> (f64, f64, f64) {
 }
 
 impl FrictionLag {
-    /// A lag at the state `x` (the origins) with its bearings, whose coefficients are at most
-    /// `mu`.
+    /// A lag at the state `x` with its bearings, whose coefficients are at most `mu`: each
+    /// node slips from where it is, carried on by what it bears on ([`Bearing::carried`]: a
+    /// node on a punch that moved sticks to it where the punch took its place).
     pub fn new(mu: f64, stick: f64, x: &[Point], bearing: Vec<Option<Bearing>>) -> Self {
-        FrictionLag { mu, stick, origin: x.to_vec(), bearing }
+        let origin = x.iter().zip(&bearing).map(|(p, b)| b.map_or(*p, |b| p + b.carried)).collect();
+        FrictionLag { mu, stick, origin, bearing }
     }
 
     /// The next lag of the same increment, at `x`, with the normal forces `bearing`: slips stay
@@ -387,7 +393,8 @@ pub fn bearings(cons: &Constraints, x: &[Point], eval: &Evaluation, coulomb: &Co
             let foot = foot_of(tool, cons, k, &x[k])?;
             let force = foot.normal.dot(&push[k]);
             let (mu, on_plies) = coulomb.on_facet(foot.facet);
-            (force > 0.0).then_some(Bearing { normal: foot.normal, force, mu, on_plies })
+            let carried = tool.motion(&foot);
+            (force > 0.0).then_some(Bearing { normal: foot.normal, force, mu, on_plies, carried })
         })
         .collect()
 }
@@ -525,8 +532,8 @@ mod tests {
         let x0 = vec![Point::new(0.0, 0.0, 0.0), Point::new(1.0, 0.0, 0.0)];
         let n = Vector::new(0.0, 0.3, 1.0).normalize();
         let bearing = vec![
-            Some(Bearing { normal: n, force: 2.0, mu: 0.4, on_plies: false }),
-            Some(Bearing { normal: Vector::z(), force: 0.5, mu: 0.3, on_plies: true }),
+            Some(Bearing { normal: n, force: 2.0, mu: 0.4, on_plies: false, carried: Vector::zeros() }),
+            Some(Bearing { normal: Vector::z(), force: 0.5, mu: 0.3, on_plies: true, carried: Vector::zeros() }),
         ];
         let lag = FrictionLag::new(0.4, 0.01, &x0, bearing);
         for x in [
@@ -562,7 +569,7 @@ mod tests {
                 for j in 0..9 {
                     let (p, n) = f(-0.4 + 0.1 * i as f64, -0.4 + 0.1 * j as f64);
                     x.push(p);
-                    b.push(Some(Bearing { normal: n, force: 1.0, mu: 0.0, on_plies: false }));
+                    b.push(Some(Bearing { normal: n, force: 1.0, mu: 0.0, on_plies: false, carried: Vector::zeros() }));
                 }
             }
             (x, b)
@@ -596,7 +603,11 @@ mod tests {
         let down = Vector::new(0.0, -a.cos(), -a.sin());
         let weight = Vector::new(0.0, 0.0, -2.0);
         let drive = vec![weight; 4];
-        let bearing = vec![Some(Bearing { normal: n, force: 2.0 * a.cos(), mu: 0.0, on_plies: false }); 4];
+        let bearing =
+            vec![
+                Some(Bearing { normal: n, force: 2.0 * a.cos(), mu: 0.0, on_plies: false, carried: Vector::zeros() });
+                4
+            ];
         let v = vec![down; 4];
         let (mu, of) = friction_needed(&v, &drive, &bearing).unwrap();
         assert!((mu - a.tan()).abs() < 1e-12 && of == Needed::Friction);
@@ -610,7 +621,8 @@ mod tests {
         let n = Vector::new(0.0, -a.sin(), a.cos());
         let down = Vector::new(0.0, -a.cos(), -a.sin());
         let drive = vec![Vector::new(0.0, 0.0, -2.0); 4];
-        let on = |mu, on_plies| Some(Bearing { normal: n, force: 2.0 * a.cos(), mu, on_plies });
+        let on =
+            |mu, on_plies| Some(Bearing { normal: n, force: 2.0 * a.cos(), mu, on_plies, carried: Vector::zeros() });
         let tool = 0.5 * a.tan();
         let bearing = vec![on(tool, false), on(tool, false), on(0.1, true), on(0.1, true)];
         let (mu, of) = friction_needed(&[down; 4], &drive, &bearing).unwrap();

@@ -621,6 +621,7 @@ fn refine_among<L: Laws + ?Sized>(
             punch: surface,
             punch_facets: tool.num_triangles() as u32,
             offset: f.punch_offset(step, load_steps),
+            step: f.punch_step(step, load_steps),
             die,
         });
         let binder = forming.and_then(|f| f.binder.as_ref());
