@@ -1,7 +1,7 @@
 //! Wrinkles: per cell of a draped net, how far the ply stands off the surface it was draped on
 //! (the tool gap) and how much it undulates about its own smoothed surface (the waviness); a
-//! cell wavier than a threshold is wrinkled, and the wrinkled cells' draped area is the ply's
-//! wrinkled area. (The bending energy density beside them comes from the mechanics' bending
+//! cell wavier than a threshold is wrinkled where the ply undulates (the wave test: a single
+//! bend is no wrinkle), and the wrinkled cells' draped area is the ply's wrinkled area. (The bending energy density beside them comes from the mechanics' bending
 //! term, `mechanics::energy::bending_energy_density`, which this layer cannot call: the caller
 //! hands it in.)
 //!
@@ -53,6 +53,47 @@
 //!   √2 σ⁴/R³ near the ply's edges, 0.11 mm for R = 50 mm at 5 mm spacing. A tool whose
 //!   curvature jumps (a fillet meeting a flat) within a few σ reads more there; the reading about
 //!   the tool does not, where the ply lies on it.
+//!
+//! **The wave test** ([`cell_undulating`]). The waviness reads a single bend as wavy too: the
+//! fit rounds a kink, so a ply folded by a slope jump Δ (tan θ for a fold by θ) deviates
+//! `Δ σ ρ(u/σ)` at a distance u across the kink, ρ = (|s| - E|s - X|)/2 with X drawn from
+//! the fit's equivalent kernel `φ(x)(3 - x²)/2`: a trough of -0.199 Δ σ at the kink, zero at
+//! ±0.61 σ, overshoots of +0.041 Δ σ at ±1.19 σ, read as a waviness of up to 0.098 Δ σ
+//! (continuous fit; the grid's cells, whose centres miss the kink's line, read 0.83-0.87 of it
+//! at 5 and 20 deg): a 45 deg fold at 5 mm reads 1 mm, above a 0.35 mm ply. And its deviation
+//! changes sign twice, as a wave's does: the fit's overshoot, not the ply's. So the test reads
+//! the ply's own bends, which nothing smooths: at each node along each fibre the second
+//! difference `p(-1) - 2 p + p(+1)` along the node's normal ([`node_bends`]). A **crest** is a
+//! node above the smoothed surface (deviation > 0) that bends convexly by more than b (bend <
+//! -b), a **trough** one below it that bends concavely by more than b; the ply **undulates**
+//! about a cell when along one of the four fibres through its corners, within its window, a
+//! crest lies between two troughs or a trough between two crests. A cell is wrinkled when its
+//! waviness exceeds the threshold and the ply undulates there; b = [`WAVE_BEND_FRACTION`] times
+//! the threshold. What it finds:
+//! - **A single kink, whatever θ and the spacing: never.** A net folded along a straight line,
+//!   `F(u) = A u + w max(0, u·ν)`, has the second differences `w (g(m-1) - 2 g(m) + g(m+1))`,
+//!   g = max(0, s) at equally spaced s: non-negative multiples of the one vector w (the slope's
+//!   jump), zero on the planes; along the node normals (which lie between the two planes') all
+//!   of one sign. No node bends the other way, so there is no crest next to the kink's trough
+//!   (the overshoots lie on the planes and do not bend), however wavy the cells read.
+//! - **A ripple `A sin(k u)`: wherever its waviness exceeds the threshold.** Its node bends
+//!   are `-4 A sin²(π d/λ) sin(k u)` (times the cosine of its slope) and its deviations
+//!   `A T sin(k u)`: each node is a crest or a trough by sign. In every half-wave a node lies
+//!   within π d/λ of the peak, |sin| >= cos(π d/λ), so with a reading `A T >= t` its bend
+//!   exceeds b = t when `4 sin²(π d/λ) cos(π d/λ) > T`: 1.50, 1.48, 1.36, 1.34, 1.42, 1.55 times
+//!   over at λ = 3, 4, 5, 6, 7, 8 spacings, growing past that, 1.12 at 2.5 spacings (it fails
+//!   under 2.45 spacings, by the worst phase, where the net can hardly show a wave). Every
+//!   half-wave has its crest or trough and a window holds three (a cell up to two rows past a
+//!   band of ripple still sees them within its window, as the band test in `tests/wrinkles.rs`
+//!   checks): the wrinkled cells are those whose reading exceeds the threshold, as before.
+//! - **Spheres, cylinders, fillets: never.** Their bends along a fibre have one sign (about
+//!   `-d²/R`; a cylinder's straight fibre zero up to rounding).
+//! - Not counted, by design or as a limit: an S (a step from one level to another: two bends
+//!   of opposite signs, one alternation); a ripple on a ply curved more than the ripple bends
+//!   (its bends `4 A sin²(π d/λ)` below the base's `d²/R` plus b never change sign: the test
+//!   reads the ply's own bends, not bends about a curved base). Counted: an undulation of the
+//!   computed net however it arose, e.g. the staircase a clamp edge oblique to the fibres
+//!   leaves on a coarse net (docs/ARCHITECTURE.md, "the wave test").
 //!
 //! **The threshold** ([`threshold`]): the ply's thickness ([`THICKNESS_FRACTION`] of it), else
 //! [`DEFAULT_THRESHOLD_M`]. A ply that undulates about its own smoothed surface by more than its
