@@ -16,7 +16,8 @@ use crate::energy_common::{Rng, TestLaws};
 use drape::geometry::{shapes, Point, TriangleMesh, Vector};
 use drape::kinematic::provenance::WrinkleThresholdFrom;
 use drape::kinematic::wrinkle::{
-    cell_waviness, gap_deviations, measure, node_deviations, node_gaps, SMOOTHING_SPACINGS, WINDOW_SIGMAS,
+    cell_undulating, cell_waviness, gap_deviations, measure, node_bends, node_deviations, node_gaps,
+    SMOOTHING_SPACINGS, WAVE_BEND_FRACTION, WINDOW_SIGMAS,
 };
 use drape::kinematic::{DrapeNet, NodeStatus};
 use drape::material::Fibre;
@@ -578,4 +579,190 @@ fn a_wrinkle_record_missing_a_complete_cell_is_refused() {
     let e = drape::io::write_net(&net, tmp.path(), &[drape::io::Format::Vtu]).unwrap_err();
     assert!(e.to_string().contains("meta.wrinkles.waviness_m"), "{e}");
     assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0);
+}
+
+/// Bends of a net that lies exactly on planes are zero up to the rounding of its positions
+/// (of order 1e-17 m for positions of order 0.1 m): a bend this small is taken as zero.
+const BEND_ROUNDING_M: f64 = 1e-12;
+
+/// A net folded along a straight hinge, isometrically (the fabric unstretched): flat for
+/// s <= 0, turned by `theta` (towards its normal, a valley, or away, a ridge) for s > 0, s the
+/// fabric distance across the hinge, which runs at `phi` to the warp `s0` past the centre node.
+fn kink_net(theta: f64, valley: bool, phi: f64, s0: f64, d: f64, n: usize) -> DrapeNet {
+    let up = if valley { 1.0 } else { -1.0 };
+    net_of(n, n, d, |u, v| {
+        let (s, t) = (u * phi.cos() + v * phi.sin() - s0, -u * phi.sin() + v * phi.cos());
+        let (x, z) = if s <= 0.0 { (s, 0.0) } else { (s * theta.cos(), up * s * theta.sin()) };
+        // Back to the frame of the fabric's directions.
+        Point::new(x * phi.cos() - t * phi.sin(), x * phi.sin() + t * phi.cos(), z)
+    })
+}
+
+/// A single kink is no wrinkle, whatever its angle and the spacing: folded at 5 to 150 deg,
+/// as a valley and as a ridge, the hinge along the warp, across it and at 20 and 45 deg to it,
+/// off the nodes, at 2, 5 and 10 mm. The waviness reads the kink (the fit rounds it: a trough
+/// at the kink between the fit's overshoots, `0.098 tan(theta) σ` at most for a small angle,
+/// see `kinematic::wrinkle`), above a threshold of half its largest reading, so the waviness
+/// alone would call it wrinkled; but every bend has the kink's sign (each is a non-negative
+/// multiple of the slope's jump across the hinge), so no node is both a crest and a trough in
+/// turn and no cell undulates: none is wrinkled.
+#[test]
+fn a_single_kink_is_not_wrinkled_at_any_angle_or_spacing() {
+    let n = 41;
+    let tool = flat_tool(10.0);
+    for (theta_deg, valley, phi_deg, d) in [
+        (5.0f64, true, 0.0f64, 0.005),
+        (20.0, false, 90.0, 0.002),
+        (45.0, true, 20.0, 0.010),
+        (45.0, false, 45.0, 0.005),
+        (90.0, true, 45.0, 0.002),
+        (120.0, false, 20.0, 0.010),
+        (150.0, true, 70.0, 0.005),
+        (10.0, false, 33.0, 0.010),
+    ] {
+        let (theta, phi) = (theta_deg.to_radians(), phi_deg.to_radians());
+        let net = kink_net(theta, valley, phi, 0.37 * d, d, n);
+        let bends = node_bends(&net);
+        let sign = if valley { 1.0 } else { -1.0 };
+        let (mut turned, mut against) = (0, 0);
+        for b in bends.iter().flat_map(|b| b.iter().flatten()) {
+            if b * sign > BEND_ROUNDING_M {
+                turned += 1;
+            }
+            if b * sign < -BEND_ROUNDING_M {
+                against += 1;
+            }
+        }
+        assert!(turned > 0 && against == 0, "{theta_deg} deg: {turned} bends with the kink, {against} against it");
+        // The record's waviness (the smaller of the readings about the ply and about the tool).
+        let largest = measure(&net, &tool, None, None).summary.max_waviness_m.unwrap();
+        let thickness = largest / 2.0;
+        let record = measure(&net, &tool, Some(thickness), None);
+        let wavy = record.waviness_m.iter().flatten().filter(|w| **w > thickness).count();
+        eprintln!(
+            "kink {theta_deg} deg ({}), hinge at {phi_deg} deg, d {d}: largest waviness {largest:.3e} m ({:.3} tan(theta) sigma), {wavy} cells wavier than {thickness:.3e} m, {} wrinkled",
+            if valley { "valley" } else { "ridge" },
+            largest / (theta.tan().abs() * SMOOTHING_SPACINGS * d),
+            record.summary.wrinkled_cells
+        );
+        assert!(wavy > 0);
+        assert!(record.undulating.iter().all(|u| *u == Some(false)), "{theta_deg} deg: a cell undulates");
+        assert_eq!(record.summary.wrinkled_cells, 0);
+        assert_eq!(record.summary.wrinkled_area_m2, 0.0);
+    }
+}
+
+/// A ripple `A sin(k u + phase)` on a plane undulates wherever its waviness reaches the
+/// threshold, so it is wrinkled exactly where it reads above it, as without the wave test:
+/// wavelengths of 2.5 to 8 spacings, along the warp, the weft and at 30 deg. With the threshold
+/// at the smallest reading of the cells whose windows are whole (the largest bend the wave test
+/// then asks for, `WAVE_BEND_FRACTION` of it), each of those cells undulates: every half-wave
+/// has a node whose bend `4 A sin²(π d/λ) |sin(k u + phase)|` (the second difference of the
+/// ripple) exceeds it, as the module's notes derive (a node within π d/λ of the half-wave's
+/// peak, |sin| >= cos(π d/λ), against a reading `A T`). With the threshold just above the
+/// largest reading no cell is wrinkled.
+#[test]
+fn a_ripple_undulates_wherever_it_reads_the_threshold() {
+    let n = 45;
+    let m = whole_window_margin();
+    let cv = n - 1;
+    let tool = flat_tool(10.0);
+    let mut rng = Rng(0x5eed_0033);
+    for (lambda, angle_deg, d) in
+        [(2.5, 0.0f64, 0.005), (3.0, 90.0, 0.004), (4.0, 30.0, 0.005), (6.0, 0.0, 0.003), (8.0, 90.0, 0.010)]
+    {
+        let (k, t) = (2.0 * PI / (lambda * d), angle_deg.to_radians());
+        let a = 0.05 * d;
+        let phase = PI * rng.next();
+        let net = net_of(n, n, d, |u, v| Point::new(u, v, a * (k * (u * t.cos() + v * t.sin()) + phase).sin()));
+        let inner: Vec<usize> =
+            (0..cv * cv).filter(|c| (m..cv - m).contains(&(c / cv)) && (m..cv - m).contains(&(c % cv))).collect();
+        let readings = cell_waviness(&net, &node_deviations(&net));
+        let (lo, hi) =
+            inner.iter().map(|&c| readings[c].unwrap()).fold((f64::MAX, 0.0f64), |(l, h), w| (l.min(w), h.max(w)));
+        // Just below the smallest reading: every inner cell is wavier.
+        let thickness = lo * (1.0 - 1e-9);
+        let record = measure(&net, &tool, Some(thickness), None);
+        assert_eq!(record.summary.wave_bend_m, Some(WAVE_BEND_FRACTION * thickness));
+        let undulating = inner.iter().filter(|&&c| record.undulating[c] == Some(true)).count();
+        let wrinkled = inner.iter().filter(|&&c| record.wrinkled(c) == Some(true)).count();
+        eprintln!(
+            "ripple {lambda} d at {angle_deg} deg, d {d}: readings in [{:.4}, {:.4}] A (T = {:.4}), {undulating} of {} inner cells undulate, {wrinkled} wrinkled",
+            lo / a,
+            hi / a,
+            transfer(lambda),
+            inner.len()
+        );
+        assert_eq!(undulating, inner.len(), "ripple {lambda} d: every inner cell undulates");
+        assert_eq!(wrinkled, inner.len(), "ripple {lambda} d: every inner cell is wrinkled");
+        // Every cell is wrinkled exactly where its waviness exceeds the threshold and it undulates.
+        let count = (0..cv * cv)
+            .filter(|&c| record.waviness_m[c].unwrap() > thickness && record.undulating[c] == Some(true))
+            .count();
+        assert_eq!(record.summary.wrinkled_cells, count);
+        // Above the largest reading: nothing is wrinkled, though the ply still undulates.
+        let above = measure(&net, &tool, Some(hi * (1.0 + 1e-9)), None);
+        assert!(inner.iter().all(|&c| above.undulating[c] == Some(true)));
+        let wavier = above.waviness_m.iter().flatten().filter(|w| **w > hi * (1.0 + 1e-9)).count();
+        assert_eq!(
+            above.summary.wrinkled_cells, wavier,
+            "cells outside the inner ones may read more (their windows are cut)"
+        );
+        assert!(inner.iter().all(|&c| above.wrinkled(c) == Some(false)));
+    }
+}
+
+/// Spheres and cylinders bend one way: every bend has one sign (the straight fibre of a
+/// cylinder's zero up to rounding), so no cell undulates and none is wrinkled, even against a
+/// threshold of half their largest waviness (the fit's error, largest near the edges), which the
+/// waviness alone would exceed.
+#[test]
+fn spheres_and_cylinders_do_not_undulate() {
+    let tool = flat_tool(10.0);
+    let nets = [
+        ("sphere", sphere_net(0.04, 0.004, 21)),
+        ("sphere", sphere_net(0.1, 0.005, 31)),
+        ("cylinder", cylinder_net(0.02, 0.004, 21, 15, Fibre::Warp)),
+        ("cylinder", cylinder_net(0.05, 0.005, 31, 21, Fibre::Weft)),
+    ];
+    for (what, net) in nets {
+        // One sign (which one depends on which side the net's normal, warp x weft, points to).
+        let bends: Vec<f64> = node_bends(&net).iter().flat_map(|b| b.iter().flatten()).copied().collect();
+        let (least, most) = bends.iter().fold((f64::MAX, f64::MIN), |(l, m), b| (l.min(*b), m.max(*b)));
+        assert!(
+            most <= BEND_ROUNDING_M || least >= -BEND_ROUNDING_M,
+            "{what}: bends from {least} m to {most} m, both ways"
+        );
+        let largest = measure(&net, &tool, None, None).summary.max_waviness_m.unwrap();
+        let thickness = largest / 2.0;
+        let record = measure(&net, &tool, Some(thickness), None);
+        let wavy = record.waviness_m.iter().flatten().filter(|w| **w > thickness).count();
+        eprintln!(
+            "{what}: largest waviness {largest:.3e} m, {wavy} cells over half of it, {} wrinkled",
+            record.summary.wrinkled_cells
+        );
+        assert!(wavy > 0);
+        assert!(record.undulating.iter().flatten().all(|u| !u));
+        assert_eq!(record.summary.wrinkled_cells, 0);
+    }
+}
+
+/// A record written before the wave test (no `undulating`) keeps its meaning: a cell is
+/// wrinkled on its waviness alone, as its summary counted; with the test, only where both hold.
+#[test]
+fn a_record_without_the_wave_test_is_wrinkled_on_its_waviness_alone() {
+    let d = 0.005;
+    let net = kink_net(30f64.to_radians(), true, 0.0, 0.37 * d, d, 31);
+    let thickness = waviness(&net).into_iter().fold(0.0, f64::max) / 2.0;
+    let mut record = measure(&net, &flat_tool(1.0), Some(thickness), None);
+    let cv = net.nv - 1;
+    let cells = (0..net.num_cells()).filter(|&c| net.cell_corners(c / cv, c % cv).is_some());
+    assert!(cells.clone().all(|c| record.wrinkled(c) == Some(false)));
+    record.undulating.clear();
+    let wavy = cells.clone().filter(|&c| record.waviness_m[c].unwrap() > thickness).count();
+    assert!(wavy > 0);
+    assert_eq!(cells.filter(|&c| record.wrinkled(c) == Some(true)).count(), wavy);
+    // And cell_undulating is what measure records.
+    let again = cell_undulating(&net, &node_deviations(&net), &node_bends(&net), WAVE_BEND_FRACTION * thickness);
+    assert!(again.iter().flatten().all(|u| !u));
 }

@@ -89,8 +89,18 @@ pub(crate) fn check_net_shears(net: &DrapeNet, frames: bool) -> Result<Vec<Optio
                 return bad(format!("meta.wrinkles.{what} holds {v}"));
             }
         }
+        // Without the wave test (a record written before it) the list is empty.
+        if !w.undulating.is_empty() && w.undulating.len() != cells {
+            return bad(format!(
+                "meta.wrinkles.undulating has {} entries for a {} x {} grid ({cells} cells)",
+                w.undulating.len(),
+                net.nu,
+                net.nv
+            ));
+        }
         let s = &w.summary;
-        let figures = [Some(s.threshold_m), Some(s.wrinkled_area_m2), s.max_waviness_m, s.max_tool_gap_m];
+        let figures =
+            [Some(s.threshold_m), Some(s.wrinkled_area_m2), s.max_waviness_m, s.max_tool_gap_m, s.wave_bend_m];
         if let Some(v) = figures.into_iter().flatten().chain(s.max_bending_energy_density_j_m2).find(|v| !v.is_finite())
         {
             return bad(format!("meta.wrinkles holds a figure of {v}"));
@@ -152,6 +162,9 @@ fn cell_problem(net: &DrapeNet, i: usize, j: usize, shear: Option<f64>, frames: 
             .find(|(_, list)| list[k].is_none());
         if let Some((what, _)) = missing {
             return Some(format!("cell ({i}, {j}) is complete but meta.wrinkles.{what} has no value for it"));
+        }
+        if !w.undulating.is_empty() && w.undulating[k].is_none() {
+            return Some(format!("cell ({i}, {j}) is complete but meta.wrinkles.undulating has no value for it"));
         }
     }
     if frames {

@@ -21,7 +21,8 @@ use std::path::Path;
 pub const CSV_HEADER: &str =
     "i,j,cx,cy,cz,shear_deg,warp_x,warp_y,warp_z,weft_x,weft_y,weft_z,normal_x,normal_y,normal_z";
 /// The columns after [`CSV_HEADER`] of a net that records its wrinkles (`meta.wrinkles`):
-/// waviness (m), wrinkled (1 where the waviness exceeds the record's threshold, else 0) and the
+/// waviness (m), wrinkled (1 where the waviness exceeds the record's threshold and the ply
+/// undulates, `WrinkleRecord::wrinkled`, else 0) and the
 /// tool gap (m); then `bending_energy_density_j_m2` when the record has it.
 pub const CSV_WRINKLE_COLUMNS: &str = "waviness_m,wrinkled,tool_gap_m";
 
@@ -52,7 +53,7 @@ fn write_csv_to<W: Write>(net: &DrapeNet, w: &mut W) -> io::Result<()> {
         if let Some(wr) = wrinkles {
             let at = |list: &[Option<f64>]| list[i * cv + j].expect("checked: complete cell");
             let waviness = at(&wr.waviness_m);
-            let wrinkled = (waviness > wr.summary.threshold_m) as u8;
+            let wrinkled = wr.wrinkled(i * cv + j).expect("checked: complete cell") as u8;
             extra += &format!(",{waviness:?},{wrinkled},{:?}", at(&wr.tool_gap_m));
             if bending {
                 extra += &format!(",{:?}", at(&wr.bending_energy_density_j_m2));

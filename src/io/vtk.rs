@@ -9,7 +9,7 @@
 //! CellData: `shear_deg` (Float64), `warp`, `weft`, `normal` (Float64 x 3, unit), `cell_i`,
 //! `cell_j` (Int32); for a net that records its wrinkles (`meta.wrinkles`, a ply of `drape
 //! run`) also `waviness_m` (Float64, m), `wrinkled` (Int32: 1 where the waviness exceeds the
-//! ply's threshold), `tool_gap_m` (Float64, m) and, for a ply with a material card,
+//! ply's threshold and the ply undulates, `WrinkleRecord::wrinkled`), `tool_gap_m` (Float64, m) and, for a ply with a material card,
 //! `bending_energy_density_j_m2` (Float64, J/m^2). PointData: `node_i`, `node_j` (Int32); for a
 //! refined net also how each node meets the tool (`meta.contact`): `contact_state` (Int32: 0
 //! free, 1 stick, 2 slip, 3 held; [`ContactState::code`]), `slip` (Float64, m, over all load
@@ -252,8 +252,8 @@ fn write_vtu_to<W: Write>(net: &DrapeNet, w: &mut W, encoding: VtuEncoding) -> i
         let cv = net.nv - 1;
         let at = |list: &[Option<f64>], (i, j): (usize, usize)| list[i * cv + j].expect("checked: complete cell");
         arrays.array(w, "Float64", "waviness_m", 1, 1, complete().map(|c| at(&wr.waviness_m, c)))?;
-        let threshold = wr.summary.threshold_m;
-        arrays.array(w, "Int32", "wrinkled", 1, 1, complete().map(|c| (at(&wr.waviness_m, c) > threshold) as i32))?;
+        let wrinkled = |(i, j): (usize, usize)| wr.wrinkled(i * cv + j).expect("checked: complete cell") as i32;
+        arrays.array(w, "Int32", "wrinkled", 1, 1, complete().map(wrinkled))?;
         arrays.array(w, "Float64", "tool_gap_m", 1, 1, complete().map(|c| at(&wr.tool_gap_m, c)))?;
         if !wr.bending_energy_density_j_m2.is_empty() {
             let values = complete().map(|c| at(&wr.bending_energy_density_j_m2, c));

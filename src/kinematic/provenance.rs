@@ -625,7 +625,13 @@ pub struct WrinkleSummary {
     /// The standard deviation of the Gaussian weights of the smoothed surface and of the
     /// waviness, in fibre spacings.
     pub smoothing_spacings: f64,
-    /// Cells whose waviness exceeds the threshold.
+    /// A crest or a trough of the wave test bends the ply by more than this, m (the bend:
+    /// the second difference of the positions along a fibre, along the normal): the
+    /// threshold times `kinematic::wrinkle::WAVE_BEND_FRACTION`. Absent from a record written
+    /// before the wave test (its cells are wrinkled on their waviness alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wave_bend_m: Option<f64>,
+    /// Cells whose waviness exceeds the threshold where the ply undulates (the wave test).
     pub wrinkled_cells: usize,
     /// Their draped area, m^2.
     pub wrinkled_area_m2: f64,
@@ -645,7 +651,7 @@ impl WrinkleSummary {
     pub fn describe(&self) -> String {
         let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.3} mm", v * 1e3));
         let mut s = format!(
-            "{} cells ({:.4} m^2) wavier than {:.3} mm (the {}); largest waviness {}, largest gap to the tool {}",
+            "{} cells ({:.4} m^2) wavier than {:.3} mm (the {}) where the ply undulates; largest waviness {}, largest gap to the tool {}",
             self.wrinkled_cells,
             self.wrinkled_area_m2,
             self.threshold_m * 1e3,
@@ -673,6 +679,11 @@ pub struct WrinkleRecord {
     /// Waviness: the amplitude of the ply's undulation about its own smoothed surface and about
     /// the tool, the smaller of the two, m.
     pub waviness_m: Vec<Option<f64>>,
+    /// The wave test: whether the ply undulates about the cell (a crest between two troughs or
+    /// a trough between two crests along a fibre through it, `kinematic::wrinkle`). Empty in a
+    /// record written before the wave test.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub undulating: Vec<Option<bool>>,
     /// The largest distance of the cell's corners from the surface the ply was draped on (the
     /// tool, or the tool offset by the plies below), m: large by design where a ply hangs off
     /// the tool.
@@ -680,4 +691,16 @@ pub struct WrinkleRecord {
     /// Bending energy per unit area, J/m^2 (empty when the ply has no material card).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub bending_energy_density_j_m2: Vec<Option<f64>>,
+}
+
+impl WrinkleRecord {
+    /// Whether cell `c` is wrinkled: its waviness exceeds the threshold and the ply undulates
+    /// there (without the wave test, in a record written before it: on its waviness alone);
+    /// `None` for a cell that is not complete. The one rule the VTU, the cells CSV and the
+    /// report's map use, and the summary's count.
+    pub fn wrinkled(&self, c: usize) -> Option<bool> {
+        let wavy = self.waviness_m.get(c).copied().flatten()? > self.summary.threshold_m;
+        let undulating = if self.undulating.is_empty() { true } else { self.undulating.get(c).copied().flatten()? };
+        Some(wavy && undulating)
+    }
 }

@@ -1,7 +1,7 @@
 //! Wrinkles: per cell of a draped net, how far the ply stands off the surface it was draped on
 //! (the tool gap) and how much it undulates about its own smoothed surface (the waviness); a
-//! cell wavier than a threshold is wrinkled, and the wrinkled cells' draped area is the ply's
-//! wrinkled area. (The bending energy density beside them comes from the mechanics' bending
+//! cell wavier than a threshold is wrinkled where the ply undulates (the wave test: a single
+//! bend is no wrinkle), and the wrinkled cells' draped area is the ply's wrinkled area. (The bending energy density beside them comes from the mechanics' bending
 //! term, `mechanics::energy::bending_energy_density`, which this layer cannot call: the caller
 //! hands it in.)
 //!
@@ -54,6 +54,47 @@
 //!   curvature jumps (a fillet meeting a flat) within a few σ reads more there; the reading about
 //!   the tool does not, where the ply lies on it.
 //!
+//! **The wave test** ([`cell_undulating`]). The waviness reads a single bend as wavy too: the
+//! fit rounds a kink, so a ply folded by a slope jump Δ (tan θ for a fold by θ) deviates
+//! `Δ σ ρ(u/σ)` at a distance u across the kink, ρ = (|s| - E|s - X|)/2 with X drawn from
+//! the fit's equivalent kernel `φ(x)(3 - x²)/2`: a trough of -0.199 Δ σ at the kink, zero at
+//! ±0.61 σ, overshoots of +0.041 Δ σ at ±1.19 σ, read as a waviness of up to 0.098 Δ σ
+//! (continuous fit; the grid's cells, whose centres miss the kink's line, read 0.83-0.87 of it
+//! at 5 and 20 deg): a 45 deg fold at 5 mm reads 1 mm, above a 0.35 mm ply. And its deviation
+//! changes sign twice, as a wave's does: the fit's overshoot, not the ply's. So the test reads
+//! the ply's own bends, which nothing smooths: at each node along each fibre the second
+//! difference `p(-1) - 2 p + p(+1)` along the node's normal ([`node_bends`]). A **crest** is a
+//! node above the smoothed surface (deviation > 0) that bends convexly by more than b (bend <
+//! -b), a **trough** one below it that bends concavely by more than b; the ply **undulates**
+//! about a cell when along one of the four fibres through its corners, within its window, a
+//! crest lies between two troughs or a trough between two crests. A cell is wrinkled when its
+//! waviness exceeds the threshold and the ply undulates there; b = [`WAVE_BEND_FRACTION`] times
+//! the threshold. What it finds:
+//! - **A single kink, whatever θ and the spacing: never.** A net folded along a straight line,
+//!   `F(u) = A u + w max(0, u·ν)`, has the second differences `w (g(m-1) - 2 g(m) + g(m+1))`,
+//!   g = max(0, s) at equally spaced s: non-negative multiples of the one vector w (the slope's
+//!   jump), zero on the planes; along the node normals (which lie between the two planes') all
+//!   of one sign. No node bends the other way, so there is no crest next to the kink's trough
+//!   (the overshoots lie on the planes and do not bend), however wavy the cells read.
+//! - **A ripple `A sin(k u)`: wherever its waviness exceeds the threshold.** Its node bends
+//!   are `-4 A sin²(π d/λ) sin(k u)` (times the cosine of its slope) and its deviations
+//!   `A T sin(k u)`: each node is a crest or a trough by sign. In every half-wave a node lies
+//!   within π d/λ of the peak, |sin| >= cos(π d/λ), so with a reading `A T >= t` its bend
+//!   exceeds b = t when `4 sin²(π d/λ) cos(π d/λ) > T`: 1.50, 1.48, 1.36, 1.34, 1.42, 1.55 times
+//!   over at λ = 3, 4, 5, 6, 7, 8 spacings, growing past that, 1.12 at 2.5 spacings (it fails
+//!   under 2.45 spacings, by the worst phase, where the net can hardly show a wave). Every
+//!   half-wave has its crest or trough and a window holds three (a cell up to two rows past a
+//!   band of ripple still sees them within its window, as the band test in `tests/wrinkles.rs`
+//!   checks): the wrinkled cells are those whose reading exceeds the threshold, as before.
+//! - **Spheres, cylinders, fillets: never.** Their bends along a fibre have one sign (about
+//!   `-d²/R`; a cylinder's straight fibre zero up to rounding).
+//! - Not counted, by design or as a limit: an S (a step from one level to another: two bends
+//!   of opposite signs, one alternation); a ripple on a ply curved more than the ripple bends
+//!   (its bends `4 A sin²(π d/λ)` below the base's `d²/R` plus b never change sign: the test
+//!   reads the ply's own bends, not bends about a curved base). Counted: an undulation of the
+//!   computed net however it arose, e.g. the staircase a clamp edge oblique to the fibres
+//!   leaves on a coarse net (docs/ARCHITECTURE.md, "the wave test").
+//!
 //! **The threshold** ([`threshold`]): the ply's thickness ([`THICKNESS_FRACTION`] of it), else
 //! [`DEFAULT_THRESHOLD_M`]. A ply that undulates about its own smoothed surface by more than its
 //! thickness no longer lies within the layer it takes up when the laminate is consolidated: the
@@ -93,6 +134,13 @@ pub const DEFAULT_THRESHOLD_M: f64 = 0.5e-3;
 /// The waviness threshold of a ply with a thickness, as a share of it: a ply undulating by more
 /// than its thickness cannot be consolidated flat within its own layer.
 pub const THICKNESS_FRACTION: f64 = 1.0;
+
+/// A crest or a trough of the wave test bends the ply by more than this share of the waviness
+/// threshold (the bend: the second difference of the positions along a fibre, along the node's
+/// normal). Every half-wave of a ripple from 2.5 spacings long whose reading reaches the
+/// threshold has a node bending by more (see the module's notes), and a bend this large is far
+/// above rounding.
+pub const WAVE_BEND_FRACTION: f64 = 1.0;
 
 /// A weighted fit's normal equations are solved by Cholesky unless a pivot falls below this
 /// share of their largest diagonal entry (nodes nearly on a line or a conic: too few to fix a
@@ -390,6 +438,108 @@ pub fn cell_waviness(net: &DrapeNet, deviations: &[Option<f64>]) -> Vec<Option<f
         .collect()
 }
 
+/// Each node's bend along the warp and along the weft (m): the second difference of the
+/// positions along the fibre, `p(-1) - 2 p + p(+1)`, along the node's normal (the sum of its
+/// complete cells' unit normals), negative where the ply turns away from its normal (convex,
+/// a crest's bend), positive where it turns towards it; `None` where the node or a neighbour
+/// along that fibre is not placed, or the node is not a corner of a complete cell. Of the net
+/// alone: no smoothing, so a kink's bends stay at the kink.
+pub fn node_bends(net: &DrapeNet) -> Vec<[Option<f64>; 2]> {
+    let (nu, nv) = (net.nu, net.nv);
+    if nu < 2 || nv < 2 {
+        return vec![[None, None]; nu * nv];
+    }
+    (0..nu * nv)
+        .into_par_iter()
+        .with_min_len(1 << 8)
+        .map(|k| {
+            let (i, j) = (k / nv, k % nv);
+            let Some(p) = net.node(i, j) else { return [None, None] };
+            let normal = [(-1, -1), (-1, 0), (0, -1), (0, 0)]
+                .into_iter()
+                .filter_map(|(a, b)| offset(i, j, a, b, nu - 1, nv - 1))
+                .filter_map(|(p, q)| net.cell_frame(p, q).map(|f| f.normal))
+                .fold(None, |acc: Option<Vector>, n| Some(acc.unwrap_or_else(Vector::zeros) + n))
+                .and_then(|n| n.try_normalize(0.0));
+            let Some(n) = normal else { return [None, None] };
+            let bend = |(a, b): (isize, isize)| {
+                let before = offset(i, j, -a, -b, nu, nv).and_then(|(p, q)| net.node(p, q))?;
+                let after = offset(i, j, a, b, nu, nv).and_then(|(p, q)| net.node(p, q))?;
+                Some((before.coords - 2.0 * p.coords + after.coords).dot(&n))
+            };
+            [bend((1, 0)), bend((0, 1))]
+        })
+        .collect()
+}
+
+/// A node's part in a wave along a fibre: a crest stands above the ply's smoothed surface and
+/// bends convexly, a trough stands below it and bends concavely, each by more than `bend`.
+fn lobe(deviation: Option<f64>, bend: Option<f64>, least: f64) -> i8 {
+    match (deviation, bend) {
+        (Some(d), Some(b)) if d > 0.0 && b < -least => 1,
+        (Some(d), Some(b)) if d < 0.0 && b > least => -1,
+        _ => 0,
+    }
+}
+
+/// The wave test of each cell, in cell order: whether the ply undulates about it, i.e. whether
+/// along one of the four fibres through its corners (the warp at its two columns, the weft at
+/// its two rows), within its window ([`WINDOW_SIGMAS`] σ of its centre), the nodes show a crest
+/// between two troughs or a trough between two crests (a crest: deviation above the smoothed
+/// surface, `deviations` ([`node_deviations`]), and a bend ([`node_bends`]) below `-least`; a
+/// trough: the opposite). `None` for a cell that is not complete. See the module's notes.
+pub fn cell_undulating(
+    net: &DrapeNet,
+    deviations: &[Option<f64>],
+    bends: &[[Option<f64>; 2]],
+    least: f64,
+) -> Vec<Option<bool>> {
+    let (nu, nv) = (net.nu, net.nv);
+    assert_eq!(deviations.len(), nu * nv, "one deviation per node");
+    assert_eq!(bends.len(), nu * nv, "one pair of bends per node");
+    let cv = nv.saturating_sub(1);
+    // The window's nodes on the four fibres through the cell's corners, in order along each:
+    // the warp at the cell's columns (offsets (a, 0), (a, 1)), the weft at its rows.
+    let about = window(-0.5);
+    let along = |fibre: usize, at: isize| -> Vec<(isize, isize)> {
+        about
+            .iter()
+            .filter(|&&(a, b, _)| if fibre == 0 { b == at } else { a == at })
+            .map(|&(a, b, _)| (a, b))
+            .collect::<Vec<_>>()
+    };
+    let lines: Vec<(usize, Vec<(isize, isize)>)> = [(0, 0), (0, 1), (1, 0), (1, 1)]
+        .into_iter()
+        .map(|(fibre, at)| {
+            let mut line = along(fibre, at);
+            line.sort_by_key(|&(a, b)| if fibre == 0 { a } else { b });
+            (fibre, line)
+        })
+        .collect();
+    (0..net.num_cells())
+        .into_par_iter()
+        .with_min_len(1 << 10)
+        .map(|c| {
+            let (i, j) = (c / cv, c % cv);
+            net.cell_corners(i, j)?;
+            let waves = lines.iter().any(|(fibre, line)| {
+                // The alternations of the lobes met along the line: two make a wave.
+                let (mut last, mut lobes) = (0i8, 0usize);
+                for &(a, b) in line {
+                    let Some((p, q)) = offset(i, j, a, b, nu, nv) else { continue };
+                    let k = p * nv + q;
+                    let s = lobe(deviations[k], bends[k][*fibre], least);
+                    if s != 0 && s != last {
+                        (last, lobes) = (s, lobes + 1);
+                    }
+                }
+                lobes >= 3
+            });
+            Some(waves)
+        })
+        .collect()
+}
+
 /// Each cell's tool gap (m): the largest distance of its corners from the surface (`gaps`,
 /// [`node_gaps`]), in cell order; `None` for a cell that is not complete.
 pub fn cell_tool_gaps(net: &DrapeNet, gaps: &[Option<f64>]) -> Vec<Option<f64>> {
@@ -417,8 +567,8 @@ pub fn measure(
     bending: Option<Vec<Option<f64>>>,
 ) -> WrinkleRecord {
     let gaps = node_gaps(net, surface);
-    let (own, about_tool) = deviations(net, Some(&gaps));
-    let (own, about_tool) = (cell_waviness(net, &own), cell_waviness(net, &about_tool));
+    let (own_deviations, about_tool) = deviations(net, Some(&gaps));
+    let (own, about_tool) = (cell_waviness(net, &own_deviations), cell_waviness(net, &about_tool));
     // The smaller reading: an undulation the tool has, or a smooth ply's gap that the tool's
     // shape bends, is no wrinkle (see the module's notes).
     let waviness: Vec<Option<f64>> = own
@@ -433,28 +583,36 @@ pub fn measure(
     let bending = bending.unwrap_or_default();
     assert!(bending.is_empty() || bending.len() == net.num_cells(), "one bending energy density per cell");
     let (threshold_m, threshold_from) = threshold(thickness);
-    let cv = net.nv.saturating_sub(1);
-    let (mut wrinkled_cells, mut wrinkled_area_m2) = (0, 0.0);
-    for (c, w) in waviness.iter().enumerate() {
-        if w.is_some_and(|w| w > threshold_m) {
-            wrinkled_cells += 1;
-            wrinkled_area_m2 += net.cell_area(c / cv, c % cv).unwrap_or(0.0);
-        }
-    }
+    // The wave test: a single bend (a kink, a fillet, a sphere) is no wrinkle however wavy it
+    // reads; the ply must undulate (see the module's notes).
+    let wave_bend_m = WAVE_BEND_FRACTION * threshold_m;
+    let undulating = cell_undulating(net, &own_deviations, &node_bends(net), wave_bend_m);
     let largest = |v: &[Option<f64>]| v.iter().flatten().copied().reduce(f64::max);
-    WrinkleRecord {
+    let mut record = WrinkleRecord {
         summary: WrinkleSummary {
             threshold_m,
             threshold_from,
             smoothing_spacings: SMOOTHING_SPACINGS,
-            wrinkled_cells,
-            wrinkled_area_m2,
+            wave_bend_m: Some(wave_bend_m),
+            wrinkled_cells: 0,
+            wrinkled_area_m2: 0.0,
             max_waviness_m: largest(&waviness),
             max_tool_gap_m: largest(&tool_gap),
             max_bending_energy_density_j_m2: largest(&bending),
         },
         waviness_m: waviness,
+        undulating,
         tool_gap_m: tool_gap,
         bending_energy_density_j_m2: bending,
+    };
+    let cv = net.nv.saturating_sub(1);
+    let (mut wrinkled_cells, mut wrinkled_area_m2) = (0, 0.0);
+    for c in 0..net.num_cells() {
+        if record.wrinkled(c) == Some(true) {
+            wrinkled_cells += 1;
+            wrinkled_area_m2 += net.cell_area(c / cv, c % cv).unwrap_or(0.0);
+        }
     }
+    (record.summary.wrinkled_cells, record.summary.wrinkled_area_m2) = (wrinkled_cells, wrinkled_area_m2);
+    record
 }

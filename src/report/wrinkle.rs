@@ -1,7 +1,8 @@
 //! The wrinkle map of a ply (`<ply>-wrinkles.png`): each cell by its waviness (the amplitude of
 //! its undulation about the ply's own smoothed surface and about the tool, the smaller,
 //! `meta.wrinkles`, see `kinematic::wrinkle`), on the shear map's views and colours from zero,
-//! the cells wavier than the ply's threshold hatched and the threshold marked on the bar.
+//! the wrinkled cells hatched (wavier than the ply's threshold where the ply undulates) and the
+//! threshold marked on the bar.
 use super::render::{LegendItem, Mark, ShadedPicture, Swatch};
 use super::shade::{self, CellPaint, PlyScene, ToolMesh};
 use super::view::{nice_ceil, shear_colour};
@@ -27,7 +28,7 @@ pub(super) fn wrinkle_picture<'a>(
     let paint: Vec<Option<CellPaint>> = (0..net.num_cells())
         .map(|c| {
             let w = record.waviness_m.get(c).copied().flatten()?;
-            Some(CellPaint { colour: shear_colour(w * 1e3, limit), hatch: w > s.threshold_m })
+            Some(CellPaint { colour: shear_colour(w * 1e3, limit), hatch: record.wrinkled(c) == Some(true) })
         })
         .collect();
     let scene = PlyScene::new(net, tool, paint, false);
