@@ -387,3 +387,45 @@ fn the_speed_accuracy_study_takes_friction_as_an_axis() {
         .code(2);
     assert!(!tmp.path().join("bad").join("speed_accuracy.json").exists());
 }
+
+/// A state already in equilibrium with friction (a formed ply held again) starts with the
+/// friction forces that hold it: after `FrictionLag::preload` the potential's gradient at each
+/// node that bears is minus the tangential part of its push (the fabric's forces less the loads,
+/// which the solver balances against the gradient), exactly, up to its capacity mu lambda; a
+/// push beyond it meets the full capacity; a node that does not bear is left alone.
+#[test]
+fn preloaded_friction_balances_the_tangential_push_up_to_its_capacity() {
+    use drape::mechanics::forming::Binder;
+    use drape::mechanics::friction::FrictionLag;
+    use drape::mechanics::{Constraints, Evaluation, Freedom};
+    // Rounding of the slip's inversion through sqrt (relative to the force).
+    const BALANCE: f64 = 1e-9;
+    let binder = Binder { outline: Vec::new(), pressure: 1.0e4, gripping: None };
+    let (mu, area, stick) = (0.3, 1e-4, 5e-6);
+    let normal = Vector::new(0.0, 0.6, 0.8);
+    // Capacity mu * 2 p A = 0.6 N on each bearing node.
+    let capacity = mu * 2.0 * binder.pressure * area;
+    let x = vec![Point::new(0.1, 0.2, 0.3), Point::new(-0.2, 0.0, 0.1), Point::new(0.0, 0.0, 0.0)];
+    let bearing = vec![Some(binder.bearing(&normal, area, mu)), Some(binder.bearing(&normal, area, mu)), None];
+    // Tangential pushes of 0.4 and 0.9 N (below and beyond the capacity), plus a normal part.
+    let (t1, t2) = (Vector::new(0.4, 0.0, 0.0), Vector::new(0.0, 0.72, -0.54));
+    let internal = vec![t1 + normal * 2.0, t2 - normal * 0.5, Vector::new(1.0, 0.0, 0.0)];
+    let eval = Evaluation { energy: 0.0, internal, external: vec![Vector::zeros(); 3], hessian: None };
+    let cons = Constraints {
+        freedom: vec![Freedom::Free; 3],
+        mode: ContactMode::Free,
+        tool: None,
+        spacing: 0.005,
+        stitched: None,
+        stick: false,
+    };
+    let mut lag = FrictionLag::new(mu, stick, &x, bearing);
+    lag.preload(&cons, &x, &eval);
+    let gradient = lag.gradient(&x);
+    assert!((gradient[0] + t1).norm() < BALANCE * t1.norm(), "{:?} against the push {t1:?}", gradient[0]);
+    let full = -t2.normalize() * capacity;
+    assert!((gradient[1] - full).norm() < BALANCE * capacity, "{:?}, the capacity against {t2:?}", gradient[1]);
+    assert!((lag.slip(1, &x[1]).norm() - stick).abs() < BALANCE * stick, "at the capacity, the stick distance");
+    assert_eq!(gradient[2], Vector::zeros());
+    assert_eq!(lag.origin[2], x[2]);
+}

@@ -531,12 +531,28 @@ pub struct FormingRecord {
     pub increments: usize,
     /// Whether a die stood opposite the punch.
     pub die: bool,
+    /// The die's file, as the scene named it (absent in files written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub die_file: Option<String>,
     /// The axes of the plan across the stroke that the binder's outline is given in (unit
     /// vectors).
     pub plan_axes: [[f64; 3]; 2],
     /// The binder, if one held the blank.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub binder: Option<BinderRecord>,
+    /// The plane the blank was laid flat in, where the binder grips it (absent in files written
+    /// before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blank_plane: Option<BlankPlaneRecord>,
+}
+
+/// The plane a flat blank was laid in.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BlankPlaneRecord {
+    /// A point of it (the blank's origin node where it was laid), m.
+    pub point_m: [f64; 3],
+    /// Its unit normal.
+    pub normal: [f64; 3],
 }
 
 /// A binder as the blank was formed with it.
@@ -546,6 +562,10 @@ pub struct BinderRecord {
     pub outline_m: Vec<[f64; 2]>,
     /// Its clamping pressure, Pa.
     pub pressure_pa: f64,
+    /// The nodes [i, j] it gripped in the last increment (absent in files written before it was
+    /// recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gripped: Option<Vec<[usize; 2]>>,
 }
 
 /// A ply's draw-in (`meta.draw_in` in the net's JSON; its largest in the layup table).

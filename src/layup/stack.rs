@@ -354,7 +354,7 @@ pub fn drape_layup(
         net.meta.draw_in = plan.and_then(|(n, from)| crate::kinematic::draw_in::draw_in(&net, &n, from));
         net.meta.wrinkles = layup.wrinkles.then(|| ply.wrinkles(&net, surface));
         net.meta.forming = match (ply.refinement.as_ref().and_then(|r| r.forming.as_ref()), &refined) {
-            (Some(f), Some(r)) => Some(f.record(r.increments.len())),
+            (Some(f), Some(r)) => Some(f.record(r.increments.len(), r.grip.as_ref(), net.nv)),
             _ => None,
         };
         // What later stages (exports, reports) need to know about the ply.

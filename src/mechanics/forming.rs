@@ -19,7 +19,7 @@ use super::contact::{ContactSurface, Foot};
 use super::friction::Bearing;
 use super::sheet::{point_in_polygon, polygon_round, PolygonFault};
 use crate::geometry::{Point, ToolError, ToolSurface, Vector};
-use crate::kinematic::provenance::{BinderRecord, FormingRecord};
+use crate::kinematic::provenance::{BinderRecord, BlankPlaneRecord, FormingRecord};
 use std::sync::Arc;
 
 /// The punch moves at most this many spacings per increment: the solver's contact search
@@ -42,8 +42,28 @@ pub struct Forming {
     pub stroke: Vector,
     /// The die: the ply stays out of it (on the side its face turns to the punch), still.
     pub die: Option<Arc<ToolSurface>>,
+    /// The die's file as the scene names it (recorded, so that the formed ply can be held by
+    /// it again: [`Forming::at_stroke_end`]).
+    pub die_file: Option<String>,
     /// The blank holder.
     pub binder: Option<Binder>,
+    /// The plane the blank was laid flat in, where the binder grips it. None: through the
+    /// origin node of the flat blank the stroke starts from, normal to it there.
+    pub blank_plane: Option<BlankPlane>,
+    /// The ply is formed already (a formed net refined again): the tools stand where the stroke
+    /// left them, and the ply is solved in one increment without motion, starting from the
+    /// equilibrium it was formed to (its friction starts with the normal forces and the
+    /// friction forces that hold it there). With a binder, `blank_plane` must then be given.
+    pub at_stroke_end: bool,
+}
+
+/// The plane a flat blank was laid in (the binder grips the blank in it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlankPlane {
+    /// A point of the plane, m.
+    pub point: Point,
+    /// Its unit normal.
+    pub normal: Vector,
 }
 
 /// A blank holder: it clamps the blank outside its opening with a pressure, friction on both
@@ -54,6 +74,21 @@ pub struct Binder {
     pub outline: Vec<[f64; 2]>,
     /// The clamping pressure, Pa.
     pub pressure: f64,
+    /// Per node, whether it grips it, given: a formed ply held again grips the nodes its last
+    /// increment gripped (those outside the opening as that increment began: a node drawn past
+    /// the opening's edge during it is let go only at the next). None: the nodes outside its
+    /// opening in the blank's plane ([`Binder::gripped`]).
+    pub gripping: Option<Vec<bool>>,
+}
+
+/// How the binder held a formed blank at the end of its stroke: the plane it gripped in and
+/// the nodes it gripped in the last increment (what a formed ply held again is held by).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grip {
+    /// The blank's plane.
+    pub plane: BlankPlane,
+    /// Per node, whether the binder gripped it (none without a binder).
+    pub nodes: Vec<bool>,
 }
 
 /// Why a forming set-up cannot run.
@@ -150,24 +185,91 @@ impl Forming {
         Ok(())
     }
 
-    /// What the net records of the process, formed in `increments` increments.
-    pub fn record(&self, increments: usize) -> FormingRecord {
+    /// What the net records of the process, formed in `increments` increments and left gripped
+    /// as `grip` says ([`super::refine::Refined::grip`]; nodes numbered on a grid `nv` nodes
+    /// wide).
+    pub fn record(&self, increments: usize, grip: Option<&Grip>, nv: usize) -> FormingRecord {
         let axes = PlanView::across(&self.stroke).axes().map(|a| [a.x, a.y, a.z]);
         FormingRecord {
             stroke_m: [self.stroke.x, self.stroke.y, self.stroke.z],
             increments,
             die: self.die.is_some(),
+            die_file: self.die_file.clone(),
             plan_axes: axes,
-            binder: self
-                .binder
-                .as_ref()
-                .map(|b| BinderRecord { outline_m: b.outline.clone(), pressure_pa: b.pressure }),
+            binder: self.binder.as_ref().map(|b| BinderRecord {
+                outline_m: b.outline.clone(),
+                pressure_pa: b.pressure,
+                gripped: grip.map(|g| {
+                    (g.nodes.iter().enumerate()).filter(|(_, &on)| on).map(|(k, _)| [k / nv, k % nv]).collect()
+                }),
+            }),
+            blank_plane: grip
+                .map(|g| g.plane)
+                .or(self.blank_plane)
+                .map(|p| BlankPlaneRecord { point_m: p.point.coords.into(), normal: p.normal.into() }),
         }
     }
 
+    /// The process a formed net of `nu` x `nv` nodes records (`record`), with the tools where
+    /// its stroke left them ([`Forming::at_stroke_end`]) and `die` its die (read from the file it
+    /// names, or another), checked as a scene's set-up is; the binder grips the nodes the
+    /// record says it gripped. A record with a binder must give the blank's plane.
+    pub fn at_end_of(
+        record: &FormingRecord,
+        die: Option<Arc<ToolSurface>>,
+        (nu, nv): (usize, usize),
+    ) -> Result<Forming, FormingError> {
+        let stroke = Vector::from(record.stroke_m);
+        let blank_plane = record
+            .blank_plane
+            .as_ref()
+            .map(|p| BlankPlane { point: Point::from(p.point_m), normal: Vector::from(p.normal).normalize() });
+        if record.binder.is_some() && blank_plane.is_none() {
+            return Err(FormingError {
+                field: "blank_plane",
+                message: "the net records a binder but not the plane it gripped the blank in (a net formed before \
+                          drape recorded it): form the ply again"
+                    .into(),
+            });
+        }
+        let binder = match &record.binder {
+            None => None,
+            Some(b) => {
+                let gripping = match &b.gripped {
+                    None => None,
+                    Some(nodes) => {
+                        let mut on = vec![false; nu * nv];
+                        for &[i, j] in nodes {
+                            if i >= nu || j >= nv {
+                                return Err(binder_error(format!(
+                                    "gripped: node [{i}, {j}] is outside the net's {nu} x {nv} grid: the net's record is damaged; form the ply again"
+                                )));
+                            }
+                            on[i * nv + j] = true;
+                        }
+                        Some(on)
+                    }
+                };
+                Some(Binder { outline: b.outline_m.clone(), pressure: b.pressure_pa, gripping })
+            }
+        };
+        let forming =
+            Forming { stroke, die, die_file: record.die_file.clone(), binder, blank_plane, at_stroke_end: true };
+        // The blank's centre where the stroke ends: its origin node laid in the plane, carried
+        // by the stroke (the binder's opening must hold it).
+        if let Some(p) = &forming.blank_plane {
+            forming.check(&(p.point + stroke))?;
+        }
+        Ok(forming)
+    }
+
     /// Increments for a stroke at `spacing`: enough that the punch moves at most
-    /// [`STROKE_STEP_SPACINGS`] per increment, at least `asked`.
+    /// [`STROKE_STEP_SPACINGS`] per increment, at least `asked`; one, with no motion, at the
+    /// stroke's end.
     pub fn increments(&self, spacing: f64, asked: usize) -> usize {
+        if self.at_stroke_end {
+            return 1;
+        }
         let needed = (self.stroke.norm() / (STROKE_STEP_SPACINGS * spacing)).ceil() as usize;
         needed.max(asked).clamp(1, MAX_STROKE_STEPS)
     }
@@ -175,6 +277,9 @@ impl Forming {
     /// Where the punch is at the end of increment `step` of `steps` (0: the start): moved back
     /// by the share of the stroke still to come.
     pub fn punch_offset(&self, step: usize, steps: usize) -> Vector {
+        if self.at_stroke_end {
+            return Vector::zeros();
+        }
         -self.stroke * (1.0 - step as f64 / steps as f64)
     }
 
@@ -186,7 +291,8 @@ impl Forming {
 
 impl Binder {
     /// Which nodes the binder grips at `x`: those outside its opening in plan and in the blank's
-    /// plane (through `plane_point`, unit normal `plane_normal`).
+    /// plane (through `plane_point`, unit normal `plane_normal`), or those it is given
+    /// ([`Binder::gripping`]) of the ply's `body`.
     pub fn gripped(
         &self,
         view: &PlanView,
@@ -196,6 +302,9 @@ impl Binder {
         plane_normal: &Vector,
         spacing: f64,
     ) -> Vec<bool> {
+        if let Some(given) = &self.gripping {
+            return given.iter().zip(body).map(|(&g, &b)| g && b).collect();
+        }
         x.iter()
             .zip(body)
             .map(|(p, &b)| {
@@ -333,7 +442,14 @@ mod tests {
 
     #[test]
     fn increments_keep_the_punch_step_below_half_a_spacing() {
-        let f = Forming { stroke: Vector::new(0.0, 0.0, 0.05), die: None, binder: None };
+        let f = Forming {
+            stroke: Vector::new(0.0, 0.0, 0.05),
+            die: None,
+            die_file: None,
+            binder: None,
+            blank_plane: None,
+            at_stroke_end: false,
+        };
         assert_eq!(f.increments(0.005, 1), 20);
         assert_eq!(f.increments(0.005, 30), 30);
         assert!((f.punch_offset(0, 20) + f.stroke).norm() < 1e-15);
@@ -346,7 +462,10 @@ mod tests {
         let f = Forming {
             stroke: Vector::new(0.0, 0.0, 0.05),
             die: None,
-            binder: Some(Binder { outline: square, pressure: 1e4 }),
+            die_file: None,
+            binder: Some(Binder { outline: square, pressure: 1e4, gripping: None }),
+            blank_plane: None,
+            at_stroke_end: false,
         };
         assert!(f.check(&Point::new(0.0, 0.0, 0.02)).is_ok());
         assert!(f.check(&Point::new(0.3, 0.0, 0.02)).is_err());

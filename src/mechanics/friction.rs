@@ -192,6 +192,30 @@ impl FrictionLag {
         self.origin.copy_from_slice(x);
     }
 
+    /// Start each node that bears where the potential's gradient balances the tangential part
+    /// of its push at `x` (`eval`'s forces less loads, friction excluded, as [`bearings`] takes
+    /// them), up to its capacity: a state already in equilibrium with friction (a formed ply
+    /// held again by its tools) starts with the friction forces that hold it. From zero slip,
+    /// where the potential's slope is zero, every node would creep up to a stick distance to
+    /// take them up again, and a taut span between two gripped ends sag by far more.
+    pub fn preload(&mut self, cons: &Constraints, x: &[Point], eval: &Evaluation) {
+        let push = pushes(cons, eval);
+        for (k, p) in x.iter().enumerate() {
+            let (c, Some(b)) = (self.capacity(k), self.bearing[k]) else { continue };
+            let t = push[k] - b.normal * b.normal.dot(&push[k]);
+            let pull = t.norm();
+            if c == 0.0 || pull == 0.0 {
+                continue;
+            }
+            // The slip s whose slope f1(s) = 2 r - r^2 (r = s / eps) is the share of the
+            // capacity the push takes: r = 1 - sqrt(1 - share), the full stick distance at it.
+            let share = (pull / c).min(1.0);
+            let slip = self.stick * (1.0 - (1.0 - share).sqrt());
+            // The gradient c f1(s) u / s, u = T (x - o), is -t when u = -s t / |t|: o = x + s t / |t|.
+            self.origin[k] = p + t * (slip / pull);
+        }
+    }
+
     /// The slip of node k at `x` in the lagged tangent plane (zero where it does not bear).
     pub fn slip(&self, k: usize, x: &Point) -> Vector {
         match &self.bearing[k] {
@@ -380,10 +404,7 @@ pub fn bearings(cons: &Constraints, x: &[Point], eval: &Evaluation, coulomb: &Co
     let n = x.len();
     let Some(tool) = cons.tool else { return vec![None; n] };
     let rep: Vec<usize> = cons.stitched.clone().unwrap_or_else(|| (0..n).collect());
-    let mut push = vec![Vector::zeros(); n];
-    for (k, &r) in rep.iter().enumerate() {
-        push[r] += eval.internal[k] - eval.external[k];
-    }
+    let push = pushes(cons, eval);
     (0..n)
         .into_par_iter()
         .map(|k| {
@@ -397,6 +418,18 @@ pub fn bearings(cons: &Constraints, x: &[Point], eval: &Evaluation, coulomb: &Co
             (force > 0.0).then_some(Bearing { normal: foot.normal, force, mu, on_plies, carried })
         })
         .collect()
+}
+
+/// Each node's push on the tool, the fabric's forces less the loads (friction excluded), a
+/// stitched node's on the node that stands for it.
+fn pushes(cons: &Constraints, eval: &Evaluation) -> Vec<Vector> {
+    let n = eval.internal.len();
+    let rep: Vec<usize> = cons.stitched.clone().unwrap_or_else(|| (0..n).collect());
+    let mut push = vec![Vector::zeros(); n];
+    for (k, &r) in rep.iter().enumerate() {
+        push[r] += eval.internal[k] - eval.external[k];
+    }
+    push
 }
 
 /// The foot of node k where it meets the tool: pressed nodes that slide on it always, free

@@ -2,7 +2,7 @@
 //! kinematic state with the tool as contact, under load steps of gravity.
 use super::contact::{ContactMode, ContactSurface, Freedom};
 use super::energy::{Gravity, Grid, HessianKind, Laws, Model};
-use super::forming::{Forming, PlanView, ToolsAt};
+use super::forming::{BlankPlane, Forming, Grip, PlanView, ToolsAt};
 use super::friction::{
     bearings, friction_needed, tangent_rigid_motions, Bearing, Coulomb, FrictionLag, Frictional, Needed, PliesBelow,
     LAG_TOLERANCE, MAX_LAGS, RELAG_SHARE, RELAG_TRAVEL_SPACINGS, SLIDE_MIN_SPACINGS, SLIDE_SHARE, STICK_SPACINGS,
@@ -286,6 +286,8 @@ pub struct Refined {
     pub energy_start: f64,
     /// Energy (full load) of the refined net.
     pub energy_final: f64,
+    /// A forming process: how its binder held the blank at the end (the plane, the nodes).
+    pub grip: Option<Grip>,
 }
 
 impl Refined {
@@ -556,6 +558,8 @@ fn refine_among<L: Laws + ?Sized>(
     // A forming process meets its tools with one-sided contact, in as many increments as its
     // stroke needs.
     let forming = settings.forming.as_ref();
+    // A formed ply held again by its tools where the stroke ended starts from equilibrium.
+    let held_again = forming.is_some_and(|f| f.at_stroke_end);
     let mode = if forming.is_some() { ContactMode::Free } else { settings.mode };
     let load_steps = forming.map_or(settings.load_steps, |f| f.increments(kinematic.spacing, settings.load_steps));
     let freedom: Vec<Freedom> = (0..active.len())
@@ -565,12 +569,16 @@ fn refine_among<L: Laws + ?Sized>(
             (true, _) => Freedom::Free,
         })
         .collect();
-    // The blank's plane (the binder grips in it), from where the flat blank was laid.
+    // The blank's plane (the binder grips in it): the set-up's, else where the flat blank was
+    // laid.
     let origin_index = kinematic.index(kinematic.origin_node.0, kinematic.origin_node.1);
-    let blank_plane = forming.map(|_| {
-        let normal = crate::kinematic::draw_in::seed_normal(kinematic).unwrap_or_else(Vector::z);
-        (starts[0][origin_index], normal)
+    let plane = forming.map(|f| {
+        f.blank_plane.unwrap_or_else(|| BlankPlane {
+            point: starts[0][origin_index],
+            normal: crate::kinematic::draw_in::seed_normal(kinematic).unwrap_or_else(Vector::z),
+        })
     });
+    let blank_plane = plane.map(|p| (p.point, p.normal));
     // The die is met as the punch is: on its smooth surface (on its facets a node at the entry
     // fillet, whose facets turn by a tenth of a right angle each, crawls from one to the next).
     let die_tool = forming.and_then(|f| f.die.as_deref());
@@ -611,6 +619,7 @@ fn refine_among<L: Laws + ?Sized>(
     let friction = coulomb.largest();
     let mut lag = FrictionLag::new(friction, stick_distance, &x, vec![None; x.len()]);
     let mut slide = None;
+    let mut grip = None;
     for step in 1..=load_steps {
         if step > 1 {
             objective.scale_loads(step as f64 / (step - 1) as f64);
@@ -631,6 +640,7 @@ fn refine_among<L: Laws + ?Sized>(
             }
             _ => vec![false; x.len()],
         };
+        grip = plane.map(|plane| Grip { plane, nodes: gripped.clone() });
         let cons = Constraints {
             freedom: (freedom.iter().zip(&gripped))
                 .map(|(&f, &g)| match (g, blank_plane) {
@@ -660,12 +670,19 @@ fn refine_among<L: Laws + ?Sized>(
         // the next ones if they hold it). The first increment starts where the ply was laid: its
         // normal forces are the load's (the fabric's own forces there are those of a start off
         // equilibrium, such as a net draped on the facets moved onto the smooth tool, and would
-        // grip with friction that no laid ply has); every later one starts from an equilibrium.
+        // grip with friction that no laid ply has); every later one starts from an equilibrium,
+        // and so does a formed ply held again where its stroke ended: the tools' reactions to
+        // its forces are what its friction bears on (with the load's alone it grips too weakly
+        // and creeps: 0.012 spacings on a cylindrical punch through a binder's slot).
         let mut eval = objective.evaluate(&x, false);
-        if step == 1 {
+        if step == 1 && !held_again {
             eval.internal.iter_mut().for_each(|f| *f = Vector::zeros());
         }
         lag = FrictionLag::new(friction, stick_distance, &x, bear(&x, &eval));
+        // ... and with the friction forces that hold it there.
+        if held_again {
+            lag.preload(&cons, &x, &eval);
+        }
         let limit = slide_limit(&lag, kinematic.spacing);
         let mut increment =
             Increment { load_factor: step as f64 / load_steps as f64, solves: 0, iterations: 0, lag_change: 0.0 };
@@ -776,7 +793,7 @@ fn refine_among<L: Laws + ?Sized>(
             net.status[k] = NodeStatus::Detached;
         }
     }
-    Ok(Refined { net, steps, increments, contact, slide, energy_kinematic, energy_start, energy_final })
+    Ok(Refined { net, steps, increments, contact, slide, energy_kinematic, energy_start, energy_final, grip })
 }
 
 /// The slide beyond which a ply has no equilibrium: [`SLIDE_SHARE`] of the region bearing on

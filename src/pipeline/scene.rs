@@ -541,11 +541,11 @@ fn forming(
     let stroke = p.stroke.expect("a formed blank has its stroke (checked with start)");
     let stroke = Vector::new(stroke[0], stroke[1], stroke[2]) * scale;
     let origin = Point::new(p.origin[0], p.origin[1], p.origin[2]) * scale;
-    let die = match &p.die {
+    let die_file = p.die.as_ref().map(|file| base.join(file));
+    let die = match &die_file {
         None => None,
-        Some(file) => {
-            let path = base.join(file);
-            let die = read_tool(&path, scale).map_err(|e| ("die", format!("{e}")))?;
+        Some(path) => {
+            let die = read_tool(path, scale).map_err(|e| ("die", format!("{e}")))?;
             let die = die_facing(die, &origin, &stroke).map_err(|e| ("die", format!("{e}")))?;
             Some(Arc::new(die))
         }
@@ -553,8 +553,17 @@ fn forming(
     let binder = p.binder.as_ref().map(|b| Binder {
         outline: b.outline.iter().map(|q| [q[0] * scale, q[1] * scale]).collect(),
         pressure: b.pressure,
+        gripping: None,
     });
-    let forming = Forming { stroke, die, binder };
+    let forming = Forming {
+        stroke,
+        die,
+        // Named as the tool is (`meta.tool`): joined to the scene's folder.
+        die_file: die_file.map(|f| f.display().to_string()),
+        binder,
+        blank_plane: None,
+        at_stroke_end: false,
+    };
     forming.check(&origin).map_err(|e| (e.field, e.message))?;
     Ok(Some(forming))
 }
