@@ -1,6 +1,7 @@
 //! Forming a flat blank by tools in motion (issue 33): a punch with a stroke, a binder, a die.
 use drape::geometry::{shapes, TriangleMesh};
 use drape::kinematic::provenance::DrawIn;
+use drape::mechanics::forming::STROKE_STEP_SPACINGS;
 use std::path::Path;
 
 use crate::common::read_json;
@@ -318,6 +319,51 @@ fn a_double_domes_plus_minus_45_plies_formed_with_a_binder_mirror_each_other() {
     assert!(mirror < IMAGE_SPACINGS * spacing, "mirror images differ by {mirror} m\n{out_plus}\n{out_minus}");
 }
 
+/// A hemispherical punch of radius `r` drawn `stroke` through a die's opening of radius
+/// `opening` with an entry fillet `fillet` (eight facets over its quarter turn), from a square
+/// blank of n x n nodes clamped on the die's face outside a round binder opening of radius
+/// `binder` at `pressure`, with `friction` on every tool.
+#[derive(Debug, Clone, Copy)]
+struct DieSetUp {
+    r: f64,
+    opening: f64,
+    fillet: f64,
+    stroke: f64,
+    n: usize,
+    spacing: f64,
+    binder: f64,
+    pressure: f64,
+    friction: f64,
+}
+
+impl DieSetUp {
+    /// Form the blank in `dir` (`punch.obj`, `die.obj`, the scene, `out/`): the command's output
+    /// and the net.
+    fn form(&self, dir: &Path) -> (String, serde_json::Value) {
+        let DieSetUp { r, opening, fillet, stroke, n, spacing, binder, pressure, friction } = *self;
+        let punch = shapes::hemisphere(r, 24);
+        let mut die = shapes::die_ring(opening, fillet, 0.2, 0.06, 192, [8, 8, 10]);
+        die.vertices.iter_mut().for_each(|v| v.z += r - stroke);
+        let outline: Vec<String> = (0..24)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / 24.0;
+                format!("[{:.6}, {:.6}]", binder * t.cos(), binder * t.sin())
+            })
+            .collect();
+        let scene = format!(
+            "units = \"m\"\ntool = \"punch.obj\"\nfriction = {friction}\n\
+             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
+             material = \"{card}\"\nspacing = {spacing}\ngrid = [{n}, {n}]\nmethod = \"mechanical\"\n\
+             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {stroke}]\ndie = \"die.obj\"\n\
+             max_iterations = 2000\n[ply.binder]\npressure = {pressure}\noutline = [{}]\n",
+            outline.join(", "),
+            card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
+        );
+        let (stdout, _, net) = run(dir, &[("punch.obj", &punch), ("die.obj", &die)], &scene);
+        (stdout, net)
+    }
+}
+
 /// A hemispherical punch drawn through a die's opening with an entry fillet (R 60 mm into R 66 mm,
 /// a 6 mm fillet, eight facets over its quarter turn) from a blank clamped on the die's face: it
 /// converges, no node is inside the punch or the die, those the binder grips lie in the die's
@@ -326,29 +372,21 @@ fn a_double_domes_plus_minus_45_plies_formed_with_a_binder_mirror_each_other() {
 /// seventh increment; on its smooth surface it converges in 320 iterations.
 #[test]
 fn a_hemisphere_drawn_through_a_die_with_an_entry_fillet_stays_out_of_both_tools() {
-    let (r, opening, fillet, stroke, n, spacing) = (0.06, 0.066, 0.006, 0.04, 29, 0.01);
+    let set_up = DieSetUp {
+        r: 0.06,
+        opening: 0.066,
+        fillet: 0.006,
+        stroke: 0.04,
+        n: 29,
+        spacing: 0.01,
+        binder: 0.08,
+        pressure: 1.0e4,
+        friction: 0.2,
+    };
+    let DieSetUp { r, opening, fillet, stroke, n, spacing, binder, .. } = set_up;
     let face = r - stroke;
     let tmp = tempfile::tempdir().unwrap();
-    let punch = shapes::hemisphere(r, 24);
-    let mut die = shapes::die_ring(opening, fillet, 0.2, 0.06, 192, [8, 8, 10]);
-    die.vertices.iter_mut().for_each(|v| v.z += face);
-    let binder = 0.08;
-    let outline: Vec<String> = (0..24)
-        .map(|k| {
-            let t = std::f64::consts::TAU * k as f64 / 24.0;
-            format!("[{:.6}, {:.6}]", binder * t.cos(), binder * t.sin())
-        })
-        .collect();
-    let scene = format!(
-        "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
-         [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
-         material = \"{card}\"\nspacing = {spacing}\ngrid = [{n}, {n}]\nmethod = \"mechanical\"\n\
-         mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {stroke}]\ndie = \"die.obj\"\n\
-         max_iterations = 2000\n[ply.binder]\npressure = 1.0e4\noutline = [{}]\n",
-        outline.join(", "),
-        card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
-    );
-    let (stdout, _, net) = run(tmp.path(), &[("punch.obj", &punch), ("die.obj", &die)], &scene);
+    let (stdout, net) = set_up.form(tmp.path());
     assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
     assert_eq!(net["status"]["placed"], n * n, "{}", net["status"]);
     let x = crate::common::all_nodes(&net);
@@ -455,5 +493,225 @@ fn a_punch_moving_along_its_face_carries_the_blank_friction_holds() {
                 );
             }
         }
+    }
+}
+
+/// How far (in spacings) a node of a formed ply may move when it is refined again where its
+/// stroke ended. The formed state balances its forces to the solver's tolerance, |F - P| <=
+/// 1e-4 of the tools' forces; the ply's stiffness against those forces is about their size over
+/// half a spacing, the most the punch moves the ply in one increment
+/// ([`STROKE_STEP_SPACINGS`]): so what is left unbalanced moves the nodes by about 1e-4 x 0.5
+/// spacings. The bound is twice that, 1e-4 spacings (measured: at most 4.4e-6 over the four
+/// set-ups below). Restarted from zero friction force the nodes crept by up to the stick
+/// distance and a taut span sagged: 0.012 spacings; with the binder letting go of the nodes
+/// drawn past its edge in the last increment, 0.0022.
+fn held_again_spacings() -> f64 {
+    2.0 * drape::mechanics::SolverSettings::default().tolerance * STROKE_STEP_SPACINGS
+}
+
+/// `drape refine` on the formed net `net` (a file), held by its tools: the punch `punch`, the
+/// card, `friction`, and `extra` arguments, into `out`; the command's run.
+fn refine_again(
+    net: &Path,
+    punch: &Path,
+    card: &str,
+    friction: f64,
+    extra: &[&str],
+    out: &Path,
+) -> assert_cmd::assert::Assert {
+    let friction = friction.to_string();
+    assert_cmd::Command::cargo_bin("drape")
+        .unwrap()
+        .arg("refine")
+        .arg("--net")
+        .arg(net)
+        .arg("--tool")
+        .arg(punch)
+        .args(["--material", card, "--mode", "pressed", "--friction", &friction])
+        .args(extra)
+        .arg("--out")
+        .arg(out)
+        .assert()
+}
+
+/// The refined net that `refine_again` wrote from the formed `net`: it converged in one
+/// increment, keeps the process's record and every node's status, and no node moved more than
+/// [`held_again_spacings`]; the largest move in spacings.
+fn held_where_it_was(formed: &serde_json::Value, refined: &serde_json::Value, stdout: &str) -> f64 {
+    assert_eq!(refined["meta"]["solver"]["converged"], true, "{stdout}");
+    assert_eq!(refined["meta"]["solver"]["increments"].as_array().unwrap().len(), 1, "{stdout}");
+    assert_eq!(refined["meta"]["forming"], formed["meta"]["forming"], "the formed ply's record is kept");
+    assert_eq!(refined["status"], formed["status"], "{stdout}");
+    let spacing = formed["spacing"].as_f64().unwrap();
+    let (before, after) = (formed["nodes"].as_array().unwrap(), refined["nodes"].as_array().unwrap());
+    let mut worst: f64 = 0.0;
+    for (p, q) in before.iter().zip(after) {
+        if let (Some(p), Some(q)) = (p.as_array(), q.as_array()) {
+            let d = (0..3).map(|c| (p[c].as_f64().unwrap() - q[c].as_f64().unwrap()).powi(2)).sum::<f64>().sqrt();
+            worst = worst.max(d / spacing);
+        }
+    }
+    println!("refined again: largest node move {worst:.3e} spacings\n{stdout}");
+    assert!(worst < held_again_spacings(), "a node moved {worst} spacings\n{stdout}");
+    worst
+}
+
+/// A blank formed by a cylindrical punch rising through a binder's slot, refined again with
+/// `drape refine` from the command line where the stroke ended: the punch still, the binder
+/// gripping the flange in the blank's plane with its recorded opening and pressure. It is an
+/// equilibrium, so no node moves (beyond friction's creep), for other radii, strokes, openings,
+/// pressures and coefficients; what does not fit a formed net is refused with exit code 2.
+#[test]
+fn a_blank_formed_through_a_binder_refined_again_moves_no_node() {
+    let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+    let card = card.to_str().unwrap();
+    for (r, h, a, pressure, friction) in [(0.05, 0.03, 0.1, 2.0e3, 0.2), (0.04, 0.02, 0.08, 8.0e3, 0.35)] {
+        let tmp = tempfile::tempdir().unwrap();
+        let punch = shapes::cylinder(r, 0.2, std::f64::consts::PI, 96, 40);
+        let scene = format!(
+            "units = \"m\"\ntool = \"punch.obj\"\nfriction = {friction}\n\
+             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
+             material = \"{card}\"\nspacing = 0.005\ngrid = [61, 21]\nmethod = \"mechanical\"\n\
+             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {h}]\nmax_iterations = 2000\n\
+             [ply.binder]\npressure = {pressure}\noutline = [[-{a}, -1.0], [{a}, -1.0], [{a}, 1.0], [-{a}, 1.0]]\n"
+        );
+        let (stdout, _, formed) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
+        assert_eq!(formed["meta"]["solver"]["converged"], true, "{stdout}");
+        // The net records the plane the binder gripped in: where the punch's top stood at the start.
+        let plane = &formed["meta"]["forming"]["blank_plane"];
+        assert_eq!(plane["normal"], serde_json::json!([0.0, 0.0, 1.0]), "{plane}");
+        assert!((plane["point_m"][2].as_f64().unwrap() - (r - h)).abs() < 1e-12, "{plane}");
+        let net = tmp.path().join("out/p.drape.json");
+        let again = tmp.path().join("again");
+        let run = refine_again(&net, &tmp.path().join("punch.obj"), card, friction, &[], &again).success();
+        let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+        held_where_it_was(&formed, &read_json(&again.join("p.drape.json")), &stdout);
+    }
+}
+
+/// A blank drawn through a die with an entry fillet, refined again with `drape refine` from the
+/// command line where the stroke ended: the punch still, the die it records (found by the file
+/// the net names, or given with `--die` once that file is gone), the binder gripping the flange
+/// on the die's face. It is an equilibrium, so no node moves (beyond friction's creep), for
+/// other radii, strokes, fillets, pressures and coefficients; a die that cannot be found is
+/// refused with exit code 2, nothing written.
+#[test]
+fn a_blank_drawn_through_a_die_refined_again_moves_no_node() {
+    let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+    let card = card.to_str().unwrap();
+    let set_ups = [
+        DieSetUp {
+            r: 0.05,
+            opening: 0.056,
+            fillet: 0.005,
+            stroke: 0.03,
+            n: 25,
+            spacing: 0.01,
+            binder: 0.07,
+            pressure: 5.0e3,
+            friction: 0.3,
+        },
+        DieSetUp {
+            r: 0.06,
+            opening: 0.066,
+            fillet: 0.006,
+            stroke: 0.04,
+            n: 29,
+            spacing: 0.01,
+            binder: 0.08,
+            pressure: 1.0e4,
+            friction: 0.2,
+        },
+    ];
+    for (k, set_up) in set_ups.into_iter().enumerate() {
+        let tmp = tempfile::tempdir().unwrap();
+        let (stdout, formed) = set_up.form(tmp.path());
+        assert_eq!(formed["meta"]["solver"]["converged"], true, "{set_up:?}\n{stdout}");
+        // The net names the die's file as the scene did (joined to its folder).
+        let die = tmp.path().join("die.obj");
+        assert_eq!(formed["meta"]["forming"]["die_file"], die.display().to_string());
+        let net = tmp.path().join("out/p.drape.json");
+        let punch = tmp.path().join("punch.obj");
+        let again = tmp.path().join("again");
+        let run = if k == 0 {
+            refine_again(&net, &punch, card, set_up.friction, &[], &again).success()
+        } else {
+            // The die moved: the net's record no longer finds it, and saying where it is does.
+            let moved = tmp.path().join("moved-die.obj");
+            std::fs::rename(&die, &moved).unwrap();
+            let refused = refine_again(&net, &punch, card, set_up.friction, &[], &again).code(2);
+            let err = String::from_utf8_lossy(&refused.get_output().stderr).to_string();
+            assert!(
+                err.contains("formed by a punch's stroke")
+                    && err.contains(&format!("{} is not found", die.display()))
+                    && err.contains("--die FILE"),
+                "{err}"
+            );
+            assert!(!again.exists(), "a refused refinement wrote {}", again.display());
+            refine_again(&net, &punch, card, set_up.friction, &["--die", moved.to_str().unwrap()], &again).success()
+        };
+        let stdout = String::from_utf8_lossy(&run.get_output().stdout).to_string();
+        held_where_it_was(&formed, &read_json(&again.join("p.drape.json")), &stdout);
+    }
+}
+
+/// What does not fit a formed net is refused with exit code 2, naming what to give, before
+/// anything is written: a free drape or load steps (it is held by its tools, its load already
+/// on), a die it was not formed with, a die given for a net no process formed, a record without
+/// the binder's plane (a net formed before drape recorded it) or gripping a node off the grid.
+#[test]
+fn a_formed_net_refined_again_with_what_does_not_fit_it_is_refused() {
+    let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+    let card = card.to_str().unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let punch = shapes::cylinder(0.05, 0.2, std::f64::consts::PI, 48, 20);
+    let scene = format!(
+        "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
+         [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, 0.05]\nwarp = [1.0, 0.0, 0.0]\n\
+         material = \"{card}\"\nspacing = 0.01\ngrid = [31, 5]\nmethod = \"mechanical\"\n\
+         mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, 0.02]\nmax_iterations = 2000\n\
+         [ply.binder]\npressure = 2.0e3\noutline = [[-0.08, -1.0], [0.08, -1.0], [0.08, 1.0], [-0.08, 1.0]]\n"
+    );
+    let (stdout, _, formed) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
+    assert_eq!(formed["meta"]["solver"]["converged"], true, "{stdout}");
+    let punch = tmp.path().join("punch.obj");
+    let net = tmp.path().join("out/p.drape.json");
+    let out = tmp.path().join("again");
+    // A net changed by `edit`, written beside the formed one.
+    let edited = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut json = formed.clone();
+        edit(&mut json);
+        let path = tmp.path().join(name);
+        std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+        path
+    };
+    let unformed = edited("unformed.drape.json", &|j| {
+        j["meta"].as_object_mut().unwrap().remove("forming");
+    });
+    let planeless = edited("planeless.drape.json", &|j| {
+        j["meta"]["forming"].as_object_mut().unwrap().remove("blank_plane");
+    });
+    let off_grid = edited("off-grid.drape.json", &|j| {
+        j["meta"]["forming"]["binder"]["gripped"].as_array_mut().unwrap().push(serde_json::json!([31, 0]));
+    });
+    let die = tmp.path().join("die.obj");
+    std::fs::write(&die, shapes::hemisphere(0.1, 4).to_obj_string()).unwrap();
+    let die = die.to_str().unwrap();
+    let pressed = ["--mode", "pressed"];
+    for (net, extra, says) in [
+        (&net, vec!["--mode", "free"], "give --mode pressed"),
+        (&net, [&pressed[..], &["--load-steps", "3"]].concat(), "leave --load-steps out"),
+        (&net, [&pressed[..], &["--die", die]].concat(), "without a die (meta.forming.die is false): leave --die out"),
+        (&unformed, [&pressed[..], &["--die", die]].concat(), "the net records no forming process (meta.forming)"),
+        (&planeless, pressed.to_vec(), "meta.forming.blank_plane: the net records a binder but not the plane"),
+        (&off_grid, pressed.to_vec(), "meta.forming.binder: gripped: node [31, 0] is outside the net's 31 x 5 grid"),
+    ] {
+        let mut command = assert_cmd::Command::cargo_bin("drape").unwrap();
+        command.arg("refine").arg("--net").arg(net).arg("--tool").arg(&punch);
+        command.args(["--material", card]).args(&extra).arg("--out").arg(&out);
+        let refused = command.assert().code(2);
+        let err = String::from_utf8_lossy(&refused.get_output().stderr).to_string();
+        assert!(err.contains(says), "{extra:?}: {err}");
+        assert!(!out.exists(), "{extra:?}: a refused refinement wrote {}", out.display());
     }
 }

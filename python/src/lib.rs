@@ -353,7 +353,7 @@ fn kinematic(
 #[pyfunction]
 #[pyo3(signature = (
     net, tool, material, mode="pressed", *, units=None, facets=false, gravity=None, load_steps=None,
-    stick=false, friction=None, holds=None, escape_saddles=false, max_iterations=None
+    stick=false, friction=None, holds=None, escape_saddles=false, max_iterations=None, die=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn refine(
@@ -371,6 +371,7 @@ fn refine(
     holds: Option<Vec<[usize; 2]>>,
     escape_saddles: bool,
     max_iterations: Option<usize>,
+    die: Option<PathBuf>,
 ) -> PyResult<Net> {
     let tool = ToolArg::extract(tool)?;
     let defaults = RefineOptions::default();
@@ -385,6 +386,7 @@ fn refine(
         holds: holds.unwrap_or_default(),
         escape_saddles,
         max_iterations: max_iterations.unwrap_or(defaults.max_iterations),
+        die,
     };
     let kinematic = &net.net;
     let (refined_net, refined, warning) = py

@@ -38,6 +38,11 @@ pub struct RefineArgs {
     /// Material card (TOML).
     #[arg(long)]
     pub material: PathBuf,
+    /// A formed net (one that records `meta.forming`) is held by the tools that formed it,
+    /// where its stroke left them: `--tool` is the punch as its file has it, and this is the
+    /// die, in the tool's units (default: the die's file the net records).
+    #[arg(long)]
+    pub die: Option<PathBuf>,
     /// Contact with the tool.
     #[arg(long, value_enum)]
     pub mode: Mode,
@@ -95,6 +100,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         holds: a.hold.iter().map(|&(i, j)| [i, j]).collect(),
         escape_saddles: a.escape_saddles,
         max_iterations: a.max_iterations,
+        die: a.die,
     };
     options.check()?;
     let net = read_net(&a.net).map_err(input)?;

@@ -2,12 +2,15 @@
 //! the command line and the Python package both come through here.
 use super::failure::{compute, input, Failure};
 use super::unit_scale;
-use crate::geometry::{ToolSurface, Vector};
+use crate::geometry::{Point, ToolSurface, Vector};
+use crate::kinematic::provenance::FormingRecord;
 use crate::kinematic::DrapeNet;
 use crate::material::MaterialCard;
+use crate::mechanics::forming::{die_facing, Forming};
 use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
 use crate::mechanics::{ContactMode, SolverSettings};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// The options of `drape refine` besides its files. [`Default`] gives the command line's
@@ -34,6 +37,9 @@ pub struct RefineOptions {
     pub escape_saddles: bool,
     /// Solver iteration limit per load step.
     pub max_iterations: usize,
+    /// The die a formed net (one that records `meta.forming`) was formed with, in the tool's
+    /// units (default: the file the net records).
+    pub die: Option<PathBuf>,
 }
 
 impl Default for RefineOptions {
@@ -49,6 +55,7 @@ impl Default for RefineOptions {
             holds: Vec::new(),
             escape_saddles: false,
             max_iterations: 100,
+            die: None,
         }
     }
 }
@@ -103,8 +110,79 @@ impl RefineOptions {
                 .map(|&[i, j]| [(i as f64 - i0 as f64) * net.spacing, (j as f64 - j0 as f64) * net.spacing])
                 .collect(),
             plies_below: None,
-            forming: None,
+            forming: self.held_by_its_tools(net)?,
         })
+    }
+
+    /// A formed net (one that records `meta.forming`) is held by the tools that formed it,
+    /// where its stroke left them: the punch (the tool given, where its file has it), the die
+    /// (`--die`, else the file the net records) and the binder with its recorded opening and
+    /// pressure, gripping in the blank's recorded plane. None for any other net.
+    fn held_by_its_tools(&self, net: &DrapeNet) -> Result<Option<Forming>, Failure> {
+        let Some(record) = &net.meta.forming else {
+            return match &self.die {
+                Some(d) => Err(input(anyhow::anyhow!(
+                    "--die {}: the net records no forming process (meta.forming): only a formed ply is held by a die; leave --die out",
+                    d.display()
+                ))),
+                None => Ok(None),
+            };
+        };
+        let formed = format!(
+            "the net was formed by a punch's stroke of ({:.1}, {:.1}, {:.1}) mm",
+            record.stroke_m[0] * 1e3,
+            record.stroke_m[1] * 1e3,
+            record.stroke_m[2] * 1e3
+        );
+        if self.mode != ContactMode::Pressed {
+            return Err(input(anyhow::anyhow!(
+                "--mode free: {formed} and is refined held by its tools where the stroke ended, as it was formed: give --mode pressed"
+            )));
+        }
+        if self.load_steps != 1 {
+            return Err(input(anyhow::anyhow!(
+                "--load-steps {}: {formed}; it is refined again in one increment with its load already on: leave --load-steps out",
+                self.load_steps
+            )));
+        }
+        let die = match (record.die, &self.die, &record.die_file) {
+            (false, Some(d), _) => {
+                return Err(input(anyhow::anyhow!(
+                    "--die {}: {formed} without a die (meta.forming.die is false): leave --die out",
+                    d.display()
+                )))
+            }
+            (false, None, _) => None,
+            (true, Some(d), _) => Some(self.read_die(d, net, record)?),
+            (true, None, Some(f)) if Path::new(f).is_file() => Some(self.read_die(Path::new(f), net, record)?),
+            (true, None, recorded) => {
+                let where_ = match recorded {
+                    Some(f) => format!("its file {f} is not found"),
+                    None => "the net does not record its file".to_string(),
+                };
+                return Err(input(anyhow::anyhow!(
+                    "{formed} with a die, and {where_}: give the die with --die FILE (in the tool's units)"
+                )));
+            }
+        };
+        let forming = Forming::at_end_of(record, die, (net.nu, net.nv))
+            .map_err(|e| input(anyhow::anyhow!("meta.forming.{e}")))?;
+        Ok(Some(forming))
+    }
+
+    /// The die at `path`, in the tool's units, facing the ply as the scene's did.
+    fn read_die(&self, path: &Path, net: &DrapeNet, record: &FormingRecord) -> Result<Arc<ToolSurface>, Failure> {
+        let scale = self.tool_scale(net)?;
+        let named = |e: &dyn std::fmt::Display| input(anyhow::anyhow!("die {}: {e}", path.display()));
+        let die = crate::io::read_tool(path, scale).map_err(|e| named(&e))?;
+        // The blank's centre where the stroke ends (the flat blank's recorded origin).
+        let stroke = Vector::from(record.stroke_m);
+        let centre = match (&record.blank_plane, net.meta.origin) {
+            (_, Some(o)) => Point::from(o),
+            (Some(p), None) => Point::from(p.point_m) + stroke,
+            (None, None) => net.positions[net.index(net.origin_node.0, net.origin_node.1)],
+        };
+        Ok(Arc::new(die_facing(die, &centre, &stroke).map_err(|e| named(&e))?))
     }
 }
 
@@ -135,8 +213,11 @@ pub fn refine_net(
         Some(material),
         Some(&settings.sheet),
     ));
-    // This refinement forms nothing, whatever the net it started from was formed by.
-    out.meta.forming = None;
+    // A formed ply held again by its tools is still the ply its process formed: its record
+    // stays; a refinement without them forms nothing, whatever the net was formed by.
+    if settings.forming.is_none() {
+        out.meta.forming = None;
+    }
     out.timing.generators_ms = 0.0;
     out.timing.fill_ms = solve_ms;
     out.timing.total_ms = solve_ms;
