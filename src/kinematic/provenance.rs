@@ -544,6 +544,10 @@ pub struct FormingRecord {
     /// before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blank_plane: Option<BlankPlaneRecord>,
+    /// The outline the sheet was cut to, corners (u, v) in fabric coordinates from the origin
+    /// node, m (absent: the whole grid, or a file written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blank_m: Option<Vec<[f64; 2]>>,
 }
 
 /// The plane a flat blank was laid in.

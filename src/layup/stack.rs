@@ -11,6 +11,7 @@ use crate::geometry::{Point, ToolError, ToolSurface, Vector};
 use crate::kinematic::coverage::{surface_coverage, SurfaceCoverage};
 use crate::kinematic::fishnet::DrapeError;
 use crate::kinematic::outline::Outline;
+use crate::kinematic::provenance::FormingRecord;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice, NodeStatus};
 use crate::material::flow::sheared_thickness;
@@ -354,7 +355,11 @@ pub fn drape_layup(
         net.meta.draw_in = plan.and_then(|(n, from)| crate::kinematic::draw_in::draw_in(&net, &n, from));
         net.meta.wrinkles = layup.wrinkles.then(|| ply.wrinkles(&net, surface));
         net.meta.forming = match (ply.refinement.as_ref().and_then(|r| r.forming.as_ref()), &refined) {
-            (Some(f), Some(r)) => Some(f.record(r.increments.len(), r.grip.as_ref(), net.nv)),
+            (Some(f), Some(r)) => Some(FormingRecord {
+                // The shape the blank was cut to: what the fabric's cells weigh and resist.
+                blank_m: ply.refinement.as_ref().and_then(|r| r.sheet.blank.clone()),
+                ..f.record(r.increments.len(), r.grip.as_ref(), net.nv)
+            }),
             _ => None,
         };
         // What later stages (exports, reports) need to know about the ply.

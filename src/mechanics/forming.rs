@@ -207,6 +207,7 @@ impl Forming {
                 .map(|g| g.plane)
                 .or(self.blank_plane)
                 .map(|p| BlankPlaneRecord { point_m: p.point.coords.into(), normal: p.normal.into() }),
+            blank_m: None,
         }
     }
 

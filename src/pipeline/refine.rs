@@ -8,6 +8,7 @@ use crate::kinematic::DrapeNet;
 use crate::material::MaterialCard;
 use crate::mechanics::forming::{die_facing, Forming};
 use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
+use crate::mechanics::sheet::{check_blank, SheetFeatures};
 use crate::mechanics::{ContactMode, SolverSettings};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -95,13 +96,22 @@ impl RefineOptions {
             return Err(input(anyhow::anyhow!("--friction must be a finite number >= 0, got {friction}")));
         }
         let (i0, j0) = net.origin_node;
+        let forming = self.held_by_its_tools(net)?;
+        // A formed blank cut to a shape is the fabric it was formed as.
+        let blank = match net.meta.forming.as_ref().and_then(|f| f.blank_m.clone()) {
+            Some(b) => {
+                check_blank(&b).map_err(|e| input(anyhow::anyhow!("meta.forming.blank_m: {e}")))?;
+                Some(b)
+            }
+            None => None,
+        };
         Ok(RefineSettings {
             mode: self.mode,
             pressed_surface: if self.facets { PressedSurface::Facets } else { PressedSurface::Smooth },
             gravity: Vector::from(self.gravity),
             load_steps: self.load_steps,
             solver: SolverSettings::default().max_iterations(self.max_iterations).escape_saddles(self.escape_saddles),
-            sheet: Default::default(),
+            sheet: SheetFeatures { blank, ..Default::default() },
             stick: self.stick,
             friction,
             holds: self
@@ -110,14 +120,15 @@ impl RefineOptions {
                 .map(|&[i, j]| [(i as f64 - i0 as f64) * net.spacing, (j as f64 - j0 as f64) * net.spacing])
                 .collect(),
             plies_below: None,
-            forming: self.held_by_its_tools(net)?,
+            forming,
         })
     }
 
     /// A formed net (one that records `meta.forming`) is held by the tools that formed it,
     /// where its stroke left them: the punch (the tool given, where its file has it), the die
     /// (`--die`, else the file the net records) and the binder with its recorded opening and
-    /// pressure, gripping in the blank's recorded plane. None for any other net.
+    /// pressure, gripping in the blank's recorded plane (and its fabric is the blank it records,
+    /// [`RefineOptions::settings`]). None for any other net.
     fn held_by_its_tools(&self, net: &DrapeNet) -> Result<Option<Forming>, Failure> {
         let Some(record) = &net.meta.forming else {
             return match &self.die {
