@@ -49,6 +49,11 @@ pub trait ContactSurface: Sync {
     fn motion(&self, _foot: &Foot) -> Vector {
         Vector::zeros()
     }
+    /// Whether any part of the surface moves over the current increment (a punch on its
+    /// stroke): it then pushes into the ply's nodes that touch it.
+    fn moving(&self) -> bool {
+        false
+    }
 }
 
 impl ContactSurface for ToolSurface {

@@ -417,6 +417,10 @@ impl ContactSurface for ToolsAt<'_> {
             Vector::zeros()
         }
     }
+
+    fn moving(&self) -> bool {
+        self.step != Vector::zeros()
+    }
 }
 
 /// The die with its normals facing the ply, which is what contact keeps the ply on the side

@@ -211,8 +211,9 @@ impl FrictionLag {
             // capacity the push takes: r = 1 - sqrt(1 - share), the full stick distance at it.
             let share = (pull / c).min(1.0);
             let slip = self.stick * (1.0 - (1.0 - share).sqrt());
-            // The gradient c f1(s) u / s, u = T (x - o), is -t when u = -s t / |t|: o = x + s t / |t|.
-            self.origin[k] = p + t * (slip / pull);
+            // The gradient c f1(s) u / s, u = T (x - o), is -t when u = -s t / |t|: o = x + s t / |t|
+            // (carried on with what it bears on, as [`FrictionLag::new`] carries it).
+            self.origin[k] = p + b.carried + t * (slip / pull);
         }
     }
 
@@ -388,6 +389,21 @@ impl Objective for Frictional<'_> {
             terms.push(("friction", self.lag.gradient(x)));
         }
         terms
+    }
+    fn step_bound(&self, x: &[Point]) -> Option<f64> {
+        if self.lag.mu == 0.0 {
+            return None;
+        }
+        // What is left of the slide the lagged normal forces were taken for, and of the travel
+        // (a rigid slide moves the force-weighted mean slip as far as its nodes): a step ends at
+        // most a stick distance past either, and the solve then stops for the lag to be renewed.
+        // A step far past it would slide on forces the ply no longer bears.
+        let slide = (self.slide_limit - self.lag.mean_slip(x)).max(0.0);
+        let travel = self.travel.map_or(f64::INFINITY, |(start, limit)| {
+            let gone = x.iter().zip(start).map(|(p, s)| (p - s).norm()).fold(0.0, f64::max);
+            (limit - gone).max(0.0)
+        });
+        Some(slide.min(travel) + self.lag.stick)
     }
     fn runaway(&self, x: &[Point]) -> bool {
         let travelled = |(start, limit): (&[Point], f64)| x.iter().zip(start).any(|(p, s)| (p - s).norm() > limit);

@@ -15,9 +15,12 @@
 //!    quadratic convergence. A step that is not a descent direction of a convex model (negative
 //!    curvature) raises the shift.
 //! 3. The trial state moves pressed nodes back onto the tool and free nodes that would enter it
-//!    onto its surface. It is accepted when the energy falls by a fair part of the model's
-//!    prediction. If not, a second-order correction (a Newton step from the trial state with the
-//!    same model) is tried first: stiff, nearly inextensible fibres make the energy a narrow
+//!    onto its surface. On a moving tool, a free node touching it that the step moves into it is
+//!    first held on the tool and the step solved again ([`block_entering`]: its pull was outward
+//!    where the model was built, so the model knew nothing of the tool there). It is accepted
+//!    when the energy falls by a fair part of the model's prediction. If not, a second-order
+//!    correction (a Newton step from the trial state with the same model) is tried first:
+//!    stiff, nearly inextensible fibres make the energy a narrow
 //!    curved valley, a straight step leaves it to second order and the fibres' stiffness
 //!    multiplies that error; the correction steps back into the valley. Only then is the shift
 //!    raised (a shorter, more cautious step). After a refusal the other core solves the rung
@@ -64,6 +67,12 @@ pub trait Objective: Sync {
     /// fails (empty if the objective cannot split them).
     fn term_forces(&self, _x: &[Point]) -> Vec<(&'static str, Vec<Vector>)> {
         Vec::new()
+    }
+    /// How far any node may move in one step from `x` (m), where the objective's data hold only
+    /// so far (a lagged friction's normal forces, for what is left of the slide they were
+    /// taken for); None: no bound but the solver's own reach.
+    fn step_bound(&self, _x: &[Point]) -> Option<f64> {
+        None
     }
     /// Whether the state `x` has run away from any equilibrium (a ply sliding off over the
     /// tool, [`super::friction::Frictional`]): the solve then stops with [`Outcome::Slides`].
@@ -586,19 +595,21 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         let lagged_before = engine.lagged_solves;
         let ahead_before = engine.solved_ahead;
         let mut trial_ms = 0.0;
-        let g = red.reduce(&unbalanced(&state.eval), &state.bases);
+        let mut g = red.reduce(&unbalanced(&state.eval), &state.bases);
         let mut base_values =
             exact_model(cons, &rep, &red, &state).expect("the Hessian is evaluated with every accepted state");
-        let exact_values = base_values.clone();
+        let mut exact_values = base_values.clone();
+        // Re-solves of this iteration with nodes its steps pushed into the tool held on it.
+        let mut blocked_solves = 0;
         let mut convex = false;
         let stiffness = red.mean_diagonal(&base_values).max(f64::MIN_POSITIVE);
         let unit_shift = stiffness / mean_mass.max(f64::MIN_POSITIVE);
         let noise = ENERGY_ROUNDING * state.eval.energy.abs().max(f64::MIN_POSITIVE);
         // What to do when the model turns out indefinite: take the elements' convex parts, which
         // still descend along a saddle; then only a larger shift helps.
-        let fallback = |shift: &mut f64, values: &mut Vec<f64>, convex: &mut bool| {
+        let fallback = |shift: &mut f64, values: &mut Vec<f64>, convex: &mut bool, red: &Reduction, state: &State| {
             if !*convex {
-                if let Some(v) = convex_model(objective, cons, &rep, &red, &state, x) {
+                if let Some(v) = convex_model(objective, cons, &rep, red, state, x) {
                     *values = v;
                     *convex = true;
                     return;
@@ -608,9 +619,12 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         };
         if prefer_convex && residual > EXACT_FIRST_RESIDUAL {
             // The exact model was indefinite last time: start where that ended.
-            fallback(&mut shift, &mut base_values, &mut convex);
+            fallback(&mut shift, &mut base_values, &mut convex, &red, &state);
         }
         let mut values = vec![0.0; base_values.len()];
+        // How far a node may move in this iteration's steps (m): the reach; once nodes are held
+        // on the tool (below), no farther than the objective's data hold.
+        let mut reach_m = reach * cons.spacing;
         // The lumped masses as a matrix of the pattern (for the Rayleigh quotients of refused steps).
         let mut mass_diagonal: Option<Vec<f64>> = None;
         let mut step_capped = false;
@@ -645,21 +659,47 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 Err(e) => {
                     // Clarabel finds no minimum of an indefinite model: as below.
                     failure = Some(e);
-                    fallback(&mut shift, &mut base_values, &mut convex);
+                    fallback(&mut shift, &mut base_values, &mut convex, &red, &state);
                     continue;
                 }
             };
             failure = None;
+            if blocked_solves < MAX_BLOCKED_SOLVES {
+                // Free nodes on the tool that the step moves into it: the model knew nothing of
+                // the tool there (their pull was outward at this state), and the trial would put
+                // them back on its face, a jump the model did not predict that refuses the step
+                // rung after rung. Instead they slide on the tool, and the step is solved again.
+                let delta = red.expand(&y, &state.bases);
+                if block_entering(cons, &rep, &mut state, &delta) {
+                    blocked_solves += 1;
+                    // Nodes that were free now slide on the tool, which the step before did not
+                    // let them: the re-solved step may carry the ply farther over the tool than
+                    // the lagged friction was taken for (a strip over a rod at 1.05 times the
+                    // capstan's friction ran off it so).
+                    reach_m = objective.step_bound(x).map_or(reach_m, |b| b.min(reach_m));
+                    let dofs = dofs_of(&state.bases, &rep);
+                    red.set_dofs(dofs);
+                    g = red.reduce(&unbalanced(&state.eval), &state.bases);
+                    exact_values = exact_model(cons, &rep, &red, &state).expect("the state has its Hessian");
+                    base_values = if convex {
+                        convex_model(objective, cons, &rep, &red, &state, x).expect("the convex model was built before")
+                    } else {
+                        exact_values.clone()
+                    };
+                    mass_diagonal = None;
+                    continue;
+                }
+            }
             let gy = dot(&g, &y);
             let y_model = red.quad(&values, &y);
             let y_hess = red.quad(&base_values, &y);
             if gy >= 0.0 || y_model <= 0.0 || y_hess < -CURVATURE_ROUNDING * y_model {
                 // Not a descent direction of a convex model, or the Hessian curves down along
                 // the step (a saddle's direction).
-                fallback(&mut shift, &mut base_values, &mut convex);
+                fallback(&mut shift, &mut base_values, &mut convex, &red, &state);
                 continue;
             }
-            let (y, capped) = cap_step(&red, y, &state.bases, reach * cons.spacing);
+            let (y, capped) = cap_step(&red, y, &state.bases, reach_m);
             let gy = dot(&g, &y);
             // The decrease the unshifted model predicts (the shifted one's if that is not
             // positive: the Hessian alone is indefinite along y).
@@ -678,24 +718,25 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             let e1 = objective.energy(&trial);
             trial_ms += t_trial.elapsed().as_secs_f64() * 1e3;
             let fall = state.eval.energy - e1;
-            let (trial, trial_feet, fall) =
-                if settings.second_order_correction && !convex && acceptable(fall, predicted, noise) {
-                    // A Newton step (the exact model) leaves the stiff fibres' curved valley to
-                    // second order as well: correct it once more on the factorisation at hand and
-                    // keep whichever state is lower. Near equilibrium this keeps the convergence
-                    // quadratic where the straight step alone stretches the fibres (the 301 x 301
-                    // bench: 7 iterations -> 5; the square table at 2.5 mm: 230 -> 42).
-                    subproblems += 1;
-                    match second_order_correction(objective, cons, &red, &mut engine, &values, &state, x, &trial, reach)
-                    {
-                        Some((trial2, feet2, e2)) if state.eval.energy - e2 > fall => {
-                            (trial2, feet2, state.eval.energy - e2)
-                        }
-                        _ => (trial, trial_feet, fall),
+            let (trial, trial_feet, fall) = if settings.second_order_correction
+                && !convex
+                && acceptable(fall, predicted, noise)
+            {
+                // A Newton step (the exact model) leaves the stiff fibres' curved valley to
+                // second order as well: correct it once more on the factorisation at hand and
+                // keep whichever state is lower. Near equilibrium this keeps the convergence
+                // quadratic where the straight step alone stretches the fibres (the 301 x 301
+                // bench: 7 iterations -> 5; the square table at 2.5 mm: 230 -> 42).
+                subproblems += 1;
+                match second_order_correction(objective, cons, &red, &mut engine, &values, &state, x, &trial, reach_m) {
+                    Some((trial2, feet2, e2)) if state.eval.energy - e2 > fall => {
+                        (trial2, feet2, state.eval.energy - e2)
                     }
-                } else {
-                    (trial, trial_feet, fall)
-                };
+                    _ => (trial, trial_feet, fall),
+                }
+            } else {
+                (trial, trial_feet, fall)
+            };
             if acceptable(fall, predicted, noise) {
                 // Where the model is stiffer along the step than the energy (the shift, or the
                 // convex parts standing in for an indefinite Hessian, limited it: a slow drift
@@ -704,7 +745,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 let y_exact = if convex { red.quad(&exact_values, &y) } else { y_hess };
                 let (trial, trial_feet, fall) = if y_exact < EXTEND_CURVATURE * y_model && fall > ROUNDING_BAND * noise
                 {
-                    extend_step(objective, cons, x, &state, &red, &y, reach * cons.spacing, (trial, trial_feet, fall))
+                    extend_step(objective, cons, x, &state, &red, &y, reach_m, (trial, trial_feet, fall))
                 } else {
                     (trial, trial_feet, fall)
                 };
@@ -734,7 +775,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 // step added to second order, with the same model.
                 subproblems += 1;
                 if let Some((trial2, feet2, e2)) =
-                    second_order_correction(objective, cons, &red, &mut engine, &values, &state, x, &trial, reach)
+                    second_order_correction(objective, cons, &red, &mut engine, &values, &state, x, &trial, reach_m)
                 {
                     let fall2 = state.eval.energy - e2;
                     if acceptable(fall2, predicted, noise) {
@@ -888,6 +929,38 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
         subproblem_status,
         stability: if outcome == Outcome::Converged { stability } else { None },
     }
+}
+
+/// Most re-solves of one iteration with the nodes its step pushed into the tool held on it
+/// ([`block_entering`]).
+const MAX_BLOCKED_SOLVES: usize = 3;
+
+/// Free contact on a moving tool: the free nodes that touch it and that `delta` moves into it
+/// slide on it from now on in this iteration (their basis loses the tool's normal). Whether any
+/// did. Only where the tool moves ([`ContactSurface::moving`]): a punch advancing pushes into
+/// nodes that touch it in every increment of the stroke (forming's iterations fell by 30 to
+/// 45%); on a tool that stands still it was neutral (free drapes of a sphere) and changed the
+/// path a strip running off a rod takes, and with it the friction it was estimated to need
+/// (docs/ARCHITECTURE.md).
+fn block_entering(cons: &Constraints, rep: &[usize], s: &mut State, delta: &[Vector]) -> bool {
+    let Some(tool) = cons.tool.filter(|t| cons.mode == ContactMode::Free && !cons.stick && t.moving()) else {
+        return false;
+    };
+    let mut any = false;
+    for k in 0..rep.len() {
+        if rep[k] != k || s.sliding[k] || s.bases[k].dofs == 0 {
+            continue;
+        }
+        let Some(foot) = s.feet[k].as_mut() else { continue };
+        if foot.gap > ACTIVE_GAP * cons.spacing || delta[k].dot(&foot.normal) >= 0.0 {
+            continue;
+        }
+        s.bases[k] = s.bases[k].without(&foot.normal);
+        s.sliding[k] = true;
+        tool.curve(foot);
+        any = true;
+    }
+    any
 }
 
 /// The shift after a refused step.
@@ -1121,7 +1194,7 @@ fn extend_step(
 
 /// The second-order correction of the step from `x` to `trial` (see the module doc): the model
 /// `values` (already factorised: only triangular solves) solved against the forces the stiff
-/// terms gained to second order along the step, capped at `reach` spacings, and applied from
+/// terms gained to second order along the step, capped at `reach` (m), and applied from
 /// `trial` with the nodes kept on or off the tool. Returns the state, its feet and its energy;
 /// None where the objective has no such forces or the solve failed.
 #[allow(clippy::too_many_arguments)] // the solve's own locals, passed as they are
@@ -1139,7 +1212,7 @@ fn second_order_correction(
     let f2 = objective.second_order_forces(x, trial)?;
     let g2 = red.reduce(&f2, &s.bases);
     let z = engine.solve(red, values, &g2).ok()?;
-    let (z, _) = cap_step(red, z, &s.bases, reach * cons.spacing);
+    let (z, _) = cap_step(red, z, &s.bases, reach);
     let dz = red.expand(&z, &s.bases);
     let (trial2, feet2) = moved(cons, trial, &dz, &s.sliding, &s.feet);
     let e2 = objective.energy(&trial2);
