@@ -336,6 +336,20 @@ struct DieSetUp {
     friction: f64,
 }
 
+/// R 60 mm into R 66 mm with a 6 mm fillet, 40 mm stroke, at 10 mm: the die set-up the tests
+/// share.
+const FILLETED_DIE: DieSetUp = DieSetUp {
+    r: 0.06,
+    opening: 0.066,
+    fillet: 0.006,
+    stroke: 0.04,
+    n: 29,
+    spacing: 0.01,
+    binder: 0.08,
+    pressure: 1.0e4,
+    friction: 0.2,
+};
+
 impl DieSetUp {
     /// Form the blank in `dir` (`punch.obj`, `die.obj`, the scene, `out/`): the command's output
     /// and the net.
@@ -372,17 +386,7 @@ impl DieSetUp {
 /// seventh increment; on its smooth surface it converges in 320 iterations.
 #[test]
 fn a_hemisphere_drawn_through_a_die_with_an_entry_fillet_stays_out_of_both_tools() {
-    let set_up = DieSetUp {
-        r: 0.06,
-        opening: 0.066,
-        fillet: 0.006,
-        stroke: 0.04,
-        n: 29,
-        spacing: 0.01,
-        binder: 0.08,
-        pressure: 1.0e4,
-        friction: 0.2,
-    };
+    let set_up = FILLETED_DIE;
     let DieSetUp { r, opening, fillet, stroke, n, spacing, binder, .. } = set_up;
     let face = r - stroke;
     let tmp = tempfile::tempdir().unwrap();
@@ -634,17 +638,7 @@ fn a_blank_drawn_through_a_die_refined_again_moves_no_node() {
             pressure: 5.0e3,
             friction: 0.3,
         },
-        DieSetUp {
-            r: 0.06,
-            opening: 0.066,
-            fillet: 0.006,
-            stroke: 0.04,
-            n: 29,
-            spacing: 0.01,
-            binder: 0.08,
-            pressure: 1.0e4,
-            friction: 0.2,
-        },
+        FILLETED_DIE,
     ];
     for (k, set_up) in set_ups.into_iter().enumerate() {
         let tmp = tempfile::tempdir().unwrap();
