@@ -239,6 +239,14 @@ impl Freedom {
         }
     }
 
+    /// Whether the node meets the tool in free contact: it moves, and no plane holds it (a
+    /// node the binder grips is held in the blank's plane by the binder, whatever tool lies
+    /// under it: a ply laid on another in a punch-and-die lies a ply's thickness above the
+    /// die's face, and its grip was undone when contact put its nodes on the face).
+    pub fn meets_tool_free(&self) -> bool {
+        self.dofs() > 0 && !matches!(self, Freedom::InPlane(_))
+    }
+
     /// Whether the node slides on the tool (its basis needs the node's [`Foot`]).
     pub fn on_tool(&self) -> bool {
         matches!(self, Freedom::OnTool | Freedom::OnToolInPlane(_))

@@ -454,7 +454,7 @@ fn foot_of(tool: &dyn ContactSurface, cons: &Constraints, k: usize, p: &Point) -
     let f = cons.freedom[k];
     match cons.mode {
         ContactMode::Pressed if f.on_tool() => Some(tool.locate(p, false, None)),
-        ContactMode::Free if f.dofs() > 0 => {
+        ContactMode::Free if f.meets_tool_free() => {
             tool.locate_near(p, cons.spacing, false, None).filter(|foot| foot.gap <= BEARING_GAP * cons.spacing)
         }
         _ => None,

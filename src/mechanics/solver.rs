@@ -1297,7 +1297,9 @@ fn feet_at(cons: &Constraints, x: &[Point], known: Option<Feet>) -> Feet {
         .enumerate()
         .map(|(k, (f, known))| match (cons.mode, f) {
             (ContactMode::Pressed, f) if f.on_tool() => known.or_else(|| Some(tool.locate(&x[k], false, None))),
-            (ContactMode::Free, f) if f.dofs() > 0 => known.or_else(|| tool.locate_near(&x[k], range, false, None)),
+            (ContactMode::Free, f) if f.meets_tool_free() => {
+                known.or_else(|| tool.locate_near(&x[k], range, false, None))
+            }
             _ => None,
         })
         .collect()
@@ -1433,7 +1435,7 @@ fn moved(cons: &Constraints, x: &[Point], delta: &[Vector], sliding: &[bool], fe
                 *p = foot.point;
                 Some(Foot { gap: 0.0, ..foot })
             }
-            ContactMode::Free if f.dofs() > 0 => {
+            ContactMode::Free if f.meets_tool_free() => {
                 let foot = tool.locate_near(p, range, false, last.map(|l| l.facet))?;
                 if sliding || foot.gap < 0.0 {
                     *p = foot.point;
