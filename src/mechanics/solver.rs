@@ -674,8 +674,8 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     blocked_solves += 1;
                     // Nodes that were free now slide on the tool, which the step before did not
                     // let them: the re-solved step may carry the ply farther over the tool than
-                    // the lagged friction was taken for (a strip over a rod at 1.05 times the
-                    // capstan's friction ran off it so).
+                    // the lagged friction was taken for (with blocking on every tool, a strip
+                    // over a rod at 1.05 times the capstan's friction ran off it so).
                     reach_m = objective.step_bound(x).map_or(reach_m, |b| b.min(reach_m));
                     let dofs = dofs_of(&state.bases, &rep);
                     red.set_dofs(dofs);
@@ -938,8 +938,8 @@ const MAX_BLOCKED_SOLVES: usize = 3;
 /// Free contact on a moving tool: the free nodes that touch it and that `delta` moves into it
 /// slide on it from now on in this iteration (their basis loses the tool's normal). Whether any
 /// did. Only where the tool moves ([`ContactSurface::moving`]): a punch advancing pushes into
-/// nodes that touch it in every increment of the stroke (forming's iterations fell by 30 to
-/// 45%); on a tool that stands still it was neutral (free drapes of a sphere) and changed the
+/// nodes that touch it in every increment of the stroke (forming's iterations fell by 15 to
+/// 40%); on a tool that stands still it was neutral (free drapes of a sphere) and changed the
 /// path a strip running off a rod takes, and with it the friction it was estimated to need
 /// (docs/ARCHITECTURE.md).
 fn block_entering(cons: &Constraints, rep: &[usize], s: &mut State, delta: &[Vector]) -> bool {
