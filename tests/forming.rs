@@ -350,6 +350,20 @@ const FILLETED_DIE: DieSetUp = DieSetUp {
     friction: 0.2,
 };
 
+/// R 50 mm into R 56 mm with a 5 mm fillet, 30 mm stroke, at 10 mm, friction 0.3: the second
+/// die set-up the tests share.
+const SMALL_DIE: DieSetUp = DieSetUp {
+    r: 0.05,
+    opening: 0.056,
+    fillet: 0.005,
+    stroke: 0.03,
+    n: 25,
+    spacing: 0.01,
+    binder: 0.07,
+    pressure: 5.0e3,
+    friction: 0.3,
+};
+
 impl DieSetUp {
     /// Form the blank in `dir` (`punch.obj`, `die.obj`, the scene, `out/`): the command's output
     /// and the net.
@@ -455,18 +469,7 @@ fn a_second_ply_formed_through_a_die_is_gripped_in_its_own_plane() {
     // The second ply's largest draw-in along the fibres against the first's (2.4% more
     // measured on the bundled punch-and-die's two plies at 10 mm).
     const DRAW_IN_SHARE: f64 = 0.1;
-    let small = DieSetUp {
-        r: 0.05,
-        opening: 0.056,
-        fillet: 0.005,
-        stroke: 0.03,
-        n: 25,
-        spacing: 0.01,
-        binder: 0.07,
-        pressure: 5.0e3,
-        friction: 0.3,
-    };
-    for (set_up, angle) in [(small, 0.0), (FILLETED_DIE, 45.0)] {
+    for (set_up, angle) in [(SMALL_DIE, 0.0), (FILLETED_DIE, 45.0)] {
         let DieSetUp { r, stroke, spacing, binder, .. } = set_up;
         let face = r - stroke;
         let tmp = tempfile::tempdir().unwrap();
@@ -702,20 +705,7 @@ fn a_blank_formed_through_a_binder_refined_again_moves_no_node() {
 fn a_blank_drawn_through_a_die_refined_again_moves_no_node() {
     let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
     let card = card.to_str().unwrap();
-    let set_ups = [
-        DieSetUp {
-            r: 0.05,
-            opening: 0.056,
-            fillet: 0.005,
-            stroke: 0.03,
-            n: 25,
-            spacing: 0.01,
-            binder: 0.07,
-            pressure: 5.0e3,
-            friction: 0.3,
-        },
-        FILLETED_DIE,
-    ];
+    let set_ups = [SMALL_DIE, FILLETED_DIE];
     for (k, set_up) in set_ups.into_iter().enumerate() {
         let tmp = tempfile::tempdir().unwrap();
         let (stdout, formed) = set_up.form(tmp.path());
