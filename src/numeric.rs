@@ -1,5 +1,16 @@
 //! Small numerical helpers shared by several stages.
 
+/// The root of `a`'s set in a union-find forest (`parent[r] == r` at a root; a set is joined to
+/// another by pointing its root at the other's), halving the path on the way: every node
+/// visited then points to its grandparent, so later searches are short.
+pub fn union_find_root(parent: &mut [usize], mut a: usize) -> usize {
+    while parent[a] != a {
+        parent[a] = parent[parent[a]];
+        a = parent[a];
+    }
+    a
+}
+
 /// Golden-section search for a minimum of `f` on `[lo, hi]`: at most `max_iterations` steps,
 /// stopping early once the bracket is narrower than `rel_tol` times its upper end. Returns the
 /// better of the final bracket's two interior points and its value.
@@ -74,5 +85,19 @@ mod tests {
     fn finds_the_minimum_of_a_parabola() {
         let (x, fx) = super::golden_section_min(|x| (x - 0.3) * (x - 0.3) + 1.0, -1.0, 2.0, 200, 1e-12);
         assert!((x - 0.3).abs() < 1e-6 && (fx - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn union_find_roots_name_the_components_and_shorten_the_paths() {
+        use super::union_find_root;
+        // A chain 9 -> 8 -> ... -> 0, and 10 -> 11 on its own.
+        let mut parent: Vec<usize> = (0..12).map(|k| if k > 0 && k < 10 { k - 1 } else { k }).collect();
+        parent[10] = 11;
+        assert_eq!(union_find_root(&mut parent, 9), 0);
+        // Halved: 9 -> 7 -> 5 -> 3 -> 1 -> 0, each visited node pointing two up the old chain.
+        assert_eq!(&parent[..10], &[0, 0, 1, 1, 3, 3, 5, 5, 7, 7]);
+        assert_eq!(union_find_root(&mut parent, 10), 11);
+        let roots: Vec<usize> = (0..12).map(|k| union_find_root(&mut parent, k)).collect();
+        assert_eq!(roots, [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 11, 11]);
     }
 }

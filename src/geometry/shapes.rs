@@ -860,18 +860,14 @@ mod tests {
         assert!(undirected.values().all(|&c| c <= 2), "non-manifold edge");
         // Components by union-find over edges.
         let mut parent: Vec<usize> = (0..nv).collect();
-        fn find(p: &mut [usize], mut i: usize) -> usize {
-            while p[i] != i {
-                p[i] = p[p[i]];
-                i = p[i];
-            }
-            i
-        }
         for &(i, j) in undirected.keys() {
-            let (a, b) = (find(&mut parent, i as usize), find(&mut parent, j as usize));
+            let (a, b) = (
+                crate::numeric::union_find_root(&mut parent, i as usize),
+                crate::numeric::union_find_root(&mut parent, j as usize),
+            );
             parent[a] = b;
         }
-        let components = (0..nv).filter(|&i| find(&mut parent, i) == i).count();
+        let components = (0..nv).filter(|&i| crate::numeric::union_find_root(&mut parent, i) == i).count();
         Topology {
             boundary_edges: undirected.values().filter(|&&c| c == 1).count(),
             edges: undirected.len(),

@@ -34,6 +34,7 @@
 //! blend running on into the die's opening, or to the fillet a centimetre away.
 use super::surface::{SurfacePoint, ToolSurface};
 use super::{Point, Vector, NO_NEIGHBOUR};
+use crate::numeric::union_find_root;
 use nalgebra::{Matrix2, Matrix3, Vector2};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
@@ -157,14 +158,6 @@ fn wendland(r: f64) -> (f64, f64) {
     (s3 * s * (4.0 * r + 1.0), -20.0 * r * s3)
 }
 
-fn root(parent: &mut [usize], mut a: usize) -> usize {
-    while parent[a] != a {
-        parent[a] = parent[parent[a]];
-        a = parent[a];
-    }
-    a
-}
-
 impl<'a> SmoothSurface<'a> {
     /// The smooth surface of `tool`.
     pub fn new(tool: &'a ToolSurface) -> Self {
@@ -189,12 +182,15 @@ impl<'a> SmoothSurface<'a> {
                     }
                     continue;
                 };
-                let (a, b) = (root(&mut facet_parent, t), root(&mut facet_parent, n));
+                let (a, b) = (union_find_root(&mut facet_parent, t), union_find_root(&mut facet_parent, n));
                 facet_parent[a] = b;
                 for c in [(k + 1) % 3, (k + 2) % 3] {
                     let v = tris[t][c];
                     if let Some(cn) = tris[n].iter().position(|&w| w == v) {
-                        let (a, b) = (root(&mut corner_parent, 3 * t + c), root(&mut corner_parent, 3 * n + cn));
+                        let (a, b) = (
+                            union_find_root(&mut corner_parent, 3 * t + c),
+                            union_find_root(&mut corner_parent, 3 * n + cn),
+                        );
                         corner_parent[a] = b;
                     }
                 }
@@ -204,7 +200,7 @@ impl<'a> SmoothSurface<'a> {
         let mut regions = vec![0u32; tris.len()];
         let mut next_region = 0;
         for (t, region) in regions.iter_mut().enumerate() {
-            let r = root(&mut facet_parent, t);
+            let r = union_find_root(&mut facet_parent, t);
             if region_id[r] == u32::MAX {
                 region_id[r] = next_region;
                 next_region += 1;
@@ -221,7 +217,7 @@ impl<'a> SmoothSurface<'a> {
             let longest =
                 (0..3).map(|c| (verts[tri[(c + 1) % 3] as usize] - verts[tri[c] as usize]).norm()).fold(0.0, f64::max);
             for c in 0..3 {
-                let r = root(&mut corner_parent, 3 * t + c);
+                let r = union_find_root(&mut corner_parent, 3 * t + c);
                 if id_of_root[r] == usize::MAX {
                     id_of_root[r] = sectors.len();
                     sectors.push(Sector {
@@ -680,12 +676,12 @@ fn face_edges(tool: &ToolSurface, sectors: &mut [Sector], sector_of_corner: &[us
                 continue;
             }
             if tool.normal(t as u32).dot(&tool.normal(n)) >= 1.0 - COPLANAR_COS_SLACK {
-                let (a, b) = (root(&mut parent, t), root(&mut parent, n as usize));
+                let (a, b) = (union_find_root(&mut parent, t), union_find_root(&mut parent, n as usize));
                 parent[a] = b;
             }
         }
     }
-    let plane: Vec<usize> = (0..tris.len()).map(|t| root(&mut parent, t)).collect();
+    let plane: Vec<usize> = (0..tris.len()).map(|t| union_find_root(&mut parent, t)).collect();
     // Each sector's facets, and the angle each plane spans at each sector.
     let mut facets: Vec<Vec<usize>> = vec![Vec::new(); sectors.len()];
     let mut spans: Vec<Vec<(usize, f64)>> = vec![Vec::new(); sectors.len()];

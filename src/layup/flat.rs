@@ -31,6 +31,7 @@ use super::curve::{first_crossing, offset_loops, smooth_loop};
 use crate::geometry::Point;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
+use crate::numeric::union_find_root;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
@@ -583,20 +584,13 @@ fn trace_triangles(tri: &Triangles) -> Vec<TriangleRegion> {
     }
     // Regions: union-find over edges shared (reversed) by two triangles.
     let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut k: usize) -> usize {
-        while parent[k] != k {
-            parent[k] = parent[parent[k]];
-            k = parent[k];
-        }
-        k
-    }
     let mut boundary: Vec<([i64; 2], [i64; 2], usize)> = Vec::new();
     for (k, c) in tri.corners.iter().enumerate() {
         for e in 0..3 {
             let (a, b) = (c[e], c[(e + 1) % 3]);
             match edge_of.get(&(b, a)) {
                 Some(&other) => {
-                    let (ra, rb) = (root(&mut parent, k), root(&mut parent, other));
+                    let (ra, rb) = (union_find_root(&mut parent, k), union_find_root(&mut parent, other));
                     // The lower root wins: labels do not depend on the order of the unions.
                     parent[ra.max(rb)] = ra.min(rb);
                 }
@@ -604,7 +598,7 @@ fn trace_triangles(tri: &Triangles) -> Vec<TriangleRegion> {
             }
         }
     }
-    let roots: Vec<usize> = (0..n).map(|k| root(&mut parent, k)).collect();
+    let roots: Vec<usize> = (0..n).map(|k| union_find_root(&mut parent, k)).collect();
     let mut region_of_root: HashMap<usize, usize> = HashMap::new();
     let mut members: Vec<Vec<usize>> = Vec::new();
     for (k, &r) in roots.iter().enumerate() {

@@ -15,6 +15,7 @@ use crate::kinematic::provenance::{
     CellChanges, ContactRecord, ContactState, SolverRecord, Stability, UnbalancedRecord, BETWEEN_PLIES,
 };
 use crate::kinematic::{drape_smooth, DrapeNet, KinematicSettings, Method, NodeStatus, SurfaceKind};
+use crate::numeric::union_find_root;
 
 /// Which Hessian the quadratic models use: the exact one (the solver's shift handles its
 /// negative curvature).
@@ -912,15 +913,8 @@ pub fn connected_body(net: &DrapeNet, layout: Option<&SheetLayout>) -> Vec<bool>
     };
     let cells: Vec<bool> = (0..cu * cv).map(|c| complete(c / cv, c % cv)).collect();
     let mut parent: Vec<usize> = (0..cells.len()).collect();
-    fn root(parent: &mut [usize], mut a: usize) -> usize {
-        while parent[a] != a {
-            parent[a] = parent[parent[a]];
-            a = parent[a];
-        }
-        a
-    }
     fn join(parent: &mut [usize], a: usize, b: usize) {
-        let (ra, rb) = (root(parent, a), root(parent, b));
+        let (ra, rb) = (union_find_root(parent, a), union_find_root(parent, b));
         parent[ra] = rb;
     }
     for i in 0..cu {
@@ -959,7 +953,7 @@ pub fn connected_body(net: &DrapeNet, layout: Option<&SheetLayout>) -> Vec<bool>
     }
     let mut size = vec![0usize; cells.len()];
     for (c, _) in cells.iter().enumerate().filter(|(_, &complete)| complete) {
-        size[root(&mut parent, c)] += 1;
+        size[union_find_root(&mut parent, c)] += 1;
     }
     // The group at the origin node, else the largest.
     let (i0, j0) = net.origin_node;
@@ -967,15 +961,15 @@ pub fn connected_body(net: &DrapeNet, layout: Option<&SheetLayout>) -> Vec<bool>
         [(i0, j0), (i0.wrapping_sub(1), j0), (i0, j0.wrapping_sub(1)), (i0.wrapping_sub(1), j0.wrapping_sub(1))]
             .into_iter()
             .filter(|&(i, j)| i < cu && j < cv && cells[i * cv + j])
-            .map(|(i, j)| root(&mut parent, i * cv + j))
+            .map(|(i, j)| union_find_root(&mut parent, i * cv + j))
             .max_by_key(|&r| size[r]);
-    let Some(chosen) = at_origin
-        .or_else(|| (0..cells.len()).filter(|&c| cells[c]).map(|c| root(&mut parent, c)).max_by_key(|&r| size[r]))
-    else {
+    let Some(chosen) = at_origin.or_else(|| {
+        (0..cells.len()).filter(|&c| cells[c]).map(|c| union_find_root(&mut parent, c)).max_by_key(|&r| size[r])
+    }) else {
         return body;
     };
     for (c, _) in cells.iter().enumerate().filter(|(_, &complete)| complete) {
-        if root(&mut parent, c) == chosen {
+        if union_find_root(&mut parent, c) == chosen {
             let (i, j) = (c / cv, c % cv);
             for (a, b) in [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)] {
                 body[net.index(a, b)] = true;
