@@ -429,3 +429,37 @@ fn preloaded_friction_balances_the_tangential_push_up_to_its_capacity() {
     assert_eq!(gradient[2], Vector::zeros());
     assert_eq!(lag.origin[2], x[2]);
 }
+
+/// A frictionless sheet dropped onto a sphere from above it, off its pole, lands and slides off:
+/// the run says so within a bounded number of iterations. Nothing bears when the drop begins,
+/// so the slide is measured from where the sheet lands (before, the sheet slid off unseen and
+/// fell to the iteration limit: the bundled sphere's sheet at mu = 0, 2,000 iterations).
+#[test]
+fn a_frictionless_sheet_dropped_off_a_spheres_pole_is_said_to_slide() {
+    let r = 0.2;
+    let tool = shapes::icosphere(r, Point::origin(), 4).into_surface().unwrap();
+    let fabric = card("sze-liu-table1.toml");
+    for (offset, height) in [([0.03, 0.02], 0.004), ([-0.05, 0.01], 0.01)] {
+        let d = 0.02;
+        let plate = shapes::plate(0.6, 0.6, 6, 6).into_surface().unwrap();
+        let mut net =
+            drape(&plate, &KinematicSettings::grid("sheet", Point::origin(), Vector::x(), d, 21, 21)).unwrap();
+        // The flat sheet above the pole, its centre `offset` off it in plan.
+        for p in net.positions.iter_mut() {
+            *p += Vector::new(offset[0], offset[1], r + height);
+        }
+        let settings = RefineSettings {
+            mode: ContactMode::Free,
+            friction: 0.0,
+            solver: SolverSettings::default().max_iterations(600),
+            ..RefineSettings::default()
+        };
+        let refined = refine(&net, &tool, &fabric, &settings).unwrap();
+        let iterations: usize = refined.steps.iter().map(|s| s.iterations.len()).sum();
+        let what =
+            format!("offset {offset:?}, {height} m above: {iterations} iterations, {}", refined.describe_failure());
+        assert_eq!(refined.outcome(), Outcome::Slides, "{what}");
+        assert!(matches!(refined.slide, Some(Slide::Away { .. })), "{what}");
+        assert!(iterations < 600, "{what}");
+    }
+}

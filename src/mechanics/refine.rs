@@ -710,7 +710,10 @@ fn refine_among<L: Laws + ?Sized>(
         let ok = loop {
             increment.solves += 1;
             let before = x.clone();
-            let travel = (friction > 0.0).then_some((before.as_slice(), RELAG_TRAVEL_SPACINGS * kinematic.spacing));
+            // With friction, and while nothing bears on the tool (a ply dropped onto it: its
+            // lag, bearing nothing, would not see it slide away after it lands).
+            let travel = (friction > 0.0 || lag.total_force() <= 0.0)
+                .then_some((before.as_slice(), RELAG_TRAVEL_SPACINGS * kinematic.spacing));
             let step_limit = lag.mean_slip(&x) + RELAG_SHARE * limit;
             let frictional = Frictional { inner: &objective, lag: &lag, slide_limit: step_limit, travel };
             let mut this_solve = solver_settings.clone().max_iterations(budget);
