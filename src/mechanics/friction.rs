@@ -328,8 +328,8 @@ pub struct Frictional<'a> {
     pub slide_limit: f64,
     /// Where the solve began, and how far a node may travel from there before the solve stops
     /// (m): normal forces taken where a falling sheet has not landed yet hold only while it
-    /// falls a few spacings. None: no limit (frictionless, where the normal forces are only
-    /// the slide's measure).
+    /// falls a few spacings; and, frictionless, while nothing bears (the slide, measured on
+    /// the nodes that bear, would not see a ply that lands and slides off). None: no limit.
     pub travel: Option<(&'a [Point], f64)>,
 }
 
