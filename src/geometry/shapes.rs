@@ -820,6 +820,7 @@ pub fn icosphere(radius: f64, centre: Point, levels: usize) -> TriangleMesh {
 mod tests {
     use super::*;
     use crate::geometry::Vector;
+    use crate::numeric::union_find_root;
     use std::collections::{HashMap, HashSet};
     use std::f64::consts::PI;
 
@@ -861,13 +862,10 @@ mod tests {
         // Components by union-find over edges.
         let mut parent: Vec<usize> = (0..nv).collect();
         for &(i, j) in undirected.keys() {
-            let (a, b) = (
-                crate::numeric::union_find_root(&mut parent, i as usize),
-                crate::numeric::union_find_root(&mut parent, j as usize),
-            );
+            let (a, b) = (union_find_root(&mut parent, i as usize), union_find_root(&mut parent, j as usize));
             parent[a] = b;
         }
-        let components = (0..nv).filter(|&i| crate::numeric::union_find_root(&mut parent, i) == i).count();
+        let components = (0..nv).filter(|&i| union_find_root(&mut parent, i) == i).count();
         Topology {
             boundary_edges: undirected.values().filter(|&&c| c == 1).count(),
             edges: undirected.len(),
