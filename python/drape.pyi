@@ -222,7 +222,8 @@ def export(
 
     Returns a dict: ``files`` (the Paths written), ``nodes`` and ``elements`` of the mesh,
     ``covered`` (elements the ply covers), ``max_abs_shear_deg`` and ``mean_abs_shear_deg`` over
-    them, ``vf_capped`` (elements at the fibre packing limit), ``notes`` (on the mesh and map).
+    them, ``vf_capped`` (elements at the fibre packing limit), ``collapsed`` (elements on cells
+    sheared past 75 deg, written at that shear), ``notes`` (on the mesh and map).
     """
 
 

@@ -422,3 +422,67 @@ fn export_lengths_in_millimetres_are_the_same_lengths_in_metres() {
     assert!(stderr.contains("--units"), "{stderr}");
     assert!(!case.dir.join("x.csv").exists());
 }
+
+/// A net sheared by `shear_deg` everywhere: warp along x, the weft turned to meet it at
+/// 90 - shear_deg, the origin node at the origin of the xy plane.
+fn uniformly_sheared_net(shear_deg: f64) -> DrapeNet {
+    let (n, d) = (11, 0.01);
+    let g = shear_deg.to_radians();
+    let (warp, weft) = (Vector::x(), Vector::new(g.sin(), g.cos(), 0.0));
+    let mut net = DrapeNet::new("s", d, n, n, (n / 2, n / 2));
+    for i in 0..n {
+        for j in 0..n {
+            let k = net.index(i, j);
+            let (u, v) = ((i as f64 - (n / 2) as f64) * d, (j as f64 - (n / 2) as f64) * d);
+            net.positions[k] = Point::origin() + warp * u + weft * v;
+            net.status[k] = drape::kinematic::NodeStatus::Placed;
+        }
+    }
+    net
+}
+
+/// A ply sheared past the collapse of its cells (75 deg: a mechanical result crushed or folded
+/// there) is exported at that shear's thickness and Vf, and the export says where; short of it
+/// the thickness is t0 / cos(shear) as before. At a fold, cos(shear) -> 0 wrote a formed hat
+/// box's 0.35 mm ply as 254 mm thick.
+#[test]
+fn a_ply_sheared_past_its_collapse_is_exported_at_the_collapse_not_as_a_spike() {
+    let dir = tempfile::tempdir().unwrap();
+    // One small element about the origin node: it lies on the net however thin its cells.
+    let mesh = dir.path().join("element.obj");
+    std::fs::write(&mesh, "v -0.002 -0.00005 0\nv 0.002 -0.00005 0\nv 0 0.0001 0\nf 1 2 3\n").unwrap();
+    let t0 = 5e-4;
+    let card = root().join("materials/glass-plain-weave.toml");
+    let vf0 = drape::material::MaterialCard::load(&card).unwrap().flow.unwrap().fibre_volume_fraction;
+    let collapse = drape::material::flow::COLLAPSED_SHEAR_DEG;
+    for shear_deg in [0.0, 30.0, 60.0, 74.0, 76.0, 85.0, 89.9] {
+        let net_path = dir.path().join(format!("s{shear_deg}.drape.json"));
+        drape::io::write_json(&uniformly_sheared_net(shear_deg), &net_path).unwrap();
+        for cavity in ["free", "fixed"] {
+            let out = dir.path().join(format!("s{shear_deg}-{cavity}.csv"));
+            let run = Command::cargo_bin("drape")
+                .unwrap()
+                .args(["export", "--net", net_path.to_str().unwrap(), "--mesh", mesh.to_str().unwrap()])
+                .args(["--format", "csv", "--out", out.to_str().unwrap(), "--cavity", cavity])
+                .args(["--material", card.to_str().unwrap(), "--thickness", &t0.to_string()])
+                .output()
+                .unwrap();
+            let stdout = String::from_utf8_lossy(&run.stdout);
+            assert!(run.status.success(), "{shear_deg} deg: {stdout} {}", String::from_utf8_lossy(&run.stderr));
+            let text = std::fs::read_to_string(&out).unwrap();
+            let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+            let row: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
+            let field = |name: &str| row[header.iter().position(|h| *h == name).unwrap()].parse::<f64>().unwrap();
+            assert!((field("shear_deg") - shear_deg).abs() < 1e-6, "{shear_deg} deg: {text}");
+            let taken = shear_deg.min(collapse).to_radians();
+            let (t, vf) = match cavity {
+                "free" => (t0 / taken.cos(), vf0),
+                _ => (t0, (vf0 / taken.cos()).min(drape::material::flow::VF_CAP)),
+            };
+            assert!((field("thickness") - t).abs() < 1e-9 * t, "{shear_deg} deg {cavity}: {text}");
+            assert!((field("vf") - vf).abs() < 1e-9, "{shear_deg} deg {cavity}: {text}");
+            let said = stdout.contains(&format!("1 elements lie on cells of the drape sheared past {collapse} deg"));
+            assert_eq!(said, shear_deg > collapse, "{shear_deg} deg: {stdout}");
+        }
+    }
+}

@@ -545,6 +545,7 @@ fn export<'py>(
     result.set_item("max_abs_shear_deg", coverage.max_abs_shear_deg)?;
     result.set_item("mean_abs_shear_deg", coverage.mean_abs_shear_deg)?;
     result.set_item("vf_capped", coverage.capped)?;
+    result.set_item("collapsed", coverage.collapsed)?;
     result.set_item("notes", notes)?;
     Ok(result)
 }

@@ -3,7 +3,7 @@
 use super::{input, Failure};
 use crate::io::read_net;
 use crate::mapping::PlyMap;
-use crate::material::flow::{Cavity, VF_CAP};
+use crate::material::flow::{Cavity, COLLAPSED_SHEAR_DEG, VF_CAP};
 use crate::pipeline::export::{export_net, ExportOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -11,9 +11,9 @@ use std::path::PathBuf;
 /// Cavity on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum CavityArg {
-    /// Closed mould: thickness fixed, Vf = Vf0 / cos(shear).
+    /// Closed mould: thickness fixed, Vf = Vf0 / cos(shear) (shear at most 75 deg, a collapsed cell).
     Fixed,
-    /// Free thickness: t = t0 / cos(shear), Vf = Vf0.
+    /// Free thickness: t = t0 / cos(shear) (shear at most 75 deg, a collapsed cell), Vf = Vf0.
     Free,
 }
 
@@ -110,6 +110,12 @@ pub(crate) fn coverage_line(ply: &PlyMap) -> String {
         line += &format!(
             "; note: the ply covers only part of the flow mesh, {} element(s) lie outside it and carry no fibre data",
             c.elements - c.covered
+        );
+    }
+    if c.collapsed > 0 {
+        line += &format!(
+            "; {} elements lie on cells of the drape sheared past {COLLAPSED_SHEAR_DEG} deg (collapsed or folded: the fabric bunches there): their thickness and Vf are written as at {COLLAPSED_SHEAR_DEG} deg",
+            c.collapsed
         );
     }
     if c.capped > 0 {

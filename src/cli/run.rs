@@ -11,6 +11,7 @@ use crate::kinematic::provenance::Stability;
 use crate::layup::stack::PlyResult;
 use crate::layup::table::{shear_range_warning, CoverageOf};
 use crate::layup::{LockingSource, DEFAULT_LOCKING_ANGLE_DEG};
+use crate::material::flow::COLLAPSED_SHEAR_DEG;
 use crate::pipeline::run::{run as run_scene, Event, RunError};
 use crate::pipeline::Scene;
 use clap::Args;
@@ -68,6 +69,12 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
                 println!(
                     "ply '{name}': the plies below bridge concave corners tighter than their thickness ({} offset vertices moved off the normals)",
                     result.offset.relaxed
+                );
+            }
+            if result.collapsed_below > 0 {
+                println!(
+                    "warning: ply '{name}': the plies below are sheared past {COLLAPSED_SHEAR_DEG} deg (collapsed or folded cells: the fabric bunches there) over {} tool vertices; the stack counts them at {COLLAPSED_SHEAR_DEG} deg",
+                    result.collapsed_below
                 );
             }
             if result.offset.folded > 0 {

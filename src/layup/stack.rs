@@ -85,6 +85,10 @@ pub struct PlyResult {
     pub warp: Vector,
     /// How the tool was offset for this ply (nothing moved for the first).
     pub offset: OffsetReport,
+    /// Tool vertices under cells of the plies below sheared past their collapse
+    /// ([`COLLAPSED_SHEAR_DEG`](crate::material::flow::COLLAPSED_SHEAR_DEG)): the stack counts
+    /// them at that shear's thickness.
+    pub collapsed_below: usize,
     /// Its row of the layup table.
     pub stats: PlyStats,
 }
@@ -264,8 +268,10 @@ pub fn drape_layup(
         StackSide::Normal => 1.0,
         StackSide::Opposite => -1.0,
     };
-    // Thickness of the stack so far at every tool vertex, metres.
+    // Thickness of the stack so far at every tool vertex, metres, and whether a ply below is
+    // collapsed there.
     let mut stack = vec![0.0; tool.vertices().len()];
+    let mut collapsed = vec![false; tool.vertices().len()];
     let mut results: Vec<PlyResult> = Vec::new();
     for (k, ply) in layup.plies.iter().enumerate() {
         on_ply(k, &ply.settings.name);
@@ -274,6 +280,7 @@ pub fn drape_layup(
         // Where this ply lies: the tool offset by the stack below it (before bridging corners).
         // The plies below end in a ramp, not a cliff (see `PLY_DROP_SLOPE`).
         let signed: Vec<f64> = ramp_drops(tool, &stack, PLY_DROP_SLOPE).iter().map(|h| sign * h).collect();
+        let collapsed_below = collapsed.iter().filter(|c| **c).count();
         let under = offset_vertices(tool, &dirs, &signed);
         let (offset_tool, offset) = if k == 0 {
             (None, OffsetReport::default())
@@ -371,7 +378,7 @@ pub fn drape_layup(
         net.meta.thickness_m = ply.thickness;
         if let Some(t0) = ply.thickness {
             if k + 1 < layup.plies.len() {
-                add_ply_thickness(&mut stack, &under, &net, t0);
+                add_ply_thickness(&mut stack, &mut collapsed, &under, &net, t0);
             }
         }
         let areal_mass = ply.material.as_ref().map(|m| m.card.areal_mass);
@@ -388,7 +395,7 @@ pub fn drape_layup(
                 stats.fabric_mass = areal_mass.map(|m| m * p.area);
             }
         }
-        results.push(PlyResult { net, refined, kinematic, choice, warp, offset, stats });
+        results.push(PlyResult { net, refined, kinematic, choice, warp, offset, collapsed_below, stats });
     }
     Ok(results)
 }
@@ -420,9 +427,11 @@ fn on_plies_below(r: &super::Refinement, stack: &[f64], tool: &ToolSurface, belo
 }
 
 /// Add a draped ply's thickness t0 / cos(gamma) (sheared cells keep their fibre lengths, so their
-/// area shrinks by cos(gamma) and the ply thickens) to the stack at every tool vertex it covers;
+/// area shrinks by cos(gamma) and the ply thickens; gamma at most
+/// [`COLLAPSED_SHEAR_DEG`](crate::material::flow::COLLAPSED_SHEAR_DEG)) to the stack at every
+/// tool vertex it covers, marking in `collapsed` those it covers with a cell sheared past that;
 /// `under[v]` is where vertex `v` lay for this ply (the tool offset by the stack below it).
-fn add_ply_thickness(stack: &mut [f64], under: &[Point], net: &DrapeNet, t0: f64) {
+fn add_ply_thickness(stack: &mut [f64], collapsed: &mut [bool], under: &[Point], net: &DrapeNet, t0: f64) {
     let Some(sampler) = NetSampler::new(net) else { return };
     // The net follows its surface up to the chord sagitta and, for a refined ply, what the
     // mechanics moved it: accept it within a ply thickness or a cell of the surface.
@@ -430,6 +439,7 @@ fn add_ply_thickness(stack: &mut [f64], under: &[Point], net: &DrapeNet, t0: f64
     for (v, p) in under.iter().enumerate() {
         if let Some(hit) = sampler.cover(p, reach) {
             stack[v] += sheared_thickness(t0, hit.shear());
+            collapsed[v] |= crate::material::flow::collapsed(hit.shear());
         }
     }
 }

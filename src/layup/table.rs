@@ -72,6 +72,10 @@ pub struct ExportPlyRow {
     /// Mean |shear| over the covered elements, degrees.
     #[serde(default)]
     pub mean_abs_shear_deg: Option<f64>,
+    /// Covered elements on cells sheared past the collapse (`material::flow::COLLAPSED_SHEAR_DEG`),
+    /// whose thickness and Vf were written at that shear.
+    #[serde(default)]
+    pub collapsed_elements: usize,
 }
 
 /// One ply of the layup table.
@@ -177,6 +181,10 @@ pub struct LayupRow {
     /// Offset vertices moved off their normals to bridge tight concave corners.
     #[serde(default)]
     pub offset_bridged_vertices: Option<usize>,
+    /// Tool vertices under cells of the plies below sheared past their collapse
+    /// (`material::flow::COLLAPSED_SHEAR_DEG`), counted in the offset at that shear's thickness.
+    #[serde(default)]
+    pub offset_collapsed_vertices: Option<usize>,
     /// How far the blank's edge moved in towards the seed, in plan, along the fibres and the
     /// diagonals through the origin node.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -288,6 +296,7 @@ impl LayupRow {
             offset_m: Some(result.offset.max_distance),
             offset_folded_triangles: Some(result.offset.folded),
             offset_bridged_vertices: Some(result.offset.relaxed),
+            offset_collapsed_vertices: Some(result.collapsed_below),
             shear_range_warning: shear_range_warning(ply, result),
             draw_in: result.net.meta.draw_in.clone(),
             wrinkles: result.net.meta.wrinkles.as_ref().map(|w| w.summary.clone()),

@@ -6,7 +6,7 @@ pub mod mesh;
 use crate::geometry::{Point, Vector};
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::DrapeNet;
-pub use crate::material::flow::{Cavity, PermeabilityModel, VF_CAP, VF_MAX_HEX};
+pub use crate::material::flow::{collapsed, Cavity, PermeabilityModel, COLLAPSED_SHEAR_DEG, VF_CAP, VF_MAX_HEX};
 pub use mesh::{Degeneracy, ElementShape, FlowElement, FlowMesh, MeshCard, MeshCards, DEGENERATE_RATIO};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -429,6 +429,9 @@ pub struct Coverage {
     pub mean_abs_shear_deg: f64,
     /// Covered elements whose Vf0 / cos(shear) reached the packing cap [`VF_CAP`].
     pub capped: usize,
+    /// Covered elements sheared past [`COLLAPSED_SHEAR_DEG`] (collapsed cells of the drape): their
+    /// thickness and Vf are those of that shear.
+    pub collapsed: usize,
 }
 
 impl PlyMap {
@@ -443,6 +446,7 @@ impl PlyMap {
             max_abs_shear_deg: max,
             mean_abs_shear_deg: mean,
             capped: self.elements.iter().flatten().filter(|f| f.vf >= VF_CAP).count(),
+            collapsed: self.elements.iter().flatten().filter(|f| collapsed(f.shear)).count(),
         }
     }
 }

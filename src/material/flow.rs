@@ -7,9 +7,10 @@ use nalgebra::Matrix3;
 /// What happens to a sheared ply's thickness (REFERENCES.md §5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Cavity {
-    /// Closed mould, cavity thickness fixed: t = t0, Vf = Vf0 / cos(gamma).
+    /// Closed mould, cavity thickness fixed: t = t0, Vf = Vf0 / cos(gamma) (gamma at most
+    /// [`COLLAPSED_SHEAR_DEG`], Vf at most [`VF_CAP`]).
     Fixed,
-    /// Free thickness: t = t0 / cos(gamma), Vf = Vf0.
+    /// Free thickness: t = t0 / cos(gamma) (gamma at most [`COLLAPSED_SHEAR_DEG`]), Vf = Vf0.
     Free,
 }
 
@@ -26,14 +27,34 @@ impl Cavity {
 
 /// Thickness of a ply laid flat at `t0` and sheared by `shear` (radians) where nothing presses
 /// it: a sheared cell keeps its fibre lengths, so its area shrinks by cos(shear) and the ply
-/// thickens to t0 / cos(shear).
+/// thickens to t0 / cos(shear), up to [`COLLAPSED_SHEAR_DEG`].
 pub fn sheared_thickness(t0: f64, shear: f64) -> f64 {
     t0 / shear_cos(shear)
 }
 
-/// cos(shear), kept above zero so that a fully sheared cell gives a huge but finite value.
+/// Shear (degrees) past which a cell of a drape has collapsed: it has lost three quarters of its
+/// area (the kinematic stage refuses a node there by default, `DEFAULT_MAX_SHEAR_DEG`), and a
+/// mechanical result sheared further has a folded or crushed cell, its fabric bunched into a
+/// wrinkle rather than thickened in the plane. Thickness and Vf are not carried past it: at the
+/// fold itself cos(shear) -> 0, and a formed hat box's 0.35 mm ply read 254 mm thick in the flow
+/// export and raised the next ply's tool by 285 mm (every vertex moved, 9,842 facets folded).
+/// Past it they stay at its values (t0 / cos 75 deg = 3.9 t0); the exports and the layup count
+/// where ([`collapsed`]).
+pub const COLLAPSED_SHEAR_DEG: f64 = 75.0;
+
+/// Whether a cell sheared by `shear` (radians) has collapsed ([`COLLAPSED_SHEAR_DEG`]).
+pub fn collapsed(shear: f64) -> bool {
+    shear.abs() > COLLAPSED_SHEAR_DEG.to_radians()
+}
+
+/// cos(shear), with the shear taken at most [`COLLAPSED_SHEAR_DEG`] (NaN stays NaN).
 fn shear_cos(shear: f64) -> f64 {
-    shear.cos().max(f64::MIN_POSITIVE)
+    let limit = COLLAPSED_SHEAR_DEG.to_radians();
+    if shear.abs() > limit {
+        limit.cos()
+    } else {
+        shear.cos()
+    }
 }
 
 /// Gebart's constant c for the axial permeability of a hexagonal fibre packing (Gebart 1992).
@@ -75,5 +96,35 @@ impl PermeabilityModel {
         let nn = normal * normal.transpose();
         let p = Matrix3::identity() - nn;
         a * k_par + (p - a) * k_perp + nn * k_perp
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sheared_ply_thickens_as_its_cells_shrink_until_they_collapse() {
+        let t0 = 3.5e-4;
+        for deg in [0.0, 10.0, 45.0, 60.0, 74.9] {
+            let g = f64::to_radians(deg);
+            for shear in [g, -g] {
+                let t = sheared_thickness(t0, shear);
+                assert!((t - t0 / g.cos()).abs() <= 1e-15 * t, "{deg} deg: {t}");
+                assert!(!collapsed(shear));
+            }
+        }
+        // Past the collapse, and at the fold itself, the thickness stays that of 75 deg.
+        let at_collapse = t0 / COLLAPSED_SHEAR_DEG.to_radians().cos();
+        assert!((at_collapse / t0 - 3.8637).abs() < 1e-4);
+        for deg in [75.1, 80.0, 89.92, 90.0] {
+            let shear = f64::to_radians(deg);
+            assert!(collapsed(shear) && collapsed(-shear), "{deg} deg");
+            assert_eq!(sheared_thickness(t0, shear), at_collapse, "{deg} deg");
+            assert_eq!(sheared_thickness(t0, -shear), at_collapse, "{deg} deg");
+            assert_eq!(Cavity::Free.sheared(t0, 0.45, shear), (at_collapse, 0.45));
+            assert_eq!(Cavity::Fixed.sheared(t0, 0.2, shear), (t0, 0.2 / COLLAPSED_SHEAR_DEG.to_radians().cos()));
+        }
+        assert!(sheared_thickness(t0, f64::NAN).is_nan());
     }
 }

@@ -511,6 +511,7 @@ fn export_flow(
                     share: if c.elements > 0 { c.covered as f64 / c.elements as f64 } else { 0.0 },
                     max_abs_shear_deg: any.then_some(c.max_abs_shear_deg),
                     mean_abs_shear_deg: any.then_some(c.mean_abs_shear_deg),
+                    collapsed_elements: c.collapsed,
                 }
             })
             .collect(),
