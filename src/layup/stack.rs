@@ -15,7 +15,7 @@ use crate::kinematic::provenance::FormingRecord;
 use crate::kinematic::sampler::NetSampler;
 use crate::kinematic::{drape, DrapeNet, Extent, KinematicSettings, MethodChoice, NodeStatus};
 use crate::material::flow::sheared_thickness;
-use crate::mechanics::forming::PlanView;
+use crate::mechanics::forming::{turned_over, PlanView};
 use crate::mechanics::friction::PliesBelow;
 use crate::mechanics::refine::{RefineError, Refined};
 use crate::mechanics::sheet::{blank_fractions, blank_nodes, default_origin_node, flat_sheet, SheetError};
@@ -155,11 +155,7 @@ pub fn resolve_warp(
     side: StackSide,
 ) -> Result<Vector, String> {
     let sp = surface.closest_point(origin);
-    let n = seed_normal(surface, &sp.point);
-    let n = match side {
-        StackSide::Normal => n,
-        StackSide::Opposite => -n,
-    };
+    let n = stacking_normal(surface, origin, side);
     let (direction, angle) = match ply.orientation {
         Orientation::Warp(w) => (w, 0.0),
         Orientation::Angle(a) => (*reference, a),
@@ -177,6 +173,15 @@ pub fn resolve_warp(
     }
     let rotation = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(n), angle);
     Ok((rotation * projected).normalize())
+}
+
+/// Unit normal of `surface` at the seed `origin`, pointing to the side the plies stack on.
+pub(crate) fn stacking_normal(surface: &ToolSurface, origin: &Point, side: StackSide) -> Vector {
+    let n = seed_normal(surface, &surface.closest_point(origin).point);
+    match side {
+        StackSide::Normal => n,
+        StackSide::Opposite => -n,
+    }
 }
 
 /// Unit normal of `surface` at its point `p`: the facet's normal inside a facet, the mean of the
@@ -323,6 +328,16 @@ pub fn drape_layup(
             (Some(r), 1..) => Some(on_plies_below(r, &stack, tool, &results)),
             (r, _) => r.clone(),
         };
+        // The mechanics keeps a ply on the side its tool's normals point to: with the plies on
+        // the other side (stack_side = "opposite", a tool whose file faces into the part), it
+        // meets the tool turned over.
+        let turned = match (layup.stack_side, &refinement) {
+            (StackSide::Opposite, Some(_)) => {
+                Some(turned_over(surface).map_err(|source| LayupError::Offset { ply: name.clone(), line, source })?)
+            }
+            _ => None,
+        };
+        let contact = turned.as_ref().unwrap_or(surface);
         let (start_net, refined, choice) = match (start, &ply.auto, &refinement) {
             (Start::Kinematic, Some(auto), Some(r)) => {
                 let a = drape_auto(surface, &settings, r, ply.locking_angle, *auto).map_err(|e| match e {
@@ -335,12 +350,12 @@ pub fn drape_layup(
                 let net = match start {
                     Start::Kinematic => drape(surface, &settings).map_err(drape_error)?,
                     Start::Flat { normal } => {
-                        flat_start(ply, &settings, &normal, surface).map_err(|source| refine_error(source.into()))?
+                        flat_start(ply, &settings, &normal, contact).map_err(|source| refine_error(source.into()))?
                     }
                 };
                 let refined = match start {
-                    Start::Kinematic => r.as_ref().map(|r| r.run_draped(&net, surface, None, &settings)),
-                    Start::Flat { .. } => r.as_ref().map(|r| r.run(&net, surface, None)),
+                    Start::Kinematic => r.as_ref().map(|r| r.run_draped(&net, contact, None, &settings)),
+                    Start::Flat { .. } => r.as_ref().map(|r| r.run(&net, contact, None)),
                 }
                 .transpose()
                 .map_err(refine_error)?;
