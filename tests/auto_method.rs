@@ -600,3 +600,43 @@ fn auto_probes_the_cone_until_the_slide_settles_and_mechanics_goes_on_from_there
         .fold(0.0f64, |m, v| m.max(v.abs()));
     assert!((change - probe).abs() < 0.125, "mechanics changed the shear by {change} deg, the probe saw {probe} deg");
 }
+
+/// A tool whose file faces into the part, with `stack_side = "opposite"`: auto drapes on it as
+/// given and its mechanics meets the tool from the plies' side, so it chooses and presses
+/// exactly as on the file facing out. (Before, auto's mechanics pressed the ply onto the tool
+/// from the wrong side.) Two generated spheres, two cards and ply angles.
+#[test]
+fn auto_on_a_tool_facing_into_the_part_chooses_and_presses_as_on_the_one_facing_out() {
+    use drape::geometry::{shapes, TriangleMesh};
+    for (radius, angle, card) in [(0.1, 0.0, "glass-plain-weave"), (0.13, 30.0, "carbon-twill")] {
+        let outward = shapes::icosphere(radius, drape::geometry::Point::origin(), 4);
+        let inward = TriangleMesh {
+            vertices: outward.vertices.clone(),
+            triangles: outward.triangles.iter().map(|&[p, q, s]| [p, s, q]).collect(),
+        };
+        let z = radius;
+        let scene = |tool: &str, side: &str| {
+            format!(
+                "units = \"m\"\ntool = \"{tool}\"\nreference = [1.0, 0.0, 0.0]\n{side}[[ply]]\nname = \"p\"\n\
+                 origin = [0.0, 0.0, {z}]\nangle_deg = {angle}\nmaterial = \"{}\"\nspacing = 0.012\n\
+                 grid = [15, 15]\nmethod = \"auto\"\ntolerance_deg = 0.002\n",
+                repo(&format!("materials/{card}.toml")).display()
+            )
+        };
+        let tools = [("out.obj", &outward), ("in.obj", &inward)];
+        let mut nets = Vec::new();
+        for (tool, side) in [("out.obj", ""), ("in.obj", "stack_side = \"opposite\"\n")] {
+            let dir = tempfile::tempdir().unwrap();
+            let (out, stdout) = crate::common::run_scene(dir.path(), &tools, &scene(tool, side));
+            let row = read_json(&out.join("layup.json"))["plies"][0].clone();
+            assert_eq!(row["method"], "mechanical", "{tool}: {stdout} {}", row["method_choice"]);
+            nets.push(drape::io::read_net(&out.join("p.drape.json")).unwrap());
+        }
+        let moved = nets[0].positions.iter().zip(&nets[1].positions).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        // The two files hold the same points; only the facets' winding differs.
+        assert!(
+            moved <= 1e-9,
+            "radius {radius}, {card}: the ply on the inward file lies {moved} m from the outward one"
+        );
+    }
+}

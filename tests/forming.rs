@@ -864,6 +864,18 @@ fn a_punch_facing_into_the_part_forms_alike_on_the_other_side_and_a_stroke_away_
                 "{tool} {side} {stroke}: {stderr}"
             );
             assert!(!out.exists());
+            // The library refuses it too, before any ply is draped (a study, an optimisation
+            // and Python drape layups without the CLI's run).
+            let loaded = drape::pipeline::scene::Scene::load(&fresh.path().join("scene.toml")).unwrap();
+            let surface = drape::io::read_tool(&loaded.tool, loaded.scale).unwrap();
+            let mut draped = 0;
+            let refused = drape::layup::stack::drape_layup(&loaded.layup, &surface, |_, _| draped += 1);
+            assert!(
+                matches!(refused, Err(drape::layup::stack::LayupError::Forming { field: "stroke", .. })),
+                "{tool:?} {side} {stroke}: {:?}",
+                refused.map(|r| r.len())
+            );
+            assert_eq!(draped, 0, "a ply was draped before the stroke was refused");
         }
     }
 }

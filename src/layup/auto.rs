@@ -92,20 +92,36 @@ impl AutoDrape {
 /// A ply's tool and its smooth surface, built the first time a step needs it and shared by
 /// every drape and mechanical step after (the choice drapes up to four nets and takes up to
 /// two steps on one tool).
+///
+/// The mechanics may meet the tool from its other side (`stack_side = "opposite"`): then it
+/// presses onto `contact`, the tool turned over, with a smooth surface of its own, while the
+/// kinematic drapes stay on the tool as the stack gives it.
 pub struct Surfaces<'a> {
     tool: &'a ToolSurface,
     smooth: OnceCell<SmoothSurface<'a>>,
+    contact: Option<(&'a ToolSurface, OnceCell<SmoothSurface<'a>>)>,
 }
 
 impl<'a> Surfaces<'a> {
-    /// The tool, its smooth surface not yet built.
+    /// The tool, its smooth surface not yet built; the mechanics meets it as it is.
     pub fn new(tool: &'a ToolSurface) -> Self {
-        Self { tool, smooth: OnceCell::new() }
+        Self { tool, smooth: OnceCell::new(), contact: None }
+    }
+
+    /// The tool for the kinematic drapes and `contact`, the surface the mechanics presses onto
+    /// (the same tool turned over).
+    pub fn with_contact(tool: &'a ToolSurface, contact: &'a ToolSurface) -> Self {
+        Self { tool, smooth: OnceCell::new(), contact: Some((contact, OnceCell::new())) }
     }
 
     /// The tool's smooth surface (built on first use).
     pub fn smooth(&self) -> &SmoothSurface<'a> {
         self.smooth.get_or_init(|| SmoothSurface::new(self.tool))
+    }
+
+    /// The surface the mechanics presses onto.
+    fn contact(&self) -> &'a ToolSurface {
+        self.contact.as_ref().map_or(self.tool, |(c, _)| c)
     }
 
     /// The kinematic drape on the surface `settings` names.
@@ -118,7 +134,10 @@ impl<'a> Surfaces<'a> {
 
     /// The smooth surface where `r`'s pressed contact slides on it.
     fn for_refinement(&self, r: &Refinement) -> Option<&SmoothSurface<'a>> {
-        (r.settings().pressed_surface == PressedSurface::Smooth).then(|| self.smooth())
+        (r.settings().pressed_surface == PressedSurface::Smooth).then(|| match &self.contact {
+            Some((contact, smooth)) => smooth.get_or_init(|| SmoothSurface::new(contact)),
+            None => self.smooth(),
+        })
     }
 }
 
@@ -144,24 +163,27 @@ pub enum AutoError {
     Refine(#[from] RefineError),
 }
 
-/// Choose the ply's model ([`choose`]) and run mechanics if it was chosen, on one smooth surface.
+/// Choose the ply's model ([`choose`]) and run mechanics if it was chosen, on one smooth surface;
+/// the mechanics meets the tool as `contact` (the same tool, turned over where the plies lie on
+/// the other side of it).
 /// Where the pressed drape's own spacing error is estimated above the tolerance, the ply is
 /// pressed again at the spacing the estimate asks for, within [`MECHANICAL_NODE_BUDGET`]
 /// ([`press_finer`]).
 pub fn drape_auto(
     surface: &ToolSurface,
+    contact: &ToolSurface,
     settings: &KinematicSettings,
     refinement: &Refinement,
     locking_angle: f64,
     auto: AutoModel,
 ) -> Result<AutoResult, AutoError> {
-    let surfaces = Surfaces::new(surface);
+    let surfaces = Surfaces::with_contact(surface, contact);
     let mut a = choose(&surfaces, settings, refinement, locking_angle, auto)?;
     if !a.mechanical() {
         return Ok(AutoResult { kinematic: a.net, refined: None, choice: a.choice });
     }
     let start = a.start.as_deref().unwrap_or(&a.net.positions);
-    let refined = refinement.run_from(&a.net, start, surface, surfaces.for_refinement(refinement))?;
+    let refined = refinement.run_from(&a.net, start, surfaces.contact(), surfaces.for_refinement(refinement))?;
     let t = Instant::now();
     let estimate = weigh_mechanical_spacing(&surfaces, settings, refinement, &refined.0, locking_angle, &mut a.choice);
     a.choice.indicators.time_ms += t.elapsed().as_secs_f64() * 1e3;
@@ -222,7 +244,7 @@ fn press_finer(
     let weighed = (|| -> Result<_, String> {
         let drawn = surfaces.drape(&finer).map_err(AutoError::from).and_then(|kinematic| {
             let pressed =
-                refinement.run_draped(&kinematic, surfaces.tool, surfaces.for_refinement(refinement), &finer)?;
+                refinement.run_draped(&kinematic, surfaces.contact(), surfaces.for_refinement(refinement), &finer)?;
             Ok((kinematic, pressed))
         });
         let (kinematic, pressed) = drawn.map_err(|why| {
@@ -339,7 +361,7 @@ fn weigh_mechanical_spacing(
         .ok()
         .and_then(|net| {
             let smooth = surfaces.for_refinement(refinement);
-            refine_draped(&net, &draped, surfaces.tool, smooth, &refinement.material, &solve).ok()
+            refine_draped(&net, &draped, surfaces.contact(), smooth, &refinement.material, &solve).ok()
         })
         .filter(Refined::ok);
     let Some(e) = coarse.and_then(|r| SpacingError::between(refined, &r.net, 2.0, locking_angle)) else {
@@ -670,8 +692,8 @@ fn equilibrium_probe(surfaces: &Surfaces, net: &DrapeNet, r: &Refinement) -> Res
         stability_check: false,
         ..settings.solver
     };
-    let refined =
-        refine_on(net, surfaces.tool, surfaces.for_refinement(r), &r.material, &settings).map_err(|e| e.to_string())?;
+    let refined = refine_on(net, surfaces.contact(), surfaces.for_refinement(r), &r.material, &settings)
+        .map_err(|e| e.to_string())?;
     let report = refined.steps.last().ok_or("the mechanical model took no load step")?;
     let change_deg =
         cell_changes(net, &refined.net).into_iter().flatten().map(|(g, _)| g.abs().to_degrees()).fold(0.0, f64::max);

@@ -57,6 +57,19 @@ pub enum LayupError {
         /// Why.
         source: RefineError,
     },
+    /// A formed ply's process does not fit the tool (its stroke moves the punch away from the
+    /// blank).
+    #[error("ply '{ply}' (line {line}), field `{field}`: {message}")]
+    Forming {
+        /// The ply.
+        ply: String,
+        /// Its line in the scene.
+        line: usize,
+        /// The scene field at fault.
+        field: &'static str,
+        /// What is wrong and what to do.
+        message: String,
+    },
     /// The ply's warp has no direction on the tool at its seed.
     #[error("ply '{ply}' (line {line}): {message}")]
     Orientation {
@@ -176,7 +189,7 @@ pub fn resolve_warp(
 }
 
 /// Unit normal of `surface` at the seed `origin`, pointing to the side the plies stack on.
-pub(crate) fn stacking_normal(surface: &ToolSurface, origin: &Point, side: StackSide) -> Vector {
+fn stacking_normal(surface: &ToolSurface, origin: &Point, side: StackSide) -> Vector {
     let n = seed_normal(surface, &surface.closest_point(origin).point);
     match side {
         StackSide::Normal => n,
@@ -268,6 +281,19 @@ pub fn drape_layup(
     tool: &ToolSurface,
     mut on_ply: impl FnMut(usize, &str),
 ) -> Result<Vec<PlyResult>, LayupError> {
+    // A formed ply whose stroke moves the punch away from the blank is refused before any ply
+    // is draped (the stack offsets the tool along the same side, so the tool's normal decides).
+    for ply in &layup.plies {
+        if let Some(forming) = ply.refinement.as_ref().and_then(|r| r.forming.as_ref()) {
+            let blank_side = stacking_normal(tool, &ply.settings.origin, layup.stack_side);
+            forming.check_pushes(&blank_side).map_err(|e| LayupError::Forming {
+                ply: ply.settings.name.clone(),
+                line: ply.line,
+                field: e.field,
+                message: e.message,
+            })?;
+        }
+    }
     let (dirs, clipped) = offset_directions(tool);
     let sign = match layup.stack_side {
         StackSide::Normal => 1.0,
@@ -340,7 +366,7 @@ pub fn drape_layup(
         let contact = turned.as_ref().unwrap_or(surface);
         let (start_net, refined, choice) = match (start, &ply.auto, &refinement) {
             (Start::Kinematic, Some(auto), Some(r)) => {
-                let a = drape_auto(surface, &settings, r, ply.locking_angle, *auto).map_err(|e| match e {
+                let a = drape_auto(surface, contact, &settings, r, ply.locking_angle, *auto).map_err(|e| match e {
                     AutoError::Drape(source) => drape_error(source),
                     AutoError::Refine(source) => refine_error(source),
                 })?;

@@ -160,8 +160,9 @@ impl PreparedPly {
         match &self.auto {
             None => drape(tool, &self.settings).map_err(input),
             Some((model, refinement)) => {
-                let chosen = drape_auto(tool, &self.settings, refinement, self.locking_angle_deg.to_radians(), *model)
-                    .map_err(|e| input(anyhow::anyhow!("{e}")))?;
+                let chosen =
+                    drape_auto(tool, tool, &self.settings, refinement, self.locking_angle_deg.to_radians(), *model)
+                        .map_err(|e| input(anyhow::anyhow!("{e}")))?;
                 let mut net = chosen.refined.map_or(chosen.kinematic, |(refined, _)| refined);
                 net.meta.method_choice = Some(chosen.choice);
                 Ok(net)

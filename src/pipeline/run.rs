@@ -25,7 +25,7 @@ use crate::kinematic::fishnet::{check_settings, check_spacing_on_tool, DrapeErro
 use crate::kinematic::Extent;
 use crate::layup::flat::{blank_pattern, ply_pattern, CutWarning, FlatError, FlatPattern};
 use crate::layup::nest::{nest, Nesting, Rotation};
-use crate::layup::stack::{drape_layup, stacking_normal, LayupError, PlyResult};
+use crate::layup::stack::{drape_layup, LayupError, PlyResult};
 use crate::layup::table::{ExportPlyRow, ExportRow, LayupRow, LayupTable, NestingRow};
 use crate::layup::Ply;
 use crate::mapping::{map_plies, FlowMesh, LayupMap, MapError, PlyToMap};
@@ -147,21 +147,6 @@ pub enum RunError {
         /// What is wrong.
         error: DrapeError,
     },
-    /// A formed ply's process does not fit the tool (its stroke moves the punch away from the
-    /// blank).
-    #[error("scene {scene}: ply '{ply}' (line {line}), field `{field}`: {message}")]
-    Forming {
-        /// The scene file.
-        scene: PathBuf,
-        /// The ply.
-        ply: String,
-        /// Its line in the scene.
-        line: usize,
-        /// The scene field at fault.
-        field: &'static str,
-        /// What is wrong and what to do.
-        message: String,
-    },
     /// The tool could not be read.
     #[error("{0}")]
     Tool(ReadToolError),
@@ -220,7 +205,6 @@ impl RunError {
         matches!(
             self,
             RunError::Settings { .. }
-                | RunError::Forming { .. }
                 | RunError::Tool(_)
                 | RunError::Layup { .. }
                 | RunError::Flat(_)
@@ -269,16 +253,6 @@ pub fn run(
             line: ply.line,
             error,
         })?;
-        if let Some(forming) = ply.refinement.as_ref().and_then(|r| r.forming.as_ref()) {
-            let blank_side = stacking_normal(&tool, &ply.settings.origin, scene.layup.stack_side);
-            forming.check_pushes(&blank_side).map_err(|e| RunError::Forming {
-                scene: scene.path.clone(),
-                ply: ply.settings.name.clone(),
-                line: ply.line,
-                field: e.field,
-                message: e.message,
-            })?;
-        }
     }
     let folder = prepare(out, replace)?;
     let mut written: Vec<PathBuf> = Vec::new();
