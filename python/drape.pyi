@@ -182,13 +182,15 @@ def refine(
     escape_saddles: bool = False,
     max_iterations: int = 100,
     die: Optional[PathLike] = None,
+    stack_side: Optional[Literal["normal", "opposite"]] = None,
 ) -> Net:
     """Refine a net mechanically (tension, shear, bending, gravity, tool contact, friction), as
     ``drape refine`` does. ``units``: the tool's (default: the unit the net records). ``gravity``
     defaults to (0, 0, -9.80665) m/s^2; ``friction`` to the card's ``[contact] friction``;
     ``holds`` are grid nodes (i, j) held in place. A formed net (``meta["forming"]``) is held by
     the tools that formed it where its stroke ended: ``tool`` is the punch, ``die`` its die (in
-    the tool's units; default: the file the net records).
+    the tool's units; default: the file the net records). ``stack_side``: the side of the tool
+    the ply lies on (default: the side the net records, else the one its normals point to).
 
     Raises InputError on bad input; ComputeError (with ``.net``, the last state) when the ply
     slides or the solver stops without equilibrium.

@@ -844,10 +844,50 @@ fn a_punch_facing_into_the_part_forms_alike_on_the_other_side_and_a_stroke_away_
         let tools = [("punch.obj", &punch), ("inward.obj", &inward)];
         let (stdout, _, net) = run(tmp.path(), &tools, &scene("punch.obj", "", h));
         assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
-        let (stdout2, _, turned) = run(tmp.path(), &tools, &scene("inward.obj", "stack_side = \"opposite\"\n", h));
+        let tmp2 = tempfile::tempdir().unwrap();
+        let (stdout2, _, turned) = run(tmp2.path(), &tools, &scene("inward.obj", "stack_side = \"opposite\"\n", h));
         assert_eq!(turned["meta"]["solver"]["converged"], true, "{stdout2}");
         assert_eq!(net["nodes"], turned["nodes"], "{b:?}, angle {angle}: the turned punch formed another blank");
         assert_eq!(net["cell_shear_deg"], turned["cell_shear_deg"]);
+        // The turned net records its side, and `drape refine` holds it on the inward file as it
+        // holds the outward net on the outward file; told the other side, it lets go of it.
+        assert_eq!(turned["meta"]["stack_side"], "opposite");
+        assert!(net["meta"].get("stack_side").is_none());
+        let card_path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("materials/{card}.toml"));
+        let card_path = card_path.to_str().unwrap();
+        let formed = tmp2.path().join("out/p.drape.json");
+        let inward_file = tmp2.path().join("inward.obj");
+        let again = tmp2.path().join("again");
+        refine_again(&formed, &inward_file, card_path, 0.2, &[], &again).success();
+        let refined = read_json(&again.join("p.drape.json"));
+        assert_eq!(refined["meta"]["stack_side"], "opposite");
+        let outward_again = tmp.path().join("again");
+        refine_again(
+            &tmp.path().join("out/p.drape.json"),
+            &tmp.path().join("punch.obj"),
+            card_path,
+            0.2,
+            &[],
+            &outward_again,
+        )
+        .success();
+        let refined_outward = read_json(&outward_again.join("p.drape.json"));
+        assert_eq!(
+            refined["nodes"], refined_outward["nodes"],
+            "held again on the inward file, the ply moved otherwise"
+        );
+        let wrong = tmp.path().join("wrong");
+        let other = refine_again(&formed, &inward_file, card_path, 0.2, &["--stack-side", "normal"], &wrong);
+        let refined = read_json(&wrong.join("p.drape.json"));
+        let moved = refined["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(turned["nodes"].as_array().unwrap())
+            .filter_map(|(p, q)| Some((p.as_array()?, q.as_array()?)))
+            .map(|(p, q)| (0..3).map(|c| (p[c].as_f64().unwrap() - q[c].as_f64().unwrap()).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        assert!(moved > 0.02, "met from the wrong side the ply stayed within {moved} m\n{:?}", other.get_output());
         for (tool, side, stroke) in
             [("inward.obj", "", h), ("punch.obj", "", -h), ("inward.obj", "stack_side = \"opposite\"\n", -h)]
         {

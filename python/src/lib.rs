@@ -10,7 +10,7 @@ use drape::material::MaterialCard;
 use drape::pipeline::export::{export_net, parse_cavity, ExportOptions};
 use drape::pipeline::failure::{compute, input, write_failure, Failure};
 use drape::pipeline::ply::{check_converged, read_tool, PlyOptions};
-use drape::pipeline::refine::{check_refined, parse_mode, refine_net, RefineOptions};
+use drape::pipeline::refine::{check_refined, parse_mode, parse_stack_side, refine_net, RefineOptions};
 use drape::pipeline::run::{run as run_scene, RunError};
 use drape::pipeline::Scene;
 use drape::study::optimise::run::{
@@ -353,7 +353,8 @@ fn kinematic(
 #[pyfunction]
 #[pyo3(signature = (
     net, tool, material, mode="pressed", *, units=None, facets=false, gravity=None, load_steps=None,
-    stick=false, friction=None, holds=None, escape_saddles=false, max_iterations=None, die=None
+    stick=false, friction=None, holds=None, escape_saddles=false, max_iterations=None, die=None,
+    stack_side=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn refine(
@@ -372,6 +373,7 @@ fn refine(
     escape_saddles: bool,
     max_iterations: Option<usize>,
     die: Option<PathBuf>,
+    stack_side: Option<String>,
 ) -> PyResult<Net> {
     let tool = ToolArg::extract(tool)?;
     let defaults = RefineOptions::default();
@@ -387,6 +389,7 @@ fn refine(
         escape_saddles,
         max_iterations: max_iterations.unwrap_or(defaults.max_iterations),
         die,
+        stack_side: stack_side.as_deref().map(parse_stack_side).transpose().map_err(to_py)?,
     };
     let kinematic = &net.net;
     let (refined_net, refined, warning) = py
@@ -399,7 +402,8 @@ fn refine(
             let (tool, _) = tool.load(scale)?;
             let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
             let label = format!("'{}'", kinematic.name);
-            let (mut out, refined) = refine_net(kinematic, &label, &tool, &card, &material, &settings)?;
+            let (mut out, refined) =
+                refine_net(kinematic, &label, &tool, options.stack_side(kinematic), &card, &material, &settings)?;
             out.timing.load_ms = load_ms;
             out.timing.total_ms += load_ms;
             let max_shear = out.shear_stats(DEFAULT_LOCKING_ANGLE_DEG.to_radians()).max_abs.to_degrees();

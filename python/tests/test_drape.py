@@ -227,7 +227,8 @@ def test_refine_refuses_like_the_cli(cli, tmp_path):
     cli("kinematic", "--tool", HEMISPHERE, "--origin", "0,0,0.1", "--warp", "1,0,0", "--spacing", "0.01", "--grid",
         "5,5", "--out", tmp_path)
     net = drape.Net.load(tmp_path / "ply.drape.json")
-    for args, options in [(["--friction=-1"], {"friction": -1.0}), (["--load-steps", "0"], {"load_steps": 0})]:
+    for args, options in [(["--friction=-1"], {"friction": -1.0}), (["--load-steps", "0"], {"load_steps": 0}),
+                          (["--stack-side", "under"], {"stack_side": "under"})]:
         done = cli("refine", "--net", tmp_path / "ply.drape.json", "--tool", HEMISPHERE, "--material", GLASS,
                    "--mode", "pressed", *args, "--out", tmp_path / "r", check=False)
         with pytest.raises(drape.InputError) as raised:

@@ -8,7 +8,7 @@ use crate::material::MaterialCard;
 use crate::mechanics::refine::Refined;
 use crate::mechanics::ContactMode;
 use crate::pipeline::ply::read_tool;
-use crate::pipeline::refine::{check_refined, refine_net, RefineOptions};
+use crate::pipeline::refine::{check_refined, parse_stack_side, refine_net, RefineOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -76,6 +76,11 @@ pub struct RefineArgs {
     /// Solver iteration limit per load step.
     #[arg(long, default_value_t = 100)]
     pub max_iterations: usize,
+    /// The side of the tool the ply lies on: normal (the side its facets' normals point to) or
+    /// opposite (a tool file facing into the part). Default: the side the net records (a layup
+    /// with stack_side = "opposite" records it), else normal.
+    #[arg(long)]
+    pub stack_side: Option<String>,
     /// Output formats: comma-separated json,vtu,csv, or none.
     #[arg(long, default_value = "json")]
     pub format: String,
@@ -101,6 +106,7 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
         escape_saddles: a.escape_saddles,
         max_iterations: a.max_iterations,
         die: a.die,
+        stack_side: a.stack_side.as_deref().map(parse_stack_side).transpose()?,
     };
     options.check()?;
     let net = read_net(&a.net).map_err(input)?;
@@ -111,7 +117,15 @@ pub fn run(a: RefineArgs) -> Result<(), Failure> {
     let tool = read_tool(&a.tool, scale)?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     print_tool_report(&a.tool, &tool);
-    let (mut out, refined) = refine_net(&net, &a.net.display().to_string(), &tool, &material, &a.material, &settings)?;
+    let (mut out, refined) = refine_net(
+        &net,
+        &a.net.display().to_string(),
+        &tool,
+        options.stack_side(&net),
+        &material,
+        &a.material,
+        &settings,
+    )?;
     out.timing.load_ms = load_ms;
     out.timing.total_ms += load_ms;
     // The last consistent state is written even when the solver did not converge.

@@ -39,6 +39,11 @@ pub struct Provenance {
     /// Largest distance the tool was offset by the plies below, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stack_offset_max_m: Option<f64>,
+    /// The side of the tool a layup's plies lie on, where it is the other side than the one its
+    /// facets' normals point to (absent: that side). `drape refine` meets the tool turned over
+    /// for such a net, as the layup's mechanics did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stack_side: Option<StackSide>,
     /// The tool file, as given to the command.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool: Option<String>,
@@ -75,6 +80,16 @@ pub struct Provenance {
     /// Keys other tools wrote, kept on a round trip.
     #[serde(flatten)]
     pub other: Map<String, Value>,
+}
+
+/// Which side of the tool the plies stack on (`"normal"` or `"opposite"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StackSide {
+    /// The side the tool's facet normals point to.
+    Normal,
+    /// The other side.
+    Opposite,
 }
 
 /// What `method = "auto"` chose for a ply, and why (`"method_choice"` in the net's meta and in

@@ -299,14 +299,7 @@ pub enum Start {
     },
 }
 
-/// Which side of the tool the plies stack on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StackSide {
-    /// The side the tool's facet normals point to.
-    Normal,
-    /// The other side.
-    Opposite,
-}
+pub use crate::kinematic::provenance::StackSide;
 
 /// The plies to drape, in stacking order (the first lies on the tool, each next one on the plies
 /// below it), and how their angles and stacking side are measured.

@@ -412,6 +412,7 @@ pub fn drape_layup(
         };
         // What later stages (exports, reports) need to know about the ply.
         net.meta.stack_offset_max_m = Some(offset.max_distance);
+        net.meta.stack_side = (layup.stack_side == StackSide::Opposite).then_some(StackSide::Opposite);
         net.meta.angle_deg = ply.angle_deg();
         if let Some(m) = &ply.material {
             net.meta.material = Some(m.path.display().to_string());

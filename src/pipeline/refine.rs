@@ -3,10 +3,10 @@
 use super::failure::{compute, input, Failure};
 use super::unit_scale;
 use crate::geometry::{Point, ToolSurface, Vector};
-use crate::kinematic::provenance::FormingRecord;
+use crate::kinematic::provenance::{FormingRecord, StackSide};
 use crate::kinematic::DrapeNet;
 use crate::material::MaterialCard;
-use crate::mechanics::forming::{die_facing, Forming};
+use crate::mechanics::forming::{die_facing, turned_over, Forming};
 use crate::mechanics::refine::{annotate, refine, PressedSurface, RefineSettings, Refined};
 use crate::mechanics::sheet::{check_blank, SheetFeatures};
 use crate::mechanics::{ContactMode, SolverSettings};
@@ -41,6 +41,9 @@ pub struct RefineOptions {
     /// The die a formed net (one that records `meta.forming`) was formed with, in the tool's
     /// units (default: the file the net records).
     pub die: Option<PathBuf>,
+    /// The side of the tool the ply lies on (default: the side the net records, else the one
+    /// the tool's facets' normals point to).
+    pub stack_side: Option<StackSide>,
 }
 
 impl Default for RefineOptions {
@@ -57,7 +60,19 @@ impl Default for RefineOptions {
             escape_saddles: false,
             max_iterations: 100,
             die: None,
+            stack_side: None,
         }
+    }
+}
+
+/// A stacking side by name: `normal` or `opposite`.
+pub fn parse_stack_side(s: &str) -> Result<StackSide, Failure> {
+    match s.trim() {
+        "normal" => Ok(StackSide::Normal),
+        "opposite" => Ok(StackSide::Opposite),
+        other => Err(input(anyhow::anyhow!(
+            "--stack-side: unknown side '{other}': use normal (the side the tool's facets' normals point to) or opposite"
+        ))),
     }
 }
 
@@ -77,6 +92,12 @@ impl RefineOptions {
             return Err(input(anyhow::anyhow!("--load-steps must be at least 1")));
         }
         Ok(())
+    }
+
+    /// The side of the tool `net` lies on: the options', else the one it records, else the
+    /// normals' side.
+    pub fn stack_side(&self, net: &DrapeNet) -> StackSide {
+        self.stack_side.or(net.meta.stack_side).unwrap_or(StackSide::Normal)
     }
 
     /// Metres per unit of the tool file: the options' units, else the ones `net` records.
@@ -198,12 +219,14 @@ impl RefineOptions {
 }
 
 /// Refine `net` (called `label` in messages: its file) on `tool` under `material` (read from
-/// `material_path`): the refined net, annotated with its change from `net` and the solver's
-/// record, its solve time in `timing.fill_ms`, and the solver's result.
+/// `material_path`), lying on the tool's `side` (met turned over where that is the side its
+/// normals do not point to): the refined net, annotated with its change from `net` and the
+/// solver's record, its solve time in `timing.fill_ms`, and the solver's result.
 pub fn refine_net(
     net: &DrapeNet,
     label: &str,
     tool: &ToolSurface,
+    side: StackSide,
     material: &MaterialCard,
     material_path: &Path,
     settings: &RefineSettings,
@@ -211,7 +234,14 @@ pub fn refine_net(
     crate::kinematic::fishnet::check_spacing_on_tool(tool, net.spacing)
         .map_err(|e| input(anyhow::anyhow!("net {label}: {e}")))?;
     let t = Instant::now();
-    let refined = refine(net, tool, material, settings).map_err(input)?;
+    // The mechanics keeps a ply on the side its tool's normals point to.
+    let turned = match side {
+        StackSide::Opposite => {
+            Some(turned_over(tool).map_err(|e| input(anyhow::anyhow!("the tool turned over: {e}")))?)
+        }
+        StackSide::Normal => None,
+    };
+    let refined = refine(net, turned.as_ref().unwrap_or(tool), material, settings).map_err(input)?;
     let solve_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut out = refined.net.clone();
     annotate(&mut out, net, &refined, material_path);
@@ -229,6 +259,7 @@ pub fn refine_net(
     if settings.forming.is_none() {
         out.meta.forming = None;
     }
+    out.meta.stack_side = (side == StackSide::Opposite).then_some(StackSide::Opposite);
     out.timing.generators_ms = 0.0;
     out.timing.fill_ms = solve_ms;
     out.timing.total_ms = solve_ms;
