@@ -79,6 +79,79 @@ fn a_punch_rising_into_a_clamped_blank_draws_in_its_path_over_the_punch() {
     }
 }
 
+/// Formed coarse to fine (`coarse_levels`), the same punch and binder give the same known
+/// answer: the blank formed on the grid of 2 or 4 times the spacing, then held by its tools on
+/// each finer grid, draws its edges in by the path over the punch less the opening's half-width
+/// (within the same 2%), the whole blank present on the ply's own grid; every level converged,
+/// the stroke's increments are the coarsest grid's and each finer one is held in one. Other
+/// radii, strokes, openings, grids and level counts than the test above.
+#[test]
+fn a_blank_formed_coarse_to_fine_draws_in_its_path_over_the_punch() {
+    const DRAW_IN_SHARE: f64 = 0.02;
+    for (r, h, a, levels, [nu, nv]) in [(0.045, 0.03, 0.09, 1, [61, 21]), (0.06, 0.035, 0.1, 2, [81, 25])] {
+        let tmp = tempfile::tempdir().unwrap();
+        let punch = shapes::cylinder(r, 0.2, std::f64::consts::PI, 96, 40);
+        let spacing = 0.004;
+        let scene = format!(
+            "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
+             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
+             material = \"{card}\"\nspacing = {spacing}\ngrid = [{nu}, {nv}]\nmethod = \"mechanical\"\n\
+             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {h}]\nmax_iterations = 2000\n\
+             coarse_levels = {levels}\n\
+             [ply.binder]\npressure = 2.0e3\noutline = [[-{a}, -1.0], [{a}, -1.0], [{a}, 1.0], [-{a}, 1.0]]\n",
+            card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
+        );
+        let (stdout, row, net) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
+        assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
+        assert_eq!(net["spacing"], spacing);
+        assert_eq!(net["status"]["placed"], nu * nv, "{}", net["status"]);
+        let record = &net["meta"]["forming"];
+        let steps = record["levels"].as_array().unwrap();
+        assert_eq!(steps.len(), levels + 1, "{record}");
+        for (k, level) in steps.iter().enumerate() {
+            let expected = spacing * (1 << (levels - k)) as f64;
+            assert!((level["spacing_m"].as_f64().unwrap() - expected).abs() < 1e-12, "{level}");
+            assert_eq!(level["converged"], true, "{level}");
+            assert_eq!(level["increments"].as_u64().unwrap() == 1, k > 0, "{level}");
+        }
+        assert_eq!(record["increments"], steps[0]["increments"]);
+        let draw_in: DrawIn = serde_json::from_value(row["draw_in"].clone()).unwrap();
+        let exact = half_path(r, h, a) - a;
+        let along_warp: Vec<f64> =
+            draw_in.edges.iter().filter(|e| e.line.is_fibre() && e.flat_m > 0.1).map(|e| e.draw_in_m).collect();
+        assert_eq!(along_warp.len(), 2, "{draw_in:?}");
+        for d in &along_warp {
+            assert!(
+                (d - exact).abs() < DRAW_IN_SHARE * exact,
+                "R {r}, stroke {h}, opening {a}, {levels} levels: the edge drew in {d} m, exactly {exact} m\n{stdout}"
+            );
+        }
+        for p in net["nodes"].as_array().unwrap() {
+            let p: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            let inside = r - (p[0] * p[0] + p[2] * p[2]).sqrt();
+            assert!(p[2] < 0.0 || inside < 1e-6 * r, "node {p:?} is inside the punch by {inside} m");
+            if p[0].abs() > a + 2.0 * spacing * (1 << levels) as f64 {
+                assert!((p[2] - (r - h)).abs() < 1e-9, "node {p:?} left the binder's plane");
+            }
+        }
+        assert!(stdout.contains("formed coarse to fine"), "{stdout}");
+        // Held again by its tools (`drape refine`), the formed net stays where it is.
+        let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
+        let again = tmp.path().join("again");
+        let held = refine_again(
+            &tmp.path().join("out/p.drape.json"),
+            &tmp.path().join("punch.obj"),
+            card.to_str().unwrap(),
+            0.2,
+            &[],
+            &again,
+        )
+        .success();
+        let refined = read_json(&again.join("p.drape.json"));
+        held_where_it_was(&net, &refined, &String::from_utf8_lossy(&held.get_output().stdout), 1.0);
+    }
+}
+
 /// What a formed blank needs, and what only a formed blank takes, are refused by name.
 #[test]
 fn forming_keys_are_checked_before_anything_runs() {
@@ -106,6 +179,13 @@ fn forming_keys_are_checked_before_anything_runs() {
             "pressure",
         ),
         ("mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, 0.05]\ndie = \"nothing.obj\"\n", "die", "nothing.obj"),
+        ("mode = \"pressed\"\ncoarse_levels = 1\n", "coarse_levels", "only a blank formed by the tools"),
+        (
+            "mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, 0.05]\ncoarse_levels = 2\n",
+            "coarse_levels",
+            "multiple of 4",
+        ),
+        ("mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, 0.05]\ncoarse_levels = 4\n", "coarse_levels", "at most 3"),
     ] {
         let err = crate::common::refused_scene(tmp.path(), &format!("{head}{tail}"));
         assert!(err.contains(&format!("field `{field}`")) && err.contains(says), "{tail}: {err}");

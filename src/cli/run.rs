@@ -85,6 +85,9 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
             }
             println!("{}", summary(&result.net, ply.locking_angle, load_ms, write_ms));
             if let Some(refined) = &result.refined {
+                if let Some(levels) = result.net.meta.forming.as_ref().and_then(|f| f.levels_summary()) {
+                    println!("  {levels}");
+                }
                 print_solver(refined);
             }
             for p in files {

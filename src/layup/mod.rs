@@ -1,6 +1,7 @@
 //! Layups: plies draped in stacking order, each on the tool offset by the plies below it
 //! ([`stack`]); their flat patterns ([`flat`]) and the nesting of those on the roll ([`nest`]).
 pub mod auto;
+pub mod coarse;
 pub mod curve;
 pub mod flat;
 pub mod nest;

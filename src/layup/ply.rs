@@ -182,6 +182,10 @@ pub struct Refinement {
     pub escape_saddles: bool,
     /// A flat blank formed by tools in motion (`start = "flat"` with `mode = "pressed"`).
     pub forming: Option<Forming>,
+    /// A formed blank is formed first at 2^`coarse_levels` times the ply's spacing, then held
+    /// by its tools where the stroke ended on each grid of half the spacing, down to the ply's
+    /// ([`super::coarse`]); 0: formed at the ply's spacing.
+    pub coarse_levels: usize,
 }
 
 impl Refinement {
@@ -203,6 +207,7 @@ impl Refinement {
             stick: false,
             escape_saddles: false,
             forming: None,
+            coarse_levels: 0,
         }
     }
 

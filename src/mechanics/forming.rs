@@ -232,6 +232,7 @@ impl Forming {
                 .or(self.blank_plane)
                 .map(|p| BlankPlaneRecord { point_m: p.point.coords.into(), normal: p.normal.into() }),
             blank_m: None,
+            levels: Vec::new(),
         }
     }
 

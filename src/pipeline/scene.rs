@@ -94,6 +94,11 @@
 //! #                           # the blank lies flat on it where the stroke begins
 //! # die = "die.obj"           # optional: the female tool, still; the ply stays on the side of it
 //! #                           # that faces the punch
+//! # coarse_levels = 1         # optional (default 0): form the blank on the grid of 2^L times the
+//! #                           # spacing first, then hold it by the tools where the stroke ended
+//! #                           # on each grid of half the spacing down to the ply's (faster: the
+//! #                           # stroke's increments are the coarse grid's); the grid's cells each
+//! #                           # side of the origin node must be a multiple of 2^L
 //! # [ply.binder]              # optional: a blank holder clamping the blank in its plane outside
 //! # outline = [[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]  # its opening in plan view
 //! #                           # across the stroke ([x, y] for a stroke along z)
@@ -108,6 +113,7 @@ use crate::io::vtk::VtuEncoding;
 use crate::kinematic::fishnet::check_memory;
 use crate::kinematic::{Extent, KinematicSettings, SurfaceKind, DEFAULT_MAX_SHEAR_DEG};
 use crate::layup::auto::DEFAULT_TOLERANCE_DEG;
+use crate::layup::coarse::{coarser_grid, MAX_COARSE_LEVELS};
 use crate::layup::{
     locking_angle_deg, AutoModel, Layup, Orientation, Ply, PlyMaterial, Refinement, StackSide, Start,
     DEFAULT_SOLVER_ITERATIONS, MAX_LOAD_STEPS, MAX_SOLVER_ITERATIONS,
@@ -240,6 +246,7 @@ struct PlyFile {
     stroke: Option<[f64; 3]>,
     die: Option<String>,
     binder: Option<BinderFile>,
+    coarse_levels: Option<usize>,
 }
 
 #[derive(Deserialize)]
@@ -457,6 +464,29 @@ fn refinement(
     }
     let forming = forming(p, start, mode, base, scale)?;
     let seam = sheet.seam;
+    let coarse_levels = match (p.coarse_levels, &forming, extent) {
+        (None | Some(0), ..) => 0,
+        (Some(_), None, _) => {
+            return Err((
+                "coarse_levels",
+                "only a blank formed by the tools is formed coarse to fine: give start = \"flat\", mode = \"pressed\" and a stroke".into(),
+            ))
+        }
+        (Some(n), ..) if n > MAX_COARSE_LEVELS => {
+            return Err(("coarse_levels", format!("at most {MAX_COARSE_LEVELS} (a grid {} times coarser), got {n}", 1 << MAX_COARSE_LEVELS)))
+        }
+        (Some(_), Some(_), _) if seam.is_some() => {
+            return Err(("coarse_levels", "a sheet with a seam is formed at its own spacing: leave coarse_levels out".into()))
+        }
+        (Some(n), Some(_), Extent::Grid { nu, nv, origin_node }) => {
+            let origin = origin_node.unwrap_or_else(|| default_origin_node(*nu, *nv, None));
+            coarser_grid(*nu, *nv, origin, 1 << n).map_err(|e| ("coarse_levels", e))?;
+            n
+        }
+        (Some(_), Some(_), Extent::Outline(_)) => {
+            return Err(("coarse_levels", "a flat blank is a grid: give grid = [nu, nv]".into()))
+        }
+    };
     Ok(Refinement {
         material: m.card.clone(),
         material_path: m.path.clone(),
@@ -512,6 +542,7 @@ fn refinement(
         },
         escape_saddles: p.escape_saddles.unwrap_or(false),
         forming,
+        coarse_levels,
     })
 }
 
@@ -782,6 +813,7 @@ impl Scene {
                         ("stroke", p.stroke.is_some()),
                         ("die", p.die.is_some()),
                         ("binder", p.binder.is_some()),
+                        ("coarse_levels", p.coarse_levels.is_some()),
                     ];
                     if let Some((field, _)) = mechanical_only.iter().find(|(_, given)| *given) {
                         return Err(at(field, "only a ply with method = \"mechanical\" uses it".into()));

@@ -85,6 +85,9 @@ pub fn net_facts(net: &DrapeNet) -> Vec<(String, String)> {
         if let Some(b) = &fm.binder {
             process += &format!(", binder at {:.1} kPa outside its opening", b.pressure_pa * 1e-3);
         }
+        if let Some(levels) = fm.levels_summary() {
+            process += &format!("; {levels}");
+        }
         f.push(("formed".to_string(), process));
     }
     if let Some(c) = &m.change_from_kinematic {
