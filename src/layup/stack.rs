@@ -276,9 +276,9 @@ fn flat_start(
 /// A blank formed coarse to fine (`coarse_levels` = L, [`super::coarse`]): formed by its tools
 /// on the grid of 2^L times the ply's spacing; then on each grid of half the spacing, down to
 /// the ply's, held by the tools where the stroke ended (one increment), starting from the
-/// coarser grid's shape. A level that does not
-/// reach equilibrium ends the sequence: its net (on its own grid) stands and says so. The net,
-/// the solver's record of the last level, and every level's record.
+/// coarser grid's shape. A level that does not reach equilibrium ends the sequence: its net (on
+/// its own grid) stands and says so. The net, the solver's record of the last level, and every
+/// level's record.
 fn form_coarse_to_fine(
     ply: &Ply,
     r: &super::Refinement,
