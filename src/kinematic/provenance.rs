@@ -572,8 +572,8 @@ pub struct FormingRecord {
 
 impl FormingRecord {
     /// How a blank formed coarse to fine was solved, level by level (`formed coarse to fine:
-    /// 10.0 mm, 24 increments, 266 iterations, 13.3 s; 5.0 mm held by the tools, 63 iterations,
-    /// 12.4 s`); None for a blank formed at its own spacing.
+    /// 10.0 mm, 12 increments, 266 iterations, 13.6 s; 5.0 mm held by the tools, 179
+    /// iterations, 27.4 s`); None for a blank formed at its own spacing.
     pub fn levels_summary(&self) -> Option<String> {
         let (first, rest) = self.levels.split_first()?;
         let describe = |l: &FormedLevel, what: String| {

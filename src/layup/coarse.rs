@@ -1,16 +1,18 @@
 //! Forming a blank coarse to fine (`coarse_levels`): the grids a blank is solved on, coarsest
-//! first, and how a formed grid's shape carries to the grid of half its spacing. Node (i, j) of a grid is node (2 i, 2 j) of the next finer one: the origin node and
-//! the blank's corners keep their fabric coordinates, so the finer grid's sheet and blank are the
-//! ply's own at that spacing.
+//! first, and how a formed grid's shape carries to the grid of half its spacing. Node (i, j) of
+//! a grid is node (2 i, 2 j) of the next finer one: the origin node and the blank's corners keep
+//! their fabric coordinates, so the finer grid's sheet and blank are the ply's own at that
+//! spacing.
 //!
 //! Why: the stroke's increments, and the wrinkles the flange buckles into step by step, are most
 //! of a formed ply's iterations (see ARCHITECTURE, "Forming coarse to fine"); on a grid of twice
-//! the spacing there are half the increments, a quarter of the nodes, and the same path.
+//! the spacing there are half the increments and a quarter of the nodes; the finer grids follow
+//! the path the coarse one took.
 use crate::geometry::Point;
 use crate::kinematic::DrapeNet;
 
-/// Most coarse levels a ply may ask for (a grid 8 times coarser: the double dome's blank at
-/// 5 mm has 14 cells across its 0.34 m width at 40 mm).
+/// Most coarse levels a ply may ask for (a grid 8 times coarser: at 5 mm that is 40 mm, 8 or 9
+/// cells across the double dome's 0.34 m wide blank).
 pub const MAX_COARSE_LEVELS: usize = 3;
 
 /// The grid of `nu` x `nv` nodes with its origin node at `origin`, at `factor` times its
