@@ -28,6 +28,60 @@ fn half_path(r: f64, h: f64, a: f64) -> f64 {
     tangent + r * (std::f64::consts::FRAC_PI_2 - touch_elevation)
 }
 
+/// Allowed error against the exact draw-in over a cylindrical punch, relative: the fabric's
+/// stretch under the binder's friction (40 N/m against 8e6 N/m), the bend at the binder's edge
+/// rounded by bending over about sqrt(B/T) = 2 mm, and the net's chords on the punch.
+const SLOT_DRAW_IN_SHARE: f64 = 0.02;
+
+/// A scene: a glass blank of `grid` nodes at `spacing` lies flat on a cylindrical punch of radius
+/// `r` (`punch.obj`) that rises `h` into it, clamped by a binder outside a slot of half-width
+/// `a` across it; `extra` are more keys of the ply.
+fn slot_scene(r: f64, h: f64, a: f64, spacing: f64, [nu, nv]: [usize; 2], extra: &str) -> String {
+    format!(
+        "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
+         [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
+         material = \"{card}\"\nspacing = {spacing}\ngrid = [{nu}, {nv}]\nmethod = \"mechanical\"\n\
+         mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {h}]\nmax_iterations = 2000\n{extra}\
+         [ply.binder]\npressure = 2.0e3\noutline = [[-{a}, -1.0], [{a}, -1.0], [{a}, 1.0], [-{a}, 1.0]]\n",
+        card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
+    )
+}
+
+/// The blank of a [`slot_scene`] (layup.json's `row`, its `net`, the run's `stdout`; `what`
+/// names the set-up in messages) drew both edges across the punch in by the exact path over it
+/// less the slot's half-width, within [`SLOT_DRAW_IN_SHARE`]; no node lies inside the punch,
+/// and those farther than `gripped_beyond` outside the slot lie in the binder's plane.
+fn assert_drawn_in_over_the_slot(
+    row: &serde_json::Value,
+    net: &serde_json::Value,
+    stdout: &str,
+    (r, h, a): (f64, f64, f64),
+    gripped_beyond: f64,
+    what: &str,
+) {
+    let draw_in: DrawIn = serde_json::from_value(row["draw_in"].clone()).unwrap();
+    let exact = half_path(r, h, a) - a;
+    let along_warp: Vec<f64> =
+        draw_in.edges.iter().filter(|e| e.line.is_fibre() && e.flat_m > 0.1).map(|e| e.draw_in_m).collect();
+    assert_eq!(along_warp.len(), 2, "{draw_in:?}");
+    for d in &along_warp {
+        assert!(
+            (d - exact).abs() < SLOT_DRAW_IN_SHARE * exact,
+            "R {r}, stroke {h}, opening {a}{what}: the edge drew in {d} m, exactly {exact} m\n{stdout}"
+        );
+    }
+    for p in net["nodes"].as_array().unwrap() {
+        let p: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let inside = r - (p[0] * p[0] + p[2] * p[2]).sqrt();
+        assert!(p[2] < 0.0 || inside < 1e-6 * r, "node {p:?} is inside the punch by {inside} m");
+        // Outside the opening the binder holds the blank in its plane (where the punch's top
+        // stood at the start).
+        if p[0].abs() > a + gripped_beyond {
+            assert!((p[2] - (r - h)).abs() < 1e-9, "node {p:?} left the binder's plane");
+        }
+    }
+}
+
 /// A cylindrical punch rises into a blank clamped by a binder outside a slot across it: the
 /// fibres across the punch are developable and keep their length, so the blank's edges draw in
 /// by the path over the punch less the opening's half-width, on both sides alike, for other
@@ -35,47 +89,16 @@ fn half_path(r: f64, h: f64, a: f64) -> f64 {
 /// punch, and those the binder still grips lie in its plane.
 #[test]
 fn a_punch_rising_into_a_clamped_blank_draws_in_its_path_over_the_punch() {
-    // Allowed error against the exact draw-in, relative: the fabric's stretch under the binder's
-    // friction (40 N/m against 8e6 N/m), the bend at the binder's edge rounded by bending over
-    // about sqrt(B/T) = 2 mm, and the net's chords on the punch.
-    const DRAW_IN_SHARE: f64 = 0.02;
     for (r, h, a) in [(0.05, 0.03, 0.1), (0.04, 0.025, 0.07)] {
         let tmp = tempfile::tempdir().unwrap();
         let punch = shapes::cylinder(r, 0.2, std::f64::consts::PI, 96, 40);
         let spacing = 0.005;
-        let scene = format!(
-            "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
-             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
-             material = \"{card}\"\nspacing = {spacing}\ngrid = [61, 21]\nmethod = \"mechanical\"\n\
-             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {h}]\nmax_iterations = 2000\n\
-             [ply.binder]\npressure = 2.0e3\noutline = [[-{a}, -1.0], [{a}, -1.0], [{a}, 1.0], [-{a}, 1.0]]\n",
-            card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
-        );
+        let scene = slot_scene(r, h, a, spacing, [61, 21], "");
         let (stdout, row, net) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
         assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
-        let draw_in: DrawIn = serde_json::from_value(row["draw_in"].clone()).unwrap();
-        let exact = half_path(r, h, a) - a;
-        let along_warp: Vec<f64> =
-            draw_in.edges.iter().filter(|e| e.line.is_fibre() && e.flat_m > 0.1).map(|e| e.draw_in_m).collect();
-        assert_eq!(along_warp.len(), 2, "{draw_in:?}");
-        for d in &along_warp {
-            assert!(
-                (d - exact).abs() < DRAW_IN_SHARE * exact,
-                "R {r}, stroke {h}, opening {a}: the edge drew in {d} m, exactly {exact} m\n{stdout}"
-            );
-        }
         // The whole blank is formed: every node placed, none inside the punch where it ends.
         assert_eq!(net["status"]["placed"], 61 * 21, "{}", net["status"]);
-        for p in net["nodes"].as_array().unwrap() {
-            let p: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-            let inside = r - (p[0] * p[0] + p[2] * p[2]).sqrt();
-            assert!(p[2] < 0.0 || inside < 1e-6 * r, "node {p:?} is inside the punch by {inside} m");
-            // Outside the opening the binder holds the blank in its plane (where the punch's top
-            // stood at the start).
-            if p[0].abs() > a + spacing {
-                assert!((p[2] - (r - h)).abs() < 1e-9, "node {p:?} left the binder's plane");
-            }
-        }
+        assert_drawn_in_over_the_slot(&row, &net, &stdout, (r, h, a), spacing, "");
     }
 }
 
@@ -87,20 +110,11 @@ fn a_punch_rising_into_a_clamped_blank_draws_in_its_path_over_the_punch() {
 /// radii, strokes, openings, grids and level counts than the test above.
 #[test]
 fn a_blank_formed_coarse_to_fine_draws_in_its_path_over_the_punch() {
-    const DRAW_IN_SHARE: f64 = 0.02;
     for (r, h, a, levels, [nu, nv]) in [(0.045, 0.03, 0.09, 1, [61, 21]), (0.06, 0.035, 0.1, 2, [81, 25])] {
         let tmp = tempfile::tempdir().unwrap();
         let punch = shapes::cylinder(r, 0.2, std::f64::consts::PI, 96, 40);
         let spacing = 0.004;
-        let scene = format!(
-            "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
-             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
-             material = \"{card}\"\nspacing = {spacing}\ngrid = [{nu}, {nv}]\nmethod = \"mechanical\"\n\
-             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {h}]\nmax_iterations = 2000\n\
-             coarse_levels = {levels}\n\
-             [ply.binder]\npressure = 2.0e3\noutline = [[-{a}, -1.0], [{a}, -1.0], [{a}, 1.0], [-{a}, 1.0]]\n",
-            card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
-        );
+        let scene = slot_scene(r, h, a, spacing, [nu, nv], &format!("coarse_levels = {levels}\n"));
         let (stdout, row, net) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
         assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
         assert_eq!(net["spacing"], spacing);
@@ -115,25 +129,8 @@ fn a_blank_formed_coarse_to_fine_draws_in_its_path_over_the_punch() {
             assert_eq!(level["increments"].as_u64().unwrap() == 1, k > 0, "{level}");
         }
         assert_eq!(record["increments"], steps[0]["increments"]);
-        let draw_in: DrawIn = serde_json::from_value(row["draw_in"].clone()).unwrap();
-        let exact = half_path(r, h, a) - a;
-        let along_warp: Vec<f64> =
-            draw_in.edges.iter().filter(|e| e.line.is_fibre() && e.flat_m > 0.1).map(|e| e.draw_in_m).collect();
-        assert_eq!(along_warp.len(), 2, "{draw_in:?}");
-        for d in &along_warp {
-            assert!(
-                (d - exact).abs() < DRAW_IN_SHARE * exact,
-                "R {r}, stroke {h}, opening {a}, {levels} levels: the edge drew in {d} m, exactly {exact} m\n{stdout}"
-            );
-        }
-        for p in net["nodes"].as_array().unwrap() {
-            let p: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-            let inside = r - (p[0] * p[0] + p[2] * p[2]).sqrt();
-            assert!(p[2] < 0.0 || inside < 1e-6 * r, "node {p:?} is inside the punch by {inside} m");
-            if p[0].abs() > a + 2.0 * spacing * (1 << levels) as f64 {
-                assert!((p[2] - (r - h)).abs() < 1e-9, "node {p:?} left the binder's plane");
-            }
-        }
+        let beyond = 2.0 * spacing * (1 << levels) as f64;
+        assert_drawn_in_over_the_slot(&row, &net, &stdout, (r, h, a), beyond, &format!(", {levels} levels"));
         assert!(stdout.contains("formed coarse to fine"), "{stdout}");
         // Held again by its tools (`drape refine`), the formed net stays where it is.
         let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml");
