@@ -524,12 +524,19 @@ impl SheetLayout {
     }
 }
 
+/// A sheet that first touches the tool where the tool's unit normal makes a cosine below minus
+/// this with the sheet's normal comes down on the back of its facets (refused). Any facet the
+/// first touch of a sheet from outside meets faces it (cosine >= 0) on a tool whose normals point
+/// out of the part; the margin lets a touch on an edge between facets pass.
+pub const BACK_FACING: f64 = 0.1;
+
 /// A flat sheet laid over `tool` as seed 000 starts its drapes: an `nu x nv` grid of spacing
 /// `d` in the plane with unit normal `normal`, its origin node over `centre` and its warp along
 /// `warp` (projected into the plane), moved along the normal until it just touches the tool
 /// (the first node whose drop along `-normal` meets the tool comes to rest on it). With a seam,
 /// the two sheets meet at the stitch line and their allowances hang from it along `-normal`,
-/// the origin node is on the stitch line.
+/// the origin node is on the stitch line. A sheet that would come down on the back of the
+/// tool's facets is refused ([`BACK_FACING`]).
 #[allow(clippy::too_many_arguments)]
 pub fn flat_sheet(
     name: &str,
@@ -579,13 +586,37 @@ pub fn flat_sheet(
     let lowest = positions.iter().map(|p| n.dot(&(p - centre))).fold(f64::INFINITY, f64::min);
     let lift = top - lowest + d;
     positions.iter_mut().for_each(|p| *p += n * lift);
-    let drop = positions.iter().filter_map(|p| tool.cast_ray(p, &-n)).fold(f64::INFINITY, f64::min);
+    let (first, drop) = positions
+        .iter()
+        .enumerate()
+        .filter_map(|(k, p)| tool.cast_ray(p, &-n).map(|t| (k, t)))
+        .fold((0, f64::INFINITY), |best, hit| if hit.1 < best.1 { hit } else { best });
     if !drop.is_finite() {
         return Err(SheetError(
             "the sheet does not lie over the tool: no node drops onto it along the sheet's normal; move its centre over the tool".into(),
         ));
     }
     positions.iter_mut().for_each(|p| *p -= n * drop);
+    // Contact keeps the ply on the side the tool's normals point to: a sheet coming down on the
+    // back of the facets would be pushed through the tool (a sphere wound inward took the whole
+    // sheet for inside it and stopped without equilibrium, its fibres stretched 1,000-fold).
+    let touched = tool.closest_point(&positions[first]);
+    let facing = touched.normal.dot(&n);
+    if facing < -BACK_FACING {
+        let (i, j) = (first / nv, first % nv);
+        let at = touched.point;
+        return Err(SheetError(format!(
+            "the sheet comes down on the back of the tool: where it first touches it (node ({i}, {j}), at \
+             ({:.4}, {:.4}, {:.4})) the tool's facets face away from the sheet (their normal makes {:.0} deg with \
+             the sheet's normal), and the ply is kept on the side the normals point to. If the tool's file \
+             faces into the part, give stack_side = \"opposite\" (or turn its triangles over); if the sheet \
+             belongs on the other side of the tool, turn sheet_normal round",
+            at.x,
+            at.y,
+            at.z,
+            facing.clamp(-1.0, 1.0).acos().to_degrees()
+        )));
+    }
     let mut net = DrapeNet::new(name, d, nu, nv, origin_node);
     net.positions = positions;
     net.status = vec![NodeStatus::Placed; nu * nv];
