@@ -481,7 +481,7 @@ fn a_ply_sheared_past_its_collapse_is_exported_at_the_collapse_not_as_a_spike() 
             };
             assert!((field("thickness") - t).abs() < 1e-9 * t, "{shear_deg} deg {cavity}: {text}");
             assert!((field("vf") - vf).abs() < 1e-9, "{shear_deg} deg {cavity}: {text}");
-            let said = stdout.contains(&format!("1 elements lie on cells of the drape sheared past {collapse} deg"));
+            let said = stdout.contains(&format!("1 element lies on cells of the drape sheared past {collapse} deg"));
             assert_eq!(said, shear_deg > collapse, "{shear_deg} deg: {stdout}");
         }
     }

@@ -84,10 +84,10 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     let net = read_net(&a.net).map_err(input)?;
     let done = export_net(&net, &a.mesh, &a.out, &plan, &options, &mut |n| eprintln!("note: {n}"))?;
     println!(
-        "flow mesh {}: {} nodes, {} elements (read in {:.1} ms)",
+        "flow mesh {}: {} nodes, {} (read in {:.1} ms)",
         a.mesh.display(),
         done.mesh.nodes.len(),
-        done.mesh.elements.len(),
+        elements(done.mesh.elements.len()),
         done.read_ms
     );
     println!("{}", coverage_line(&done.map));
@@ -98,30 +98,42 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// "1 element", "2 elements".
+pub(crate) fn elements(n: usize) -> String {
+    format!("{n} element{}", if n == 1 { "" } else { "s" })
+}
+
 /// One line on a mapped ply: elements covered and their shear.
 pub(crate) fn coverage_line(ply: &PlyMap) -> String {
     let c = ply.coverage();
     let share = 100.0 * c.covered as f64 / c.elements.max(1) as f64;
     let mut line = format!(
-        "  ply {}: covers {} of {} elements ({share:.1}%); |shear| max {:.2} deg, mean {:.2} deg",
-        ply.ply, c.covered, c.elements, c.max_abs_shear_deg, c.mean_abs_shear_deg
+        "  ply {}: covers {} of {} ({share:.1}%); |shear| max {:.2} deg, mean {:.2} deg",
+        ply.ply,
+        c.covered,
+        elements(c.elements),
+        c.max_abs_shear_deg,
+        c.mean_abs_shear_deg
     );
     if c.covered < c.elements {
         line += &format!(
-            "; note: the ply covers only part of the flow mesh, {} element(s) lie outside it and carry no fibre data",
-            c.elements - c.covered
+            "; note: the ply covers only part of the flow mesh, {} outside it carr{} no fibre data",
+            elements(c.elements - c.covered),
+            if c.elements - c.covered == 1 { "ies" } else { "y" }
         );
     }
     if c.collapsed > 0 {
         line += &format!(
-            "; {} elements lie on cells of the drape sheared past {COLLAPSED_SHEAR_DEG} deg (collapsed or folded: the fabric bunches there): their thickness and Vf are written as at {COLLAPSED_SHEAR_DEG} deg",
-            c.collapsed
+            "; {} lie{} on cells of the drape sheared past {COLLAPSED_SHEAR_DEG} deg (collapsed or folded: the fabric bunches there): {} thickness and Vf are written as at {COLLAPSED_SHEAR_DEG} deg",
+            elements(c.collapsed),
+            if c.collapsed == 1 { "s" } else { "" },
+            if c.collapsed == 1 { "its" } else { "their" }
         );
     }
     if c.capped > 0 {
         line += &format!(
-            "; Vf0 / cos(shear) passes the fibre packing limit in {} elements: Vf written as {VF_CAP:.4} there (the fabric locks before that)",
-            c.capped
+            "; Vf0 / cos(shear) passes the fibre packing limit in {}: Vf written as {VF_CAP:.4} there (the fabric locks before that)",
+            elements(c.capped)
         );
     }
     line

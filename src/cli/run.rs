@@ -118,11 +118,11 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
         Event::FlowNote(n) => println!("note: {n}"),
         Event::FlowMapped { path, mesh, map, ms } => {
             println!(
-                "flow mesh {}: {} nodes, {} elements; mapped {} plies in {:.1} ms",
+                "flow mesh {}: {} nodes, {}; mapped {} in {:.1} ms",
                 path.display(),
                 mesh.nodes.len(),
-                mesh.elements.len(),
-                map.plies.len(),
+                super::export::elements(mesh.elements.len()),
+                if map.plies.len() == 1 { "1 ply".to_string() } else { format!("{} plies", map.plies.len()) },
                 ms
             );
             for ply in &map.plies {
