@@ -589,6 +589,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                     reach = MAX_STEP_SPACINGS;
                     prefer_convex = false;
                     newton_tail = false;
+                    middling_run = 0;
                     residual = residual_of(&red, &state, force_scale);
                     continue;
                 }
