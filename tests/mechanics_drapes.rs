@@ -425,7 +425,7 @@ fn every_ply_of_the_hemisphere_layup_presses_to_equilibrium_on_the_stack_below_i
 /// (Before: the bundled sphere's sheet at 3 cm on its file turned over stopped without
 /// equilibrium after 16 s with its fibres stretched, energy 0.6 J -> 2,800 J.) Two generated
 /// spheres and a plate, other sizes and ply angles; the seed's soft fabric, as stiffer cards on
-/// a sphere this small do not settle yet (see the stop notes).
+/// a sphere this small do not settle yet (docs/ARCHITECTURE.md, "Open" under the blocking).
 #[test]
 fn a_sheet_dropped_on_the_back_of_the_tool_is_refused_and_drapes_as_on_the_front_on_the_other_side() {
     use crate::common::{read_json, refused_scene, run_scene, write_scene};
