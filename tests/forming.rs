@@ -184,23 +184,9 @@ fn a_hemisphere_formed_coarse_to_fine_keeps_its_symmetries_and_gains_the_finer_g
     const SMOOTH_SHARE: f64 = 1e-4;
     let (r, stroke, n, spacing) = (0.07, 0.04, 29, 0.008);
     let punch = shapes::hemisphere(r, 24);
-    let opening: Vec<String> = (0..24)
-        .map(|k| {
-            let t = std::f64::consts::TAU * k as f64 / 24.0;
-            format!("[{:.6}, {:.6}]", 0.095 * t.cos(), 0.095 * t.sin())
-        })
-        .collect();
     let form = |n: usize, spacing: f64, levels: usize| {
         let tmp = tempfile::tempdir().unwrap();
-        let scene = format!(
-            "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
-             [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
-             material = \"{card}\"\nspacing = {spacing}\ngrid = [{n}, {n}]\nmethod = \"mechanical\"\n\
-             mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {stroke}]\nmax_iterations = 2000\n\
-             coarse_levels = {levels}\n[ply.binder]\npressure = 1.0e4\noutline = [{}]\n",
-            opening.join(", "),
-            card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
-        );
+        let scene = hemisphere_in_binder(r, stroke, n, spacing, 0.095, &format!("coarse_levels = {levels}\n"));
         let (stdout, _, net) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
         assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
         assert_eq!(net["status"]["placed"], n * n, "{}", net["status"]);
@@ -296,21 +282,7 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
     let (r, stroke, n, spacing) = (0.06, 0.035, 25, 0.01);
     let tmp = tempfile::tempdir().unwrap();
     let punch = shapes::hemisphere(r, 24);
-    let opening: Vec<String> = (0..24)
-        .map(|k| {
-            let t = std::f64::consts::TAU * k as f64 / 24.0;
-            format!("[{:.6}, {:.6}]", 0.085 * t.cos(), 0.085 * t.sin())
-        })
-        .collect();
-    let scene = format!(
-        "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
-         [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
-         material = \"{card}\"\nspacing = {spacing}\ngrid = [{n}, {n}]\nmethod = \"mechanical\"\n\
-         mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {stroke}]\nmax_iterations = 2000\n\
-         [ply.binder]\npressure = 1.0e4\noutline = [{}]\n",
-        opening.join(", "),
-        card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
-    );
+    let scene = hemisphere_in_binder(r, stroke, n, spacing, 0.085, "");
     let (stdout, row, net) = run(tmp.path(), &[("punch.obj", &punch)], &scene);
     assert_eq!(net["meta"]["solver"]["converged"], true, "{stdout}");
     assert_eq!(net["status"]["placed"], n * n, "{}", net["status"]);
@@ -351,6 +323,27 @@ fn a_hemisphere_formed_from_a_clamped_blank_keeps_the_set_ups_symmetries() {
         svg.contains("the binder&apos;s opening") || svg.contains("the binder's opening"),
         "no binder in the draw-in picture"
     );
+}
+
+/// A scene: a hemispherical punch (`punch.obj`, radius `r`) rising `stroke` through a binder's
+/// round opening of radius `opening` (24 sides) that clamps a flat glass blank of `n` x `n`
+/// nodes at `spacing` at 10 kPa, friction 0.2; `extra` lines join the ply's keys.
+fn hemisphere_in_binder(r: f64, stroke: f64, n: usize, spacing: f64, opening: f64, extra: &str) -> String {
+    let outline: Vec<String> = (0..24)
+        .map(|k| {
+            let t = std::f64::consts::TAU * k as f64 / 24.0;
+            format!("[{:.6}, {:.6}]", opening * t.cos(), opening * t.sin())
+        })
+        .collect();
+    format!(
+        "units = \"m\"\ntool = \"punch.obj\"\nfriction = 0.2\n\
+         [[ply]]\nname = \"p\"\norigin = [0.0, 0.0, {r}]\nwarp = [1.0, 0.0, 0.0]\n\
+         material = \"{card}\"\nspacing = {spacing}\ngrid = [{n}, {n}]\nmethod = \"mechanical\"\n\
+         mode = \"pressed\"\nstart = \"flat\"\nstroke = [0.0, 0.0, {stroke}]\nmax_iterations = 2000\n\
+         {extra}[ply.binder]\npressure = 1.0e4\noutline = [{}]\n",
+        outline.join(", "),
+        card = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/glass-plain-weave.toml").display()
+    )
 }
 
 /// The binder's opening round a double dome's body: a stadium `clearance` outside its foot, in
