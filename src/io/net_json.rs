@@ -294,6 +294,9 @@ pub fn read_net(path: &Path) -> Result<DrapeNet, ExportError> {
     let mut net = DrapeNet::new(&f.ply, f.spacing, nu, nv, (i0, j0));
     net.method = f.method;
     net.meta = f.meta;
+    // Kept sorted, as `DrapeNet::cell_cut` searches them (a file edited by hand may not be).
+    net.meta.cut_cells.sort_unstable();
+    net.meta.cut_cells.dedup();
     net.timing = Timing {
         load_ms: f.timing_ms.load,
         generators_ms: f.timing_ms.generators,

@@ -155,10 +155,20 @@ impl DrapeNet {
         (self.nu - 1) * (self.nv - 1)
     }
 
-    /// The four corners of cell (i, j) if all are placed: [(i,j), (i+1,j), (i,j+1), (i+1,j+1)].
+    /// The four corners of cell (i, j) if all are placed and the sheet was not cut through it
+    /// ([`Provenance::cut_cells`]): [(i,j), (i+1,j), (i,j+1), (i+1,j+1)].
     #[inline]
     pub fn cell_corners(&self, i: usize, j: usize) -> Option<[Point; 4]> {
+        if self.cell_cut(i, j) {
+            return None;
+        }
         Some([self.node(i, j)?, self.node(i + 1, j)?, self.node(i, j + 1)?, self.node(i + 1, j + 1)?])
+    }
+
+    /// Whether the sheet was cut through cell (i, j) ([`Provenance::cut_cells`], kept sorted).
+    #[inline]
+    pub fn cell_cut(&self, i: usize, j: usize) -> bool {
+        !self.meta.cut_cells.is_empty() && self.meta.cut_cells.binary_search(&[i, j]).is_ok()
     }
 
     /// Mean shear angle of cell (i, j) in radians: the mean over its four corners of

@@ -73,6 +73,11 @@ pub struct Provenance {
     /// ([`super::wrinkle`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wrinkles: Option<WrinkleRecord>,
+    /// Cells the sheet was cut through (a `[[ply.cut]]`, the edge between a seam's two sheets, a
+    /// cell the blank leaves out), as `[i, j]`, sorted: no fabric lies there, so they have no
+    /// shear, frame or any other cell value, whatever their corners ([`super::DrapeNet::cell_corners`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cut_cells: Vec<[usize; 2]>,
     /// For a blank formed by tools in motion: the stroke, the die and the binder it was formed
     /// with.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -518,6 +518,7 @@ fn refine_among<L: Laws + ?Sized>(
         return Err(RefineError::Empty);
     }
     let stitched = layout.as_ref().map(|l| l.stitched.clone());
+    let cut_cells = layout.as_ref().map(|l| l.cut_cells()).unwrap_or_default();
     let mut grid = Grid::with_active(kinematic.nu, kinematic.nv, kinematic.spacing, active.clone());
     if let Some(layout) = layout {
         grid = grid.with_sheet(layout);
@@ -807,6 +808,7 @@ fn refine_among<L: Laws + ?Sized>(
     let contact = contact_record(&objective, &lag, &x, &slid, (&active, &held, held_nodes), settings, &slide);
     let mut net = kinematic.clone();
     net.method = Method::Mechanical;
+    net.meta.cut_cells = cut_cells;
     for (k, p) in x.iter().enumerate() {
         if active[k] {
             net.positions[k] = *p;

@@ -493,6 +493,11 @@ impl SheetLayout {
     pub fn cell_cut(&self, i: usize, j: usize) -> bool {
         self.cell_cut[i * (self.nv - 1) + j]
     }
+    /// The cells removed, as `[i, j]`, sorted (what [`crate::kinematic::Provenance::cut_cells`] records).
+    pub fn cut_cells(&self) -> Vec<[usize; 2]> {
+        let cv = self.nv.saturating_sub(1);
+        self.cell_cut.iter().enumerate().filter(|(_, c)| **c).map(|(k, _)| [k / cv, k % cv]).collect()
+    }
     /// Whether no warp bending triple is centred on node (i, j).
     #[inline]
     pub fn warp_hinge(&self, i: usize, j: usize) -> bool {
