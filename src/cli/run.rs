@@ -102,8 +102,8 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
         }
         Event::CuttingPlan { pieces, nesting, files } => {
             println!(
-                "flat patterns: {} pieces, {:.4} m^2 of fabric on {:.3} m of a {:.3} m roll ({:.4} m^2 used, {:.1}% waste)",
-                pieces,
+                "flat patterns: {pieces} piece{}, {:.4} m^2 of fabric on {:.3} m of a {:.3} m roll ({:.4} m^2 used, {:.1}% waste)",
+                if pieces == 1 { "" } else { "s" },
                 nesting.pattern_area,
                 nesting.length,
                 nesting.roll_width,

@@ -403,7 +403,8 @@ impl ContactSummary {
                 None => format!("friction {}", self.friction),
             }
         };
-        let mut s = format!("{grip}: {} nodes stick, {} slip, {} free", self.stick, self.slip, self.free);
+        let nodes = if self.stick == 1 { "node sticks" } else { "nodes stick" };
+        let mut s = format!("{grip}: {} {nodes}, {} slip, {} free", self.stick, self.slip, self.free);
         if self.held > 0 {
             s += &format!(", {} held", self.held);
         }
