@@ -15,9 +15,10 @@
 //!    quadratic convergence. A step that is not a descent direction of a convex model (negative
 //!    curvature) raises the shift.
 //! 3. The trial state moves pressed nodes back onto the tool and free nodes that would enter it
-//!    onto its surface. On a moving tool, a free node touching it that the step moves into it is
-//!    first held on the tool and the step solved again ([`block_entering`]: its pull was outward
-//!    where the model was built, so the model knew nothing of the tool there). It is accepted
+//!    onto its surface. On a moving tool (on one standing still: a node the tool keeps letting
+//!    go), a free node touching it that the step moves into it is first held on the tool and the
+//!    step solved again ([`block_entering`]: its pull was outward where the model was built, so
+//!    the model knew nothing of the tool there). It is accepted
 //!    when the energy falls by a fair part of the model's prediction. If not, a second-order
 //!    correction (a Newton step from the trial state with the same model) is tried first:
 //!    stiff, nearly inextensible fibres make the energy a narrow
@@ -512,6 +513,11 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
     let mut newton_tail = false;
     // Accepted steps in a row that were tiny and only middlingly predicted (`MIDDLING_RUN`).
     let mut middling_run = 0usize;
+    // Per node: how often the tool let it go (it slid on the tool at one state and not at the
+    // next), and whether it was let go again at this state after earlier ones
+    // ([`RELEASES_BEFORE_BLOCKING`]).
+    let mut releases = vec![0u32; n];
+    let mut cycling = vec![false; n];
     let mut it = 0;
     loop {
         if residual <= settings.tolerance || red.is_empty() {
@@ -682,7 +688,7 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
                 // them back on its face, a jump the model did not predict that refuses the step
                 // rung after rung. Instead they slide on the tool, and the step is solved again.
                 let delta = red.expand(&y, &state.bases);
-                if block_entering(cons, &rep, &mut state, &delta) {
+                if block_entering(cons, &rep, &mut state, &delta, &cycling) {
                     blocked_solves += 1;
                     // Nodes that were free now slide on the tool, which the step before did not
                     // let them: the re-solved step may carry the ply farther over the tool than
@@ -813,7 +819,13 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
             Some((trial, feet, ratio, corrected)) => {
                 let step = x.iter().zip(&trial).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max) / cons.spacing;
                 x.copy_from_slice(&trial);
+                let slid = std::mem::take(&mut state.sliding);
                 state = adopt(objective, cons, &rep, &full, &pairs, x, Some(feet), &mut red);
+                for (k, (&was, &is)) in slid.iter().zip(&state.sliding).enumerate() {
+                    let let_go = was && !is;
+                    releases[k] += u32::from(let_go);
+                    cycling[k] = let_go && releases[k] >= RELEASES_BEFORE_BLOCKING;
+                }
                 let middling =
                     (MIDDLING_RATIO..GOOD_RATIO).contains(&ratio) && step <= LAGGED_STEP_SPACINGS && !corrected;
                 middling_run = if middling { middling_run + 1 } else { 0 };
@@ -954,21 +966,32 @@ pub fn solve(objective: &dyn Objective, x: &mut [Point], cons: &Constraints, set
 /// Most re-solves of one iteration with the nodes its step pushed into the tool held on it
 /// ([`block_entering`]).
 const MAX_BLOCKED_SOLVES: usize = 3;
+/// A free node on a tool that stands still is blocked ([`block_entering`]) once the tool lets it
+/// go for the second time: let go, caught again and let go once more, it is cycling. Its push on
+/// the tool changes sign from one state to the next while the rest of the ply moves (a stiff
+/// sheet balanced on a sphere's pole bending down round it), and each time it is free the step
+/// carries it into the tool, whose face puts it back: a jump the model did not predict, refused
+/// rung after rung (carbon twill on a sphere of R = 0.1 m: 3,000 iterations, unconverged; now
+/// 448). The first release is left alone: a node lifting off for good (the ply leaving a rod
+/// where it hangs) is let go once, and blocking it changed the path a strip runs off a rod.
+const RELEASES_BEFORE_BLOCKING: u32 = 2;
 
 /// Free contact on a moving tool: the free nodes that touch it and that `delta` moves into it
 /// slide on it from now on in this iteration (their basis loses the tool's normal). Whether any
 /// did. Only where the tool moves ([`ContactSurface::moving`]): a punch advancing pushes into
 /// nodes that touch it in every increment of the stroke (forming's iterations fell by 15 to
-/// 40%); on a tool that stands still it was neutral (free drapes of a sphere) and changed the
-/// path a strip running off a rod takes, and with it the friction it was estimated to need
-/// (docs/ARCHITECTURE.md).
-fn block_entering(cons: &Constraints, rep: &[usize], s: &mut State, delta: &[Vector]) -> bool {
-    let Some(tool) = cons.tool.filter(|t| cons.mode == ContactMode::Free && !cons.stick && t.moving()) else {
+/// 40%). On a tool that stands still, only the nodes `cycling` marks: let go by the tool again
+/// at this state ([`RELEASES_BEFORE_BLOCKING`]). Blocking every node there was neutral on free
+/// drapes of a sphere and changed the path a strip running off a rod takes, and with it the
+/// friction it was estimated to need (docs/ARCHITECTURE.md).
+fn block_entering(cons: &Constraints, rep: &[usize], s: &mut State, delta: &[Vector], cycling: &[bool]) -> bool {
+    let Some(tool) = cons.tool.filter(|_| cons.mode == ContactMode::Free && !cons.stick) else {
         return false;
     };
+    let moving = tool.moving();
     let mut any = false;
     for k in 0..rep.len() {
-        if rep[k] != k || s.sliding[k] || s.bases[k].dofs == 0 {
+        if rep[k] != k || s.sliding[k] || s.bases[k].dofs == 0 || !(moving || cycling[k]) {
             continue;
         }
         let Some(foot) = s.feet[k].as_mut() else { continue };
