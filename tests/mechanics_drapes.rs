@@ -289,6 +289,26 @@ fn sheet_variants_over_the_sphere_converge_and_do_what_they_say() {
         let back = drape::io::read_net(&dir.path().join("sheet.drape.json")).unwrap();
         assert_eq!(back.meta.cut_cells, net.meta.cut_cells);
         assert_eq!(back.cell_shears(), net.cell_shears());
+        // `drape refine` does not know the cuts themselves: it refuses to join the sheet
+        // across them and says how to drape it again.
+        let refine = Command::cargo_bin("drape")
+            .unwrap()
+            .arg("refine")
+            .arg("--net")
+            .arg(dir.path().join("sheet.drape.json"))
+            .arg("--tool")
+            .arg(repo("geometries/sphere/sphere.obj"))
+            .arg("--material")
+            .arg(repo("materials/sze-liu-table1.toml"))
+            .args(["--mode", "free", "--friction", "0.3", "--out"])
+            .arg(dir.path().join("again"))
+            .assert()
+            .code(2);
+        let err = String::from_utf8_lossy(&refine.get_output().stderr).to_string();
+        let count = format!("cut through {} cells", net.meta.cut_cells.len());
+        for says in [count.as_str(), "meta.cut_cells", "drape run"] {
+            assert!(err.contains(says), "the refusal does not say '{says}': {err}");
+        }
     }
 }
 

@@ -126,13 +126,33 @@ impl RefineOptions {
             }
             None => None,
         };
+        // The cuts and seams a sheet was draped with are not in the net, only the cells they
+        // cut through: refined without them, the sheet would be joined across them.
+        let sheet = SheetFeatures { blank, ..Default::default() };
+        if !net.meta.cut_cells.is_empty() {
+            let known = match &sheet.blank {
+                Some(_) => sheet.layout(net.nu, net.nv, net.spacing, net.origin_node).map(|l| l.cut_cells()),
+                None => Ok(Vec::new()),
+            }
+            .unwrap_or_default();
+            let unknown = net.meta.cut_cells.iter().filter(|c| known.binary_search(c).is_err()).count();
+            if unknown > 0 {
+                return Err(input(anyhow::anyhow!(
+                    "ply '{}' was draped as a sheet cut through {unknown} cell{} (a [[ply.cut]], a seam or a blank: \
+                     meta.cut_cells), and the net does not record the cuts themselves: refined here, the sheet \
+                     would be joined across them. Drape it again with its scene: drape run SCENE",
+                    net.name,
+                    if unknown == 1 { "" } else { "s" }
+                )));
+            }
+        }
         Ok(RefineSettings {
             mode: self.mode,
             pressed_surface: if self.facets { PressedSurface::Facets } else { PressedSurface::Smooth },
             gravity: Vector::from(self.gravity),
             load_steps: self.load_steps,
             solver: SolverSettings::default().max_iterations(self.max_iterations).escape_saddles(self.escape_saddles),
-            sheet: SheetFeatures { blank, ..Default::default() },
+            sheet,
             stick: self.stick,
             friction,
             holds: self
