@@ -976,12 +976,12 @@ const MAX_BLOCKED_SOLVES: usize = 3;
 /// where it hangs) is let go once, and blocking it changed the path a strip runs off a rod.
 const RELEASES_BEFORE_BLOCKING: u32 = 2;
 
-/// Free contact on a moving tool: the free nodes that touch it and that `delta` moves into it
-/// slide on it from now on in this iteration (their basis loses the tool's normal). Whether any
-/// did. Only where the tool moves ([`ContactSurface::moving`]): a punch advancing pushes into
+/// Free contact: the free nodes that touch the tool and that `delta` moves into it slide on it
+/// from now on in this iteration (their basis loses the tool's normal). Whether any did. On a
+/// tool that moves ([`ContactSurface::moving`]) every such node: a punch advancing pushes into
 /// nodes that touch it in every increment of the stroke (forming's iterations fell by 15 to
-/// 40%). On a tool that stands still, only the nodes `cycling` marks: let go by the tool again
-/// at this state ([`RELEASES_BEFORE_BLOCKING`]). Blocking every node there was neutral on free
+/// 40%). On a tool that stands still only the nodes `cycling` marks, let go by the tool again at
+/// this state ([`RELEASES_BEFORE_BLOCKING`]): blocking every node there was neutral on free
 /// drapes of a sphere and changed the path a strip running off a rod takes, and with it the
 /// friction it was estimated to need (docs/ARCHITECTURE.md).
 fn block_entering(cons: &Constraints, rep: &[usize], s: &mut State, delta: &[Vector], cycling: &[bool]) -> bool {
