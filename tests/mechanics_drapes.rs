@@ -274,10 +274,14 @@ fn sheet_variants_over_the_sphere_converge_and_do_what_they_say() {
     // net says which, they have no cell values, and the net is written (before: `drape run`
     // refused to write the bundled seam and cut scenes after solving them, a cut cell having a
     // shear but no bending energy).
-    for (r, cut_cells) in
-        [(&cut[0], (8..22).map(|i| [i, 28]).collect::<Vec<_>>()), (&seam[0], (0..n - 1).map(|j| [15, j]).collect())]
-    {
+    use drape::kinematic::provenance::SheetFeature;
+    for (r, cut_cells, feature) in [
+        (&cut[0], (8..22).map(|i| [i, 28]).collect::<Vec<_>>(), SheetFeature::Cut),
+        (&seam[0], (0..n - 1).map(|j| [15, j]).collect(), SheetFeature::Seam),
+        (&fold[0], Vec::new(), SheetFeature::Fold),
+    ] {
         let net = &r.net;
+        assert_eq!(net.meta.sheet_features, [feature]);
         for [i, j] in &cut_cells {
             assert!(net.meta.cut_cells.contains(&[*i, *j]), "cell ({i}, {j}) is not recorded as cut");
         }
@@ -289,8 +293,8 @@ fn sheet_variants_over_the_sphere_converge_and_do_what_they_say() {
         let back = drape::io::read_net(&dir.path().join("sheet.drape.json")).unwrap();
         assert_eq!(back.meta.cut_cells, net.meta.cut_cells);
         assert_eq!(back.cell_shears(), net.cell_shears());
-        // `drape refine` does not know the cuts themselves: it refuses to join the sheet
-        // across them and says how to drape it again.
+        // `drape refine` does not know the features themselves: it refuses to join the sheet
+        // across its cuts and seams or to drop its fold, and says how to drape it again.
         let refine = Command::cargo_bin("drape")
             .unwrap()
             .arg("refine")
@@ -305,8 +309,8 @@ fn sheet_variants_over_the_sphere_converge_and_do_what_they_say() {
             .assert()
             .code(2);
         let err = String::from_utf8_lossy(&refine.get_output().stderr).to_string();
-        let count = format!("cut through {} cells", net.meta.cut_cells.len());
-        for says in [count.as_str(), "meta.cut_cells", "drape run"] {
+        let feature = format!("scene's {}", feature.name());
+        for says in [feature.as_str(), "meta.sheet_features", "drape run"] {
             assert!(err.contains(says), "the refusal does not say '{says}': {err}");
         }
     }

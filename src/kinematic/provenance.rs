@@ -78,6 +78,11 @@ pub struct Provenance {
     /// shear, frame or any other cell value, whatever their corners ([`super::DrapeNet::cell_corners`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cut_cells: Vec<[usize; 2]>,
+    /// The features of the flat sheet a mechanical ply was draped as (seed 000's sheets, a
+    /// blank): the net records that they were there, not the features themselves, which its
+    /// scene gives (`drape refine` refuses a net it could not draw them from).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sheet_features: Vec<SheetFeature>,
     /// For a blank formed by tools in motion: the stroke, the die and the binder it was formed
     /// with.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -411,6 +416,35 @@ impl ContactSummary {
         s +=
             &format!("; largest slip {:.2} mm, largest pressure {:.3} Pa", self.max_slip_m * 1e3, self.max_pressure_pa);
         s
+    }
+}
+
+/// A feature of the flat sheet a mechanical ply was draped as ([`Provenance::sheet_features`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SheetFeature {
+    /// Reinforced bands (`[[ply.reinforcement]]`).
+    Reinforcement,
+    /// Two sheets stitched together (`[ply.seam]`).
+    Seam,
+    /// A fold (`[ply.fold]`).
+    Fold,
+    /// Cuts (`[[ply.cut]]`).
+    Cut,
+    /// The sheet cut to a blank (`blank`).
+    Blank,
+}
+
+impl SheetFeature {
+    /// Its name, as the JSON writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SheetFeature::Reinforcement => "reinforcement",
+            SheetFeature::Seam => "seam",
+            SheetFeature::Fold => "fold",
+            SheetFeature::Cut => "cut",
+            SheetFeature::Blank => "blank",
+        }
     }
 }
 

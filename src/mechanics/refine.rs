@@ -809,6 +809,7 @@ fn refine_among<L: Laws + ?Sized>(
     let mut net = kinematic.clone();
     net.method = Method::Mechanical;
     net.meta.cut_cells = cut_cells;
+    net.meta.sheet_features = settings.sheet.kinds();
     for (k, p) in x.iter().enumerate() {
         if active[k] {
             net.positions[k] = *p;

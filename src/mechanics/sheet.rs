@@ -9,6 +9,7 @@
 //! tension, shear, bending and weight is multiplied by. The energy terms read the layout through
 //! [`super::energy::Grid`].
 use crate::geometry::{Point, ToolSurface, Vector};
+use crate::kinematic::provenance::SheetFeature;
 use crate::kinematic::{DrapeNet, NodeStatus};
 use std::fmt;
 
@@ -277,6 +278,21 @@ pub struct SheetLayout {
 }
 
 impl SheetFeatures {
+    /// The kinds of feature the sheet has (what [`crate::kinematic::Provenance::sheet_features`]
+    /// records).
+    pub fn kinds(&self) -> Vec<SheetFeature> {
+        [
+            (!self.reinforcements.is_empty(), SheetFeature::Reinforcement),
+            (self.seam.is_some(), SheetFeature::Seam),
+            (self.fold.is_some(), SheetFeature::Fold),
+            (!self.cuts.is_empty(), SheetFeature::Cut),
+            (self.blank.is_some(), SheetFeature::Blank),
+        ]
+        .into_iter()
+        .filter_map(|(there, kind)| there.then_some(kind))
+        .collect()
+    }
+
     /// Whether there is anything to lay out.
     pub fn is_empty(&self) -> bool {
         self.reinforcements.is_empty()

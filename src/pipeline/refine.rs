@@ -3,7 +3,7 @@
 use super::failure::{compute, input, Failure};
 use super::unit_scale;
 use crate::geometry::{Point, ToolSurface, Vector};
-use crate::kinematic::provenance::{FormingRecord, StackSide};
+use crate::kinematic::provenance::{FormingRecord, SheetFeature, StackSide};
 use crate::kinematic::DrapeNet;
 use crate::material::MaterialCard;
 use crate::mechanics::forming::{die_facing, turned_over, Forming};
@@ -126,25 +126,25 @@ impl RefineOptions {
             }
             None => None,
         };
-        // The cuts and seams a sheet was draped with are not in the net, only the cells they
-        // cut through: refined without them, the sheet would be joined across them.
+        // The sheet's features are its scene's, not the net's (a formed blank's outline aside):
+        // refined without them, the sheet would be joined across its cuts and seams and lose its
+        // folds, reinforcements or blank.
         let sheet = SheetFeatures { blank, ..Default::default() };
-        if !net.meta.cut_cells.is_empty() {
-            let known = match &sheet.blank {
-                Some(_) => sheet.layout(net.nu, net.nv, net.spacing, net.origin_node).map(|l| l.cut_cells()),
-                None => Ok(Vec::new()),
-            }
-            .unwrap_or_default();
-            let unknown = net.meta.cut_cells.iter().filter(|c| known.binary_search(c).is_err()).count();
-            if unknown > 0 {
-                return Err(input(anyhow::anyhow!(
-                    "ply '{}' was draped as a sheet cut through {unknown} cell{} (a [[ply.cut]], a seam or a blank: \
-                     meta.cut_cells), and the net does not record the cuts themselves: refined here, the sheet \
-                     would be joined across them. Drape it again with its scene: drape run SCENE",
-                    net.name,
-                    if unknown == 1 { "" } else { "s" }
-                )));
-            }
+        let unknown: Vec<&str> = net
+            .meta
+            .sheet_features
+            .iter()
+            .filter(|f| !(**f == SheetFeature::Blank && sheet.blank.is_some()))
+            .map(|f| f.name())
+            .collect();
+        if !unknown.is_empty() {
+            return Err(input(anyhow::anyhow!(
+                "ply '{}' was draped as a flat sheet with its scene's {} (meta.sheet_features), which the net does not \
+                 record: refined here without them, the sheet would be joined across its cuts and seams and lose its \
+                 folds, reinforcements or blank. Drape it again with its scene: drape run SCENE",
+                net.name,
+                unknown.join(", ")
+            )));
         }
         Ok(RefineSettings {
             mode: self.mode,
