@@ -1,6 +1,6 @@
 //! `drape export --net NET.drape.json --mesh FLOW --format F --out PATH`: fibre orientations,
 //! shear, thickness and fibre volume fraction of one net on the user's resin-flow mesh.
-use super::{input, Failure};
+use super::{counted, input, Failure};
 use crate::io::read_net;
 use crate::mapping::PlyMap;
 use crate::material::flow::{Cavity, COLLAPSED_SHEAR_DEG, VF_CAP};
@@ -87,7 +87,7 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
         "flow mesh {}: {} nodes, {} (read in {:.1} ms)",
         a.mesh.display(),
         done.mesh.nodes.len(),
-        elements(done.mesh.elements.len()),
+        counted(done.mesh.elements.len(), "element", "elements"),
         done.read_ms
     );
     println!("{}", coverage_line(&done.map));
@@ -98,11 +98,6 @@ pub fn run(a: ExportArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// "1 element", "2 elements".
-pub(crate) fn elements(n: usize) -> String {
-    format!("{n} element{}", if n == 1 { "" } else { "s" })
-}
-
 /// One line on a mapped ply: elements covered and their shear.
 pub(crate) fn coverage_line(ply: &PlyMap) -> String {
     let c = ply.coverage();
@@ -111,21 +106,21 @@ pub(crate) fn coverage_line(ply: &PlyMap) -> String {
         "  ply {}: covers {} of {} ({share:.1}%); |shear| max {:.2} deg, mean {:.2} deg",
         ply.ply,
         c.covered,
-        elements(c.elements),
+        counted(c.elements, "element", "elements"),
         c.max_abs_shear_deg,
         c.mean_abs_shear_deg
     );
     if c.covered < c.elements {
         line += &format!(
             "; note: the ply covers only part of the flow mesh, {} outside it carr{} no fibre data",
-            elements(c.elements - c.covered),
+            counted(c.elements - c.covered, "element", "elements"),
             if c.elements - c.covered == 1 { "ies" } else { "y" }
         );
     }
     if c.collapsed > 0 {
         line += &format!(
             "; {} lie{} on cells of the drape sheared past {COLLAPSED_SHEAR_DEG} deg (collapsed or folded: the fabric bunches there): {} thickness and Vf are written as at {COLLAPSED_SHEAR_DEG} deg",
-            elements(c.collapsed),
+            counted(c.collapsed, "element", "elements"),
             if c.collapsed == 1 { "s" } else { "" },
             if c.collapsed == 1 { "its" } else { "their" }
         );
@@ -133,7 +128,7 @@ pub(crate) fn coverage_line(ply: &PlyMap) -> String {
     if c.capped > 0 {
         line += &format!(
             "; Vf0 / cos(shear) passes the fibre packing limit in {}: Vf written as {VF_CAP:.4} there (the fabric locks before that)",
-            elements(c.capped)
+            counted(c.capped, "element", "elements")
         );
     }
     line

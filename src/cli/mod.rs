@@ -68,6 +68,11 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     }
 }
 
+/// `n` and what it counts, in the singular for one: "1 element", "2 elements".
+pub(crate) fn counted(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 /// Parse `A,B` into two whole numbers.
 pub fn parse_pair(s: &str) -> Result<[usize; 2], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -102,8 +102,8 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
         }
         Event::CuttingPlan { pieces, nesting, files } => {
             println!(
-                "flat patterns: {pieces} piece{}, {:.4} m^2 of fabric on {:.3} m of a {:.3} m roll ({:.4} m^2 used, {:.1}% waste)",
-                if pieces == 1 { "" } else { "s" },
+                "flat patterns: {}, {:.4} m^2 of fabric on {:.3} m of a {:.3} m roll ({:.4} m^2 used, {:.1}% waste)",
+                super::counted(pieces, "piece", "pieces"),
                 nesting.pattern_area,
                 nesting.length,
                 nesting.roll_width,
@@ -121,8 +121,8 @@ fn print(event: Event, bar: &mut Option<ProgressBar>) {
                 "flow mesh {}: {} nodes, {}; mapped {} in {:.1} ms",
                 path.display(),
                 mesh.nodes.len(),
-                super::export::elements(mesh.elements.len()),
-                if map.plies.len() == 1 { "1 ply".to_string() } else { format!("{} plies", map.plies.len()) },
+                super::counted(mesh.elements.len(), "element", "elements"),
+                super::counted(map.plies.len(), "ply", "plies"),
                 ms
             );
             for ply in &map.plies {

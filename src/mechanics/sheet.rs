@@ -295,11 +295,7 @@ impl SheetFeatures {
 
     /// Whether there is anything to lay out.
     pub fn is_empty(&self) -> bool {
-        self.reinforcements.is_empty()
-            && self.seam.is_none()
-            && self.fold.is_none()
-            && self.cuts.is_empty()
-            && self.blank.is_none()
+        self.kinds().is_empty()
     }
 
     /// The features on an `nu x nv` grid of spacing `d` with its origin node at `origin`.
